@@ -1,0 +1,22 @@
+# Warning and code-generation flags shared by all fluxdrive targets.
+set(FD_WARNINGS -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes
+    -Wmissing-prototypes -Wconversion -Wno-sign-conversion)
+
+# The MCU core and app: single precision only (ARCHITECTURE.md, "Conventions").
+set(FD_CORE_FLAGS ${FD_WARNINGS} -Wdouble-promotion -fsingle-precision-constant
+    -Wfloat-equal -Wvla)
+
+option(FD_SANITIZE "Build with address and undefined-behaviour sanitizers" OFF)
+if(FD_SANITIZE AND NOT CMAKE_CROSSCOMPILING)
+  add_compile_options(-fsanitize=address,undefined -fno-sanitize-recover=all
+                      -fno-omit-frame-pointer)
+  add_link_options(-fsanitize=address,undefined)
+endif()
+
+function(fd_core_target tgt)
+  target_compile_options(${tgt} PRIVATE ${FD_CORE_FLAGS})
+endfunction()
+
+function(fd_host_target tgt)
+  target_compile_options(${tgt} PRIVATE ${FD_WARNINGS})
+endfunction()

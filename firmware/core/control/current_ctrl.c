@@ -1,0 +1,52 @@
+/*
+ * current_ctrl.c - dq current regulator (FOC baseline).
+ *
+ * Per axis: PI with kp = wc*L, ki = wc*Rs, so the PI zero cancels the
+ * electrical pole Rs/L and the loop is wc/s (closed loop wc/(s+wc), ignoring
+ * the computation and PWM delay). Cross-coupling and back-EMF are fed
+ * forward from the measured currents. Voltage limit: circle of radius v_max,
+ * d axis first (it sets the flux), q gets what is left; the PI integrators
+ * are clamped against these limits (see pi_ctrl.c), so they never wind up.
+ */
+#include "control/current_ctrl.h"
+
+#include <math.h>
+
+void current_ctrl_init(current_ctrl_t *cc, const current_ctrl_cfg_t *cfg) {
+  cc->cfg = *cfg;
+  const float wc = cfg->bandwidth;
+  pi_ctrl_init(&cc->pi_d, wc * cfg->ld, wc * cfg->rs, cfg->ts, -INFINITY, INFINITY);
+  pi_ctrl_init(&cc->pi_q, wc * cfg->lq, wc * cfg->rs, cfg->ts, -INFINITY, INFINITY);
+  cc->limited = 0;
+}
+
+void current_ctrl_reset(current_ctrl_t *cc) {
+  pi_ctrl_reset(&cc->pi_d, 0.0f);
+  pi_ctrl_reset(&cc->pi_q, 0.0f);
+  cc->limited = 0;
+}
+
+dq_t current_ctrl_update(current_ctrl_t *cc, dq_t i_ref, dq_t i, float we, float v_max) {
+  dq_t v = {0.0f, 0.0f};
+  if (!(v_max > 0.0f) || !isfinite(v_max)) {
+    cc->limited = 1; /* no voltage available: output zero, keep integrators */
+    return v;
+  }
+  if (!isfinite(we)) {
+    we = 0.0f;
+  }
+  const current_ctrl_cfg_t *c = &cc->cfg;
+  /* decoupling feed-forward: v = Rs i + L di/dt + we J lambda */
+  const float ff_d = -we * c->lq * i.q;
+  const float ff_q = we * (c->ld * i.d + c->lambda_m);
+
+  pi_ctrl_set_limits(&cc->pi_d, -v_max, v_max);
+  v.d = pi_ctrl_update(&cc->pi_d, i_ref.d - i.d, ff_d);
+  const float vq_room_sq = v_max * v_max - v.d * v.d;
+  const float vq_max = (vq_room_sq > 0.0f) ? sqrtf(vq_room_sq) : 0.0f;
+  pi_ctrl_set_limits(&cc->pi_q, -vq_max, vq_max);
+  v.q = pi_ctrl_update(&cc->pi_q, i_ref.q - i.q, ff_q);
+
+  cc->limited = (fabsf(v.d) >= v_max || fabsf(v.q) >= vq_max) ? 1 : 0;
+  return v;
+}

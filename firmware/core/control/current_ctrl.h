@@ -1,0 +1,35 @@
+/*
+ * current_ctrl.h - rotor-frame (dq) current regulator: the FOC baseline the
+ * papers compare against. Two PI regulators designed by pole-zero
+ * cancellation (kp = wc*L, ki = wc*Rs, closed loop ~ wc/(s+wc)), decoupling
+ * feed-forward (-we*Lq*iq on d; +we*(Ld*id + lambda_m) on q), and a circular
+ * voltage limit with d-axis priority; the integrators stop when limited.
+ */
+#ifndef FD_CONTROL_CURRENT_CTRL_H
+#define FD_CONTROL_CURRENT_CTRL_H
+
+#include "math/frames.h"
+#include "math/pi_ctrl.h"
+
+typedef struct {
+  float rs;        /* stator resistance [Ohm] */
+  float ld, lq;    /* inductances [H] */
+  float lambda_m;  /* PM flux linkage [Vs] */
+  float bandwidth; /* closed-loop bandwidth wc [rad/s] */
+  float ts;        /* sampling period [s] */
+} current_ctrl_cfg_t;
+
+typedef struct {
+  current_ctrl_cfg_t cfg;
+  pi_ctrl_t pi_d;
+  pi_ctrl_t pi_q;
+  int limited; /* 1 when the last output was on the voltage limit */
+} current_ctrl_t;
+
+void current_ctrl_init(current_ctrl_t *cc, const current_ctrl_cfg_t *cfg);
+void current_ctrl_reset(current_ctrl_t *cc);
+/* i_ref, i: dq currents [A]; we: electrical speed [rad/s]; v_max: available
+ * voltage amplitude [V]. Returns the dq voltage reference, |v| <= v_max. */
+dq_t current_ctrl_update(current_ctrl_t *cc, dq_t i_ref, dq_t i, float we, float v_max);
+
+#endif

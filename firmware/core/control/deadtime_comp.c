@@ -1,0 +1,51 @@
+/*
+ * deadtime_comp.c - predictive dead-time compensation, Rubino 2020, Fig. 8.
+ */
+#include "control/deadtime_comp.h"
+
+#include <math.h>
+#include <string.h>
+
+int deadtime_comp_init(deadtime_comp_t *d, const deadtime_comp_cfg_t *cfg) {
+  memset(d, 0, sizeof(*d));
+  if (!(isfinite(cfg->td) && cfg->td >= 0.0f && isfinite(cfg->ts) && cfg->ts > 0.0f &&
+        cfg->td < cfg->ts && isfinite(cfg->i_band) && cfg->i_band >= 0.0f)) {
+    return -1;
+  }
+  d->cfg = *cfg;
+  deadtime_comp_reset(d);
+  return 0;
+}
+
+void deadtime_comp_reset(deadtime_comp_t *d) {
+  d->dt_ratio = d->cfg.td / d->cfg.ts;
+}
+
+float deadtime_comp_sign(const deadtime_comp_t *d, float i) {
+  if (!isfinite(i)) {
+    return 0.0f;
+  }
+  if (i >= d->cfg.i_band) {
+    return (i > 0.0f) ? 1.0f : 0.0f; /* i_band = 0 and i = 0: no correction */
+  }
+  if (i <= -d->cfg.i_band) {
+    return (i < 0.0f) ? -1.0f : 0.0f;
+  }
+  return i / d->cfg.i_band; /* |i| < i_band implies i_band > 0 */
+}
+
+void deadtime_comp_apply(const deadtime_comp_t *d, const float duty_in[3], abc_t i_pred,
+                         float duty_out[3]) {
+  const float ix[3] = {i_pred.a, i_pred.b, i_pred.c};
+  for (int k = 0; k < 3; ++k) {
+    /* Rubino 2020, Fig. 8: feed-forward of the dead-time error over [tau+1, tau+2) */
+    float y = duty_in[k] + d->dt_ratio * deadtime_comp_sign(d, ix[k]);
+    if (!(y >= 0.0f)) { /* also catches NaN */
+      y = 0.0f;
+    }
+    if (y > 1.0f) {
+      y = 1.0f;
+    }
+    duty_out[k] = y;
+  }
+}

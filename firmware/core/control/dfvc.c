@@ -1,0 +1,192 @@
+/*
+ * dfvc.c - DB-DFVC and PI-DFVC for SPM machines, Rubino 2020, Figs. 2-7.
+ */
+#include "control/dfvc.h"
+
+#include <math.h>
+#include <string.h>
+
+#define DFVC_INV_SQRT3 0.577350269189626f
+#define DFVC_2PI       6.28318530717959f
+#define DFVC_DEG       0.0174532925199433f
+
+void dfvc_cfg_defaults(dfvc_cfg_t *cfg) {
+  memset(cfg, 0, sizeof(*cfg));
+  /* Rubino 2020, Table I */
+  cfg->rs = 7.1f;
+  cfg->ls = 0.057f;
+  cfg->lambda_m = 0.19f;
+  cfg->pole_pairs = 21.0f;
+  cfg->ts = 62.5e-6f;
+  /* section III.B, IV */
+  cfg->omega_c = 125.0f;
+  cfg->delta_max = 80.0f * DFVC_DEG;
+  cfg->v_sd_max = 60.0f;
+  cfg->pi_bw_flux = DFVC_2PI * 1000.0f;
+  cfg->pi_bw_iqs = DFVC_2PI * 1000.0f;
+  /* open in the paper: see dfvc.h */
+  cfg->omega_s_bw = 1000.0f;
+  cfg->i_max = 2.5f * 1.41421356f;
+  cfg->lambda_min = 0.2f * cfg->lambda_m;
+  cfg->lambda_collapse = 0.5f * cfg->lambda_min;
+  cfg->v_margin = 0.95f;
+  cfg->mpe_mode = CURRENT_PREDICTOR_EXACT;
+  cfg->omega_delta_mode = DFVC_OMEGA_DELTA_TARGET;
+  cfg->rot_advance = 0.5f;
+}
+
+int dfvc_init(dfvc_t *c, const dfvc_cfg_t *cfg) {
+  memset(c, 0, sizeof(*c));
+  c->cfg = *cfg;
+  const dfvc_cfg_t *k = cfg;
+  if (!(isfinite(k->rot_advance) && k->rot_advance >= 0.0f && k->rot_advance <= 1.0f &&
+        isfinite(k->lambda_collapse) && k->lambda_collapse >= 0.0f &&
+        (k->omega_delta_mode == DFVC_OMEGA_DELTA_TARGET ||
+         k->omega_delta_mode == DFVC_OMEGA_DELTA_OBSERVED))) {
+    return -1;
+  }
+  const flux_observer_cfg_t oc = {k->rs, k->ls, k->lambda_m, k->pole_pairs,
+                                  k->ts, k->omega_c, k->omega_s_bw};
+  const current_predictor_cfg_t pc = {k->rs, k->ls, k->lambda_m, k->ts, k->mpe_mode};
+  const dfvc_refs_cfg_t rc = {k->rs,    k->ls,        k->lambda_m,   k->pole_pairs,
+                              k->i_max, k->delta_max, k->lambda_min, k->v_margin};
+  const dfvc_deadbeat_cfg_t dc = {k->rs, k->ls, k->lambda_m, k->ts, k->v_sd_max};
+  const dfvc_pi_cfg_t ic = {k->rs, k->ls, k->ts, k->pi_bw_flux, k->pi_bw_iqs, k->v_sd_max};
+  if (flux_observer_init(&c->obs, &oc) != 0 || current_predictor_init(&c->mpe, &pc) != 0 ||
+      dfvc_refs_init(&c->refs, &rc) != 0 || dfvc_deadbeat_init(&c->db, &dc) != 0 ||
+      dfvc_pi_init(&c->pi, &ic) != 0) {
+    return -1;
+  }
+  c->last_law = DFVC_LAW_DEADBEAT;
+  return 0;
+}
+
+void dfvc_reset(dfvc_t *c) {
+  flux_observer_reset(&c->obs);
+  current_predictor_reset(&c->mpe);
+  dfvc_refs_reset(&c->refs);
+  dfvc_deadbeat_reset(&c->db);
+  dfvc_pi_reset(&c->pi);
+  c->last_law = DFVC_LAW_DEADBEAT;
+}
+
+static int dfvc_finite_ab(ab_t x) {
+  return isfinite(x.alpha) && isfinite(x.beta);
+}
+
+static int dfvc_inputs_ok(const dfvc_in_t *in) {
+  return (in->law == DFVC_LAW_DEADBEAT || in->law == DFVC_LAW_PI) && dfvc_finite_ab(in->i_ab) &&
+         dfvc_finite_ab(in->v_ab_applied) && isfinite(in->theta_r) && isfinite(in->omega_r) &&
+         isfinite(in->v_dc) && isfinite(in->torque_ref) && isfinite(in->lambda_ref);
+}
+
+void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
+  const dfvc_cfg_t *k = &c->cfg;
+  memset(out, 0, sizeof(*out));
+  if (!dfvc_inputs_ok(in)) {
+    out->fault = DFVC_FAULT_INPUT;
+    return;
+  }
+
+  /* MPE, eq. (21): current at tau+1 */
+  const ab_t i1 = current_predictor_step(&c->mpe, in->i_ab, in->v_ab_applied, in->theta_r,
+                                         in->omega_r);
+
+  /* stator flux at tau and its prediction at tau+1, Fig. 3, eqs. (19)-(20) */
+  flux_observer_out_t o;
+  flux_observer_update(&c->obs, in->i_ab, i1, in->v_ab_applied, in->theta_r, in->omega_r, &o);
+  const float theta_r1 = in->theta_r + in->omega_r * k->ts;
+  const dq_t i1_dqs = frames_park(i1, o.sc_s_next);
+  const float delta1 = frames_wrap_pi(o.theta_s_next - theta_r1);
+
+  /* references, Fig. 5, eqs. (22)-(26), from the quantities at tau */
+  const dfvc_refs_in_t ri = {in->torque_ref, in->lambda_ref, in->omega_r,
+                             in->v_dc,       o.i_dqs.d,      o.i_dqs.q};
+  dfvc_refs_out_t r;
+  dfvc_refs_update(&c->refs, &ri, &r);
+
+  /* the linear range of the min-max modulator */
+  const float v_max = fmaxf(in->v_dc, 0.0f) * DFVC_INV_SQRT3;
+  dq_t v_dqs;
+  uint32_t lim = r.limits;
+  if (in->law == DFVC_LAW_DEADBEAT) {
+    dfvc_deadbeat_in_t di;
+    di.lambda_ref = r.lambda_ref;
+    di.iqs_ref = r.iqs_ref;
+    di.lambda_s_next = o.lambda_s_next;
+    di.i_dqs_next = i1_dqs;
+    di.omega_r = in->omega_r;
+    di.omega_delta = (k->omega_delta_mode == DFVC_OMEGA_DELTA_TARGET)
+                         ? dfvc_deadbeat_omega_delta_target(&c->db, r.iqs_ref, delta1)
+                         : frames_wrap_pi(delta1 - o.delta) / k->ts;
+    di.v_max = v_max;
+    dfvc_deadbeat_out_t dout;
+    /* Rubino 2020, eqs. (28), (29), (33) */
+    dfvc_deadbeat_step(&c->db, &di, &dout);
+    v_dqs = dout.v_dqs;
+    lim |= ((dout.sat & DFVC_DEADBEAT_SAT_D) ? DFVC_LIMIT_VD : 0u) |
+           ((dout.sat & DFVC_DEADBEAT_SAT_Q) ? DFVC_LIMIT_VQ : 0u);
+  } else {
+    if (c->last_law != DFVC_LAW_PI) {
+      dfvc_pi_reset(&c->pi);
+    }
+    dfvc_pi_in_t pin;
+    pin.lambda_ref = r.lambda_ref;
+    pin.iqs_ref = r.iqs_ref;
+    pin.lambda_s = o.lambda_s;
+    pin.i_dqs = o.i_dqs;
+    pin.omega_r = in->omega_r;
+    pin.omega_delta = o.omega_s - in->omega_r;
+    pin.v_max = v_max;
+    dfvc_pi_out_t pout;
+    /* Rubino 2020, section IV.7 */
+    dfvc_pi_step(&c->pi, &pin, &pout);
+    v_dqs = pout.v_dqs;
+    lim |= ((pout.sat & DFVC_PI_SAT_D) ? DFVC_LIMIT_VD : 0u) |
+           ((pout.sat & DFVC_PI_SAT_Q) ? DFVC_LIMIT_VQ : 0u);
+  }
+  c->last_law = in->law;
+
+  /* (ds, qs) -> (alpha, beta) at the predicted flux angle theta_s(tau+1)
+   * (Rubino 2020, Fig. 7), advanced by rot_advance * omega_r * Ts */
+  const sincos_t adv = frames_sincos(k->rot_advance * in->omega_r * k->ts);
+  sincos_t scv;
+  scv.c = o.sc_s_next.c * adv.c - o.sc_s_next.s * adv.s;
+  scv.s = o.sc_s_next.s * adv.c + o.sc_s_next.c * adv.s;
+  const ab_t v_ab = frames_park_inv(v_dqs, scv);
+
+  /* double-step prediction (section IV.B): current at tau+2 under v_ab */
+  const ab_t i2 = current_predictor_step(&c->mpe, i1, v_ab, theta_r1, in->omega_r);
+
+  if (!(dfvc_finite_ab(v_ab) && dfvc_finite_ab(i2) && dfvc_finite_ab(o.lambda_next) &&
+        isfinite(r.lambda_ref) && isfinite(r.iqs_ref))) {
+    dfvc_reset(c);
+    memset(out, 0, sizeof(*out));
+    out->fault = DFVC_FAULT_STATE;
+    return;
+  }
+
+  out->v_ab_ref = v_ab;
+  out->i_ab_pred = i1;
+  out->i_ab_pred2 = i2;
+  out->i_ab_mid.alpha = 0.5f * (i1.alpha + i2.alpha);
+  out->i_ab_mid.beta = 0.5f * (i1.beta + i2.beta);
+  out->lambda_s = o.lambda_s;
+  out->lambda_s_pred = o.lambda_s_next;
+  out->lambda_ref = r.lambda_ref;
+  out->theta_s = o.theta_s;
+  out->omega_s = o.omega_s;
+  out->delta = o.delta;
+  out->i_ds = o.i_dqs.d;
+  out->i_qs = o.i_dqs.q;
+  out->i_qs_ref = r.iqs_ref;
+  out->i_qs_pred = i1_dqs.q;
+  out->torque = o.torque;
+  /* torque at tau+1, eq. (16) */
+  out->torque_pred = 1.5f * k->pole_pairs * o.lambda_s_next * i1_dqs.q;
+  out->torque_min = r.torque_min;
+  out->torque_max = r.torque_max;
+  out->v_dqs = v_dqs;
+  out->limits = lim;
+  out->fault = (o.lambda_s < k->lambda_collapse) ? DFVC_FAULT_FLUX_COLLAPSE : 0u;
+}

@@ -1,0 +1,68 @@
+/*
+ * dfvc_deadbeat.c - deadbeat flux and i_qs laws, Rubino 2020, eqs. (28)-(33).
+ */
+#include "control/dfvc_deadbeat.h"
+
+#include <math.h>
+#include <string.h>
+
+static int dfvc_deadbeat_pos(float x) {
+  return isfinite(x) && x > 0.0f;
+}
+
+int dfvc_deadbeat_init(dfvc_deadbeat_t *db, const dfvc_deadbeat_cfg_t *cfg) {
+  memset(db, 0, sizeof(*db));
+  const dfvc_deadbeat_cfg_t *c = cfg;
+  if (!(isfinite(c->rs) && c->rs >= 0.0f && dfvc_deadbeat_pos(c->ls) &&
+        dfvc_deadbeat_pos(c->lambda_m) && dfvc_deadbeat_pos(c->ts) &&
+        dfvc_deadbeat_pos(c->v_sd_max))) {
+    return -1;
+  }
+  db->cfg = *cfg;
+  dfvc_deadbeat_reset(db);
+  return 0;
+}
+
+void dfvc_deadbeat_reset(dfvc_deadbeat_t *db) {
+  db->inv_ts = 1.0f / db->cfg.ts;
+  db->ls_ts = db->cfg.ls / db->cfg.ts;
+}
+
+float dfvc_deadbeat_omega_delta_target(const dfvc_deadbeat_t *db, float iqs_ref,
+                                       float delta_next) {
+  /* q_s row of Rubino 2020, eq. (16): Ls i_qs = lambda_m sin(delta) */
+  float s = db->cfg.ls * iqs_ref / db->cfg.lambda_m;
+  s = fminf(fmaxf(s, -1.0f), 1.0f);
+  return frames_wrap_pi(asinf(s) - delta_next) * db->inv_ts;
+}
+
+void dfvc_deadbeat_step(const dfvc_deadbeat_t *db, const dfvc_deadbeat_in_t *in,
+                        dfvc_deadbeat_out_t *out) {
+  const dfvc_deadbeat_cfg_t *c = &db->cfg;
+  unsigned sat = 0u;
+
+  /* Rubino 2020, eq. (29) */
+  const float vd = c->rs * in->i_dqs_next.d + (in->lambda_ref - in->lambda_s_next) * db->inv_ts;
+  /* Rubino 2020, eq. (33) */
+  const float vq = c->rs * in->i_dqs_next.q + in->omega_delta * c->ls * in->i_dqs_next.d +
+                   in->omega_r * in->lambda_s_next + db->ls_ts * (in->iqs_ref - in->i_dqs_next.q);
+  out->v_dqs_raw.d = vd;
+  out->v_dqs_raw.q = vq;
+
+  const float vmax = fmaxf(in->v_max, 0.0f);
+  const float vd_max = fminf(c->v_sd_max, vmax);
+  float vdl = vd;
+  if (fabsf(vdl) > vd_max) {
+    vdl = copysignf(vd_max, vdl);
+    sat |= DFVC_DEADBEAT_SAT_D;
+  }
+  const float vq_max = sqrtf(fmaxf(vmax * vmax - vdl * vdl, 0.0f));
+  float vql = vq;
+  if (fabsf(vql) > vq_max) {
+    vql = copysignf(vq_max, vql);
+    sat |= DFVC_DEADBEAT_SAT_Q;
+  }
+  out->v_dqs.d = vdl;
+  out->v_dqs.q = vql;
+  out->sat = sat;
+}

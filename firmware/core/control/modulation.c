@@ -1,0 +1,62 @@
+/*
+ * modulation.c - min-max zero-sequence injection (equivalent to centred
+ * SVPWM) normalised by the measured DC-link voltage.
+ *
+ * v0 = -(max + min)/2, duty_x = 1/2 + (v_x + v0) / v_dc. The linear range is
+ * the circle inscribed in the hexagon, |v| <= v_dc/sqrt(3); beyond it the
+ * request is scaled onto that circle keeping its angle. The applied vector
+ * is reconstructed from the duties (Clarke of duty*v_dc; the common mode
+ * drops out), so rounding and clamping are reported honestly.
+ */
+#include "control/modulation.h"
+
+#include <math.h>
+
+#define MOD_INV_SQRT3 0.577350269189626f
+
+float modulation_v_max(float v_dc) {
+  return (v_dc > 0.0f && isfinite(v_dc)) ? v_dc * MOD_INV_SQRT3 : 0.0f;
+}
+
+static float mod_clamp01(float x) {
+  return (x > 1.0f) ? 1.0f : ((x < 0.0f) ? 0.0f : x);
+}
+
+static float mod_max3(float a, float b, float c) {
+  const float m = (a > b) ? a : b;
+  return (m > c) ? m : c;
+}
+
+static float mod_min3(float a, float b, float c) {
+  const float m = (a < b) ? a : b;
+  return (m < c) ? m : c;
+}
+
+modulation_out_t modulation_minmax(ab_t v_ref, float v_dc) {
+  modulation_out_t out = {{0.5f, 0.5f, 0.5f}, {0.0f, 0.0f}, 1};
+  const float v_max = modulation_v_max(v_dc);
+  if (!(v_max > 0.0f) || !isfinite(v_ref.alpha) || !isfinite(v_ref.beta)) {
+    return out; /* safe output: zero average voltage, flagged */
+  }
+  out.saturated = 0;
+  const float mag = sqrtf(v_ref.alpha * v_ref.alpha + v_ref.beta * v_ref.beta);
+  if (!isfinite(mag)) {
+    out.saturated = 1; /* finite but huge components overflowed */
+    return out;
+  }
+  if (mag > v_max) {
+    const float k = v_max / mag;
+    v_ref.alpha *= k;
+    v_ref.beta *= k;
+    out.saturated = 1;
+  }
+  const abc_t v = frames_clarke_inv(v_ref);
+  const float v_cm = -0.5f * (mod_max3(v.a, v.b, v.c) + mod_min3(v.a, v.b, v.c));
+  const float inv_vdc = 1.0f / v_dc;
+  out.duty[0] = mod_clamp01(0.5f + (v.a + v_cm) * inv_vdc);
+  out.duty[1] = mod_clamp01(0.5f + (v.b + v_cm) * inv_vdc);
+  out.duty[2] = mod_clamp01(0.5f + (v.c + v_cm) * inv_vdc);
+  const abc_t v_pole = {out.duty[0] * v_dc, out.duty[1] * v_dc, out.duty[2] * v_dc};
+  out.v_applied = frames_clarke(v_pole);
+  return out;
+}

@@ -1,0 +1,27 @@
+/*
+ * modulation.h - min-max (zero-sequence injection) modulation, equivalent to
+ * centred space-vector PWM, normalised by the measured DC-link voltage.
+ *
+ * Linear range: |v_ab| <= v_dc / sqrt(3). Overmodulation behaviour (defined):
+ * a request beyond the linear range is scaled down to the circle of radius
+ * v_dc / sqrt(3) keeping its angle (no low-order harmonics, the applied
+ * vector is reported so observers and anti-windup see what was applied).
+ */
+#ifndef FD_CONTROL_MODULATION_H
+#define FD_CONTROL_MODULATION_H
+
+#include "math/frames.h"
+
+typedef struct {
+  float duty[3];  /* duty cycles of phases a, b, c in [0, 1] */
+  ab_t v_applied; /* average voltage vector these duties apply [V] */
+  int saturated;  /* 1 when the request was scaled to the linear limit */
+} modulation_out_t;
+
+/* Largest voltage amplitude in the linear range. */
+float modulation_v_max(float v_dc);
+/* v_ref: alpha-beta voltage reference [V]; v_dc > 0. A non-positive or
+ * non-finite v_dc gives 50 % duties and v_applied = 0. */
+modulation_out_t modulation_minmax(ab_t v_ref, float v_dc);
+
+#endif

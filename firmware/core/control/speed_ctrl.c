@@ -1,0 +1,55 @@
+/*
+ * speed_ctrl.c - speed PI -> torque reference with a slew-limited speed
+ * reference and dynamic torque limits (anti-windup through pi_ctrl).
+ */
+#include "control/speed_ctrl.h"
+
+#include <math.h>
+
+void speed_ctrl_init(speed_ctrl_t *sc, const speed_ctrl_cfg_t *cfg) {
+  sc->cfg = *cfg;
+  const float tm = fabsf(cfg->torque_max);
+  sc->cfg.torque_max = tm;
+  pi_ctrl_init(&sc->pi, cfg->kp, cfg->ki, cfg->ts, -tm, tm);
+  sc->w_ref_ramped = 0.0f;
+}
+
+void speed_ctrl_reset(speed_ctrl_t *sc, float w_meas, float torque_now) {
+  const float tm = sc->cfg.torque_max;
+  pi_ctrl_set_limits(&sc->pi, -tm, tm);
+  pi_ctrl_reset(&sc->pi, torque_now); /* zero error -> output = torque_now */
+  sc->w_ref_ramped = isfinite(w_meas) ? w_meas : 0.0f;
+}
+
+/* Open loop (kp s + ki)/(J s^2): kp = J wb puts the crossover near wb, the
+ * PI zero ki/kp = wb/4 keeps ~76 deg of phase margin. The closed loop has a
+ * double pole at wb/2 (critically damped): J s^2 + kp s + ki. */
+void speed_ctrl_design(speed_ctrl_cfg_t *cfg, float j, float wb) {
+  cfg->kp = j * wb;
+  cfg->ki = cfg->kp * wb * 0.25f;
+  cfg->j_ff = j;
+}
+
+float speed_ctrl_update(speed_ctrl_t *sc, float w_ref, float w, float t_min, float t_max) {
+  const float tm = sc->cfg.torque_max;
+  const float step = sc->cfg.accel_max * sc->cfg.ts;
+  const float w_prev = sc->w_ref_ramped;
+  if (isfinite(w_ref)) {
+    const float dw = w_ref - sc->w_ref_ramped;
+    if (dw > step) {
+      sc->w_ref_ramped += step;
+    } else if (dw < -step) {
+      sc->w_ref_ramped -= step;
+    } else {
+      sc->w_ref_ramped = w_ref;
+    }
+  }
+  /* dynamic limits, clamped to the static one; NaN means "no extra limit" */
+  const float hi = (t_max < tm) ? t_max : tm;
+  const float lo = (t_min > -tm) ? t_min : -tm;
+  pi_ctrl_set_limits(&sc->pi, lo, hi);
+  /* Acceleration feed-forward J dw_ref/dt: the PI integral need not carry the
+   * ramp's torque, so it does not overshoot when the ramp ends. */
+  const float t_acc = sc->cfg.j_ff * (sc->w_ref_ramped - w_prev) / sc->cfg.ts;
+  return pi_ctrl_update(&sc->pi, sc->w_ref_ramped - w, t_acc);
+}

@@ -1,0 +1,98 @@
+/*
+ * flux_observer.c - hybrid stator-flux observer with one-step prediction,
+ * Rubino 2020, Fig. 3 and eqs. (19)-(20).
+ */
+#include "estimation/flux_observer.h"
+
+#include <math.h>
+#include <string.h>
+
+/* Amplitude and unit vector of a flux vector; a vanishing vector gets the
+ * identity direction (theta = 0). */
+static float flux_observer_polar(ab_t x, sincos_t *sc) {
+  const float a = sqrtf(x.alpha * x.alpha + x.beta * x.beta);
+  if (a > 1e-9f) {
+    sc->c = x.alpha / a;
+    sc->s = x.beta / a;
+  } else {
+    sc->c = 1.0f;
+    sc->s = 0.0f;
+  }
+  return a;
+}
+
+int flux_observer_init(flux_observer_t *o, const flux_observer_cfg_t *cfg) {
+  memset(o, 0, sizeof(*o));
+  const flux_observer_cfg_t *c = cfg;
+  if (!(isfinite(c->rs) && c->rs >= 0.0f && isfinite(c->ls) && c->ls > 0.0f &&
+        isfinite(c->lambda_m) && c->lambda_m >= 0.0f && isfinite(c->pole_pairs) &&
+        c->pole_pairs > 0.0f && isfinite(c->ts) && c->ts > 0.0f && isfinite(c->omega_c) &&
+        c->omega_c >= 0.0f && isfinite(c->omega_s_bw) && c->omega_s_bw > 0.0f)) {
+    return -1;
+  }
+  o->cfg = *cfg;
+  o->alpha_s = -expm1f(-c->omega_s_bw * c->ts);
+  flux_observer_reset(o);
+  return 0;
+}
+
+void flux_observer_reset(flux_observer_t *o) {
+  o->lambda_hat.alpha = 0.0f;
+  o->lambda_hat.beta = 0.0f;
+  o->theta_s_prev = 0.0f;
+  o->omega_s = 0.0f;
+  o->started = 0;
+}
+
+void flux_observer_update(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, float theta_r,
+                          float omega_r, flux_observer_out_t *out) {
+  const flux_observer_cfg_t *c = &o->cfg;
+  const sincos_t scr = frames_sincos(theta_r);
+
+  /* current model, Rubino 2020, eq. (2) in (alpha, beta) */
+  ab_t lcm;
+  lcm.alpha = c->ls * i.alpha + c->lambda_m * scr.c;
+  lcm.beta = c->ls * i.beta + c->lambda_m * scr.s;
+  if (!o->started) {
+    o->lambda_hat = lcm;
+  }
+  const ab_t lh = o->lambda_hat;
+
+  out->lambda = lh;
+  out->lambda_cm = lcm;
+  out->lambda_s = flux_observer_polar(lh, &out->sc_s);
+  out->theta_s = atan2f(out->sc_s.s, out->sc_s.c);
+
+  /* Fig. 3: back-EMF (resistive drop averaged over the period) plus the
+   * current-model correction omega_c (lambda_cm - lambda_hat), then the one-step
+   * prediction, Rubino 2020, eqs. (19)-(20) */
+  const float hr = 0.5f * c->rs;
+  ab_t e;
+  e.alpha = v.alpha - hr * (i.alpha + i_next.alpha) + c->omega_c * (lcm.alpha - lh.alpha);
+  e.beta = v.beta - hr * (i.beta + i_next.beta) + c->omega_c * (lcm.beta - lh.beta);
+  ab_t ln;
+  ln.alpha = lh.alpha + c->ts * e.alpha;
+  ln.beta = lh.beta + c->ts * e.beta;
+  out->lambda_next = ln;
+  out->lambda_s_next = flux_observer_polar(ln, &out->sc_s_next);
+  out->theta_s_next = atan2f(out->sc_s_next.s, out->sc_s_next.c);
+
+  /* flux-frame speed: filtered derivative of theta_s */
+  if (!o->started) {
+    o->omega_s = isfinite(omega_r) ? omega_r : 0.0f;
+  } else {
+    const float raw = frames_wrap_pi(out->theta_s - o->theta_s_prev) / c->ts;
+    o->omega_s += o->alpha_s * (raw - o->omega_s);
+  }
+  o->theta_s_prev = out->theta_s;
+  out->omega_s = o->omega_s;
+
+  /* load angle, Rubino 2020, eq. (9)-c */
+  out->delta = frames_wrap_pi(out->theta_s - theta_r);
+  /* stator-flux frame currents and torque, eq. (16) */
+  out->i_dqs = frames_park(i, out->sc_s);
+  out->torque = 1.5f * c->pole_pairs * out->lambda_s * out->i_dqs.q;
+
+  o->lambda_hat = ln;
+  o->started = 1;
+}

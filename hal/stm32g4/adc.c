@@ -1,0 +1,233 @@
+/*
+ * adc.c - phase currents, DC-link and star-point voltage sampled by ADC1 and
+ * ADC2 injected sequences at the TIM1 update (carrier valley).
+ *
+ * RM0440 section 21.4: clock (21.4.3: CKMODE = 11, adc_hclk/4 = 42.5 MHz,
+ * synchronous, so the trigger-to-sample delay is fixed), deep power-down exit
+ * and regulator start-up (21.4.6), calibration (21.4.8: ADCAL with ADEN = 0,
+ * single-ended), enable (21.4.9: ADRDY), injected group (21.4.21: JSQR with
+ * JEXTSEL = TIM1_TRGO, JEXTEN = rising edge; JQDIS = 1, queue disabled).
+ * The interrupt is the end of ADC1's injected sequence (JEOS); the board
+ * table puts the longest sequence on ADC1 and the handler waits for ADC2.
+ * OPAMP PGA (RM0440 section 25.3.5) for boards that amplify the shunt
+ * signal inside the MCU.
+ */
+#include "adc.h"
+
+#include "board.h"
+#include "clock.h"
+#include "hal.h"
+#include "hal_stm32g4.h"
+#include "pwm_tim1.h"
+
+#define HOT __attribute__((section(".ccmram.text.hal")))
+
+enum { SIG_IA = 0, SIG_IB, SIG_IC, SIG_VDC, SIG_VSTAR, SIG_COUNT };
+
+typedef struct {
+  uint8_t adc;     /* 1, 2; 0 = not measured */
+  uint8_t channel; /* ADCx_INn */
+  uint8_t smp;     /* ADC_SMP_* */
+} adc_signal_t;
+
+static const adc_signal_t k_sig[SIG_COUNT] = {BOARD_ADC_IA, BOARD_ADC_IB, BOARD_ADC_IC,
+                                              BOARD_ADC_VDC, BOARD_ADC_VSTAR};
+static const hal_pin_t k_adc_pins[BOARD_ADC_NPINS] = BOARD_ADC_PINS;
+
+/* Data register of each signal, set by hal_adc_init. */
+static reg32_t *s_jdr[SIG_COUNT];
+
+static struct {
+  uint32_t isr_count;
+  uint32_t overruns;
+  bool overrun_flag;
+  uint32_t cycles_last;
+  uint32_t cycles_max;
+} s_isr;
+
+static adc_regs_t *adc_of(uint32_t n) {
+  return (n == 1u) ? ADC1 : ADC2;
+}
+
+static bool wait_flag(reg32_t *reg, uint32_t mask, bool set) {
+  for (uint32_t t = 0; t < 1000000u; t++) {
+    if (((*reg & mask) != 0u) == set) {
+      return true;
+    }
+  }
+  return false;
+}
+
+static void opamp_init(void) {
+#if BOARD_USE_OPAMP_PGA
+  /* OPAMP1..3: VINP0 input, PGA mode (VM_SEL = 10), board gain code,
+   * high-speed mode, output to the pin (OPAINTOEN = 0) which is also the
+   * ADC input; configure first, then enable (RM0440 25.3). */
+  RCC->APB2ENR |= RCC_APB2ENR_SYSCFGEN; /* OPAMP registers sit on the SYSCFG clock */
+  (void)RCC->APB2ENR;
+  const uint32_t csr = (0u << OPAMP_CSR_VP_SEL_Pos) | (2u << OPAMP_CSR_VM_SEL_Pos) |
+                       ((uint32_t)BOARD_OPAMP_PGA_GAIN_CODE << OPAMP_CSR_PGA_GAIN_Pos) |
+                       OPAMP_CSR_OPAHSM;
+  for (uint32_t i = 0; i < 3u; i++) {
+    OPAMP->CSR[i] = csr;
+    OPAMP->CSR[i] = csr | OPAMP_CSR_OPAEN;
+  }
+#endif
+}
+
+static bool adc_power_up(adc_regs_t *adc) {
+  adc->CR = 0u;               /* DEEPPWD = 0 */
+  adc->CR = ADC_CR_ADVREGEN;  /* regulator on */
+  hal_delay_cycles(170u * 25u); /* t_ADCVREG_STUP = 20 us */
+  adc->DIFSEL = 0u;             /* all single ended */
+  adc->CR = ADC_CR_ADVREGEN | ADC_CR_ADCAL; /* ADCALDIF = 0 */
+  if (!wait_flag(&adc->CR, ADC_CR_ADCAL, false)) {
+    return false;
+  }
+  hal_delay_cycles(64u); /* >= 4 ADC clocks between ADCAL = 0 and ADEN */
+  adc->ISR = ADC_ISR_ADRDY;
+  adc->CR = ADC_CR_ADVREGEN | ADC_CR_ADEN;
+  return wait_flag(&adc->ISR, ADC_ISR_ADRDY, true);
+}
+
+bool hal_adc_init(void) {
+  opamp_init();
+  for (uint32_t i = 0; i < BOARD_ADC_NPINS; i++) {
+    hal_gpio_analog(k_adc_pins[i].port, k_adc_pins[i].pin);
+  }
+
+  RCC->CCIPR = (RCC->CCIPR & ~RCC_CCIPR_ADC12SEL_Msk) |
+               (RCC_CCIPR_ADC12SEL_SYSCLK << RCC_CCIPR_ADC12SEL_Pos);
+  RCC->AHB2ENR |= RCC_AHB2ENR_ADC12EN;
+  (void)RCC->AHB2ENR;
+  ADC12_COMMON->CCR = 3u << ADC_CCR_CKMODE_Pos; /* independent mode, HCLK/4 */
+
+  if (!adc_power_up(ADC1) || !adc_power_up(ADC2)) {
+    return false;
+  }
+
+  uint32_t jsqr[2] = {0u, 0u};
+  uint32_t len[2] = {0u, 0u};
+  for (uint32_t s = 0; s < SIG_COUNT; s++) {
+    const adc_signal_t *sig = &k_sig[s];
+    if (sig->adc == 0u) {
+      s_jdr[s] = 0;
+      continue;
+    }
+    const uint32_t a = sig->adc - 1u;
+    adc_regs_t *adc = adc_of(sig->adc);
+    const uint32_t rank = len[a]++;
+    jsqr[a] |= (uint32_t)sig->channel << ADC_JSQR_JSQ_Pos(rank);
+    if (sig->channel < 10u) {
+      const uint32_t sh = 3u * sig->channel;
+      adc->SMPR1 = (adc->SMPR1 & ~(7u << sh)) | ((uint32_t)sig->smp << sh);
+    } else {
+      const uint32_t sh = 3u * (sig->channel - 10u);
+      adc->SMPR2 = (adc->SMPR2 & ~(7u << sh)) | ((uint32_t)sig->smp << sh);
+    }
+    s_jdr[s] = &adc->JDR[rank];
+  }
+  for (uint32_t a = 0; a < 2u; a++) {
+    adc_regs_t *adc = adc_of(a + 1u);
+    adc->CFGR = ADC_CFGR_JQDIS; /* 12 bit, right aligned, injected queue off */
+    if (len[a] == 0u) {
+      continue;
+    }
+    /* JEXTSEL = 0: TIM1_TRGO; JEXTEN = 01: rising edge; JL = length - 1 */
+    adc->JSQR = jsqr[a] | (0u << ADC_JSQR_JEXTSEL_Pos) | (1u << ADC_JSQR_JEXTEN_Pos) |
+                ((len[a] - 1u) << ADC_JSQR_JL_Pos);
+  }
+  return len[0] >= len[1]; /* the interrupt comes from ADC1: it must finish last */
+}
+
+void hal_adc_start(void) {
+  ADC1->ISR = ADC_ISR_JEOC | ADC_ISR_JEOS | ADC_ISR_JQOVF;
+  ADC2->ISR = ADC_ISR_JEOC | ADC_ISR_JEOS | ADC_ISR_JQOVF;
+  ADC1->IER = ADC_IER_JEOSIE;
+  ADC1->CR |= ADC_CR_JADSTART;
+  if ((ADC2->JSQR & (3u << ADC_JSQR_JEXTEN_Pos)) != 0u) {
+    ADC2->CR |= ADC_CR_JADSTART;
+  }
+  NVIC->IPR[IRQN_ADC1_2] = (uint8_t)(0u << (8u - NVIC_PRIO_BITS)); /* highest */
+  NVIC->ICPR[IRQN_ADC1_2 / 32u] = 1u << (IRQN_ADC1_2 % 32u);
+  NVIC->ISER[IRQN_ADC1_2 / 32u] = 1u << (IRQN_ADC1_2 % 32u);
+}
+
+/* ---- hal.h ---- */
+
+HOT static float raw_volts(const reg32_t *jdr) {
+  return (float)(*jdr & 0xFFFFu) * (BOARD_VDDA / 4095.0f);
+}
+
+HOT void hal_adc_read(hal_adc_sample_t *s) {
+  float i[3];
+  int missing = -1;
+  float sum = 0.0f;
+  for (int k = 0; k < 3; k++) {
+    if (s_jdr[k] != 0) {
+      i[k] = (raw_volts(s_jdr[k]) - BOARD_I_MID_V) * BOARD_I_A_PER_V;
+      sum += i[k];
+    } else {
+      i[k] = 0.0f;
+      missing = k;
+    }
+  }
+  if (missing >= 0) {
+    i[missing] = -sum; /* two-shunt boards: Kirchhoff */
+  }
+  s->i_abc[0] = i[0];
+  s->i_abc[1] = i[1];
+  s->i_abc[2] = i[2];
+  s->v_dc = (s_jdr[SIG_VDC] != 0) ? raw_volts(s_jdr[SIG_VDC]) * BOARD_VDC_RATIO : 0.0f;
+  /* star point measured to ground; hal.h wants it w.r.t. the DC midpoint */
+  s->v_star = (s_jdr[SIG_VSTAR] != 0)
+                  ? raw_volts(s_jdr[SIG_VSTAR]) * BOARD_VSTAR_RATIO - 0.5f * s->v_dc
+                  : 0.0f;
+  s->enc_angle = 0.0f; /* no encoder interface on these boards yet */
+  s->enc_valid = false;
+}
+
+/* End of ADC1's injected sequence: the PWM-period interrupt. */
+void ADC1_2_IRQHandler(void);
+HOT void ADC1_2_IRQHandler(void) {
+  const uint32_t t0 = DWT->CYCCNT;
+  ADC1->ISR = ADC_ISR_JEOC | ADC_ISR_JEOS;
+  for (uint32_t t = 0; t < 200u && (ADC2->ISR & ADC_ISR_JEOS) == 0u; t++) {
+  }
+  ADC2->ISR = ADC_ISR_JEOC | ADC_ISR_JEOS;
+  hal_tim1_clear_update(); /* set at this period's valley */
+
+  board_control_isr();
+
+  /* Overrun: the next valley (update) came before the ISR finished. */
+  if (hal_tim1_update_pending()) {
+    s_isr.overrun_flag = true;
+    s_isr.overruns++;
+  }
+  s_isr.isr_count++;
+  const uint32_t dt = DWT->CYCCNT - t0;
+  s_isr.cycles_last = dt;
+  if (dt > s_isr.cycles_max) {
+    s_isr.cycles_max = dt;
+  }
+}
+
+bool hal_isr_overrun(void) {
+  const uint32_t pm = hal_irq_save();
+  const bool f = s_isr.overrun_flag;
+  s_isr.overrun_flag = false;
+  hal_irq_restore(pm);
+  return f;
+}
+
+uint32_t hal_isr_overrun_count(void) {
+  return s_isr.overruns;
+}
+
+uint32_t hal_isr_count(void) {
+  return s_isr.isr_count;
+}
+
+uint32_t hal_isr_cycles_max(void) {
+  return s_isr.cycles_max;
+}

@@ -1,0 +1,45 @@
+/*
+ * hal_stm32g4.c - bring-up of the STM32G4 HAL and where each hal.h function
+ * lives:
+ *   hal_adc_read                      adc.c (JDR of ADC1/ADC2 -> SI)
+ *   hal_pwm_set_duty/enable/disable/is_enabled,
+ *   hal_fault_hw_tripped/clear        pwm_tim1.c (CCRx, BDTR.MOE, SR.BIF)
+ *   hal_can_send/receive              fdcan.c (Tx FIFO, Rx FIFO 0)
+ *   hal_time_us                       time.c (TIM2 at 1 MHz)
+ *   hal_watchdog_kick                 iwdg.c
+ * Each is implemented next to its registers so the ISR path has no extra
+ * call layer.
+ */
+#include "hal_stm32g4.h"
+
+#include "adc.h"
+#include "board.h"
+#include "cordic.h"
+#include "fdcan.h"
+#include "hal_time.h"
+#include "pwm_tim1.h"
+
+uint32_t hal_stm32g4_init(void) {
+  uint32_t err = 0u;
+  if (((RCC->CFGR & RCC_CFGR_SWS_Msk) >> RCC_CFGR_SWS_Pos) != RCC_CFGR_SW_PLL) {
+    err |= HAL_INIT_ERR_CLOCK; /* every timing below assumes 170 MHz */
+  }
+  hal_time_init();
+  hal_cordic_init();
+  hal_tim1_init(); /* gates off from here on */
+  if (!hal_adc_init()) {
+    err |= HAL_INIT_ERR_ADC;
+  }
+  if (!hal_fdcan_init(BOARD_CAN_BITRATE, BOARD_CAN_NODE_ID, 0x7Fu)) {
+    err |= HAL_INIT_ERR_CAN;
+  }
+  return err;
+}
+
+uint32_t hal_stm32g4_start(void) {
+  const uint32_t pm = hal_irq_save();
+  const bool aligned = hal_tim1_start();
+  hal_adc_start();
+  hal_irq_restore(pm);
+  return aligned ? 0u : HAL_INIT_ERR_PWM;
+}

@@ -1,0 +1,48 @@
+/*
+ * hal_stm32g4.h - what the STM32G4 HAL offers beyond hal.h, for the board
+ * files only (firmware/app sees hal.h alone).
+ */
+#ifndef FLUXDRIVE_HAL_STM32G4_H
+#define FLUXDRIVE_HAL_STM32G4_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+/* Bring-up result bits of hal_stm32g4_init (0 = all fine). */
+enum {
+  HAL_INIT_ERR_CLOCK = 1u << 0, /* SYSCLK is not the PLL at 170 MHz */
+  HAL_INIT_ERR_ADC = 1u << 1,   /* ADC regulator / calibration / ready time-out */
+  HAL_INIT_ERR_CAN = 1u << 2,   /* FDCAN did not enter or leave INIT */
+  HAL_INIT_ERR_PWM = 1u << 3    /* TIM1 update could not be aligned to the valley */
+};
+
+/* Configure every peripheral (gates off). Returns HAL_INIT_ERR_* bits. */
+uint32_t hal_stm32g4_init(void);
+/* Start the PWM carrier, align its update, arm the ADC trigger and the
+ * PWM-period interrupt. Returns HAL_INIT_ERR_PWM on failure. */
+uint32_t hal_stm32g4_start(void);
+
+/* Implemented by the board file: called from the end-of-conversion
+ * interrupt (ADC1 JEOS) every PWM period. */
+void board_control_isr(void);
+
+/* ISR overrun: true when, since the last call, a PWM-period interrupt was
+ * still running at the next carrier valley. Read-and-clear. */
+bool hal_isr_overrun(void);
+uint32_t hal_isr_overrun_count(void);
+uint32_t hal_isr_count(void);
+/* Longest ISR seen, in core cycles (170 per microsecond). */
+uint32_t hal_isr_cycles_max(void);
+
+/* CAN acceptance: standard and extended identifiers whose bits under
+ * `mask` equal node_id, plus the broadcast identifier 0 under the same mask
+ * (e.g. mask 0x7F for a CANopen-style node id in the low 7 bits). Every other
+ * frame is rejected in hardware. */
+void hal_can_set_node_filter(uint32_t node_id, uint32_t mask);
+/* true while the controller is bus-off (it restarts by itself). */
+bool hal_can_bus_off(void);
+
+/* Start the independent watchdog (cannot be stopped until reset). */
+void hal_watchdog_start(uint32_t timeout_ms);
+
+#endif

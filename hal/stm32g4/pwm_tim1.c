@@ -1,0 +1,189 @@
+/*
+ * pwm_tim1.c - TIM1 as the three-phase modulator, RM0440 section 28
+ * (advanced-control timer TIM1).
+ *
+ * Carrier: centre-aligned mode 1 (CMS = 01), ARR = 170 MHz / (2 f_pwm),
+ * so the counter runs 0 -> ARR -> 0 once per PWM period.
+ * Pattern: PWM mode 2 (OCxREF active while CNT > CCRx), CCRx = (1 - d) ARR:
+ * the high side conducts around the peak and ALL LOW SIDES conduct around
+ * the valley (zero vector 000), where the low-side shunts carry the phase
+ * currents.
+ * Sampling instant: the repetition counter (RCR = 1) makes one update event
+ * per period, aligned to the underflow (valley); TRGO = update starts the
+ * ADC injected sequence there (hal.h timing model).
+ * Preload: OCxPE = 1 and ARPE = 1, so duties written by the ISR after the
+ * valley of period k are transferred at the valley k+1 and act over
+ * [k+1, k+2).
+ * Protection: BKIN (board's comparator) with BKE = 1: MOE is cleared in
+ * hardware, outputs go to the idle level (OSSI = 1, OISx = off level), BIF
+ * latches until software clears it. AOE = 0: no automatic restart. LOCK
+ * level 1 freezes dead time, break and idle configuration until reset.
+ */
+#include "pwm_tim1.h"
+
+#include "board.h"
+#include "hal.h"
+
+#define HOT __attribute__((section(".ccmram.text.hal")))
+
+uint32_t hal_tim1_dtg(uint32_t dead_ns, uint32_t f_tim) {
+  const uint64_t ticks = ((uint64_t)dead_ns * f_tim + 999999999u) / 1000000000u;
+  if (ticks <= 127u) {
+    return (uint32_t)ticks; /* DTG[7] = 0: DT = DTG x t_DTS */
+  }
+  if (ticks <= 254u) {
+    return 0x80u | (uint32_t)((ticks + 1u) / 2u - 64u); /* (64 + DTG[5:0]) x 2 t_DTS */
+  }
+  if (ticks <= 504u) {
+    return 0xC0u | (uint32_t)((ticks + 7u) / 8u - 32u); /* (32 + DTG[4:0]) x 8 t_DTS */
+  }
+  if (ticks <= 1008u) {
+    return 0xE0u | (uint32_t)((ticks + 15u) / 16u - 32u); /* (32 + DTG[4:0]) x 16 t_DTS */
+  }
+  return 0xFFu;
+}
+
+static const hal_pin_t k_pwm_pins[6] = BOARD_PWM_PINS;
+
+void hal_tim1_init(void) {
+  RCC->APB2ENR |= RCC_APB2ENR_TIM1EN;
+  (void)RCC->APB2ENR;
+  DBGMCU->APB2FZR |= DBGMCU_APB2FZR_TIM1_STOP; /* core halted: outputs disabled */
+
+  TIM1->CR1 = 0u;
+  TIM1->PSC = 0u;
+  TIM1->ARR = BOARD_PWM_ARR;
+  TIM1->RCR = 0u;
+  TIM1->CCR1 = BOARD_PWM_ARR; /* d = 0 */
+  TIM1->CCR2 = BOARD_PWM_ARR;
+  TIM1->CCR3 = BOARD_PWM_ARR;
+
+  TIM1->CCMR1 = (TIM_OCM_PWM2 << TIM_CCMR_OC1M_Pos) | TIM_CCMR_OC1PE |
+                (TIM_OCM_PWM2 << TIM_CCMR_OC2M_Pos) | TIM_CCMR_OC2PE;
+  TIM1->CCMR2 = (TIM_OCM_PWM2 << TIM_CCMR_OC1M_Pos) | TIM_CCMR_OC1PE; /* channel 3 */
+
+  const uint32_t hp = BOARD_PWM_HIGH_ACTIVE_LOW ? TIM_CCER_CC1P : 0u;
+  const uint32_t lp = BOARD_PWM_LOW_ACTIVE_LOW ? TIM_CCER_CC1NP : 0u;
+  uint32_t ccer = 0u;
+  for (uint32_t ch = 0; ch < 3u; ch++) {
+    ccer |= (TIM_CCER_CC1E | TIM_CCER_CC1NE | hp | lp) << (4u * ch);
+  }
+  TIM1->CCER = ccer;
+
+  /* TRGO = update; idle levels (MOE = 0) = switch off. */
+  uint32_t cr2 = TIM_CR2_MMS_UPDATE << TIM_CR2_MMS_Pos;
+  for (uint32_t ch = 0; ch < 3u; ch++) {
+    cr2 |= (BOARD_PWM_HIGH_ACTIVE_LOW ? 1u : 0u) << (8u + 2u * ch); /* OISx */
+    cr2 |= (BOARD_PWM_LOW_ACTIVE_LOW ? 1u : 0u) << (9u + 2u * ch);  /* OISxN */
+  }
+  TIM1->CR2 = cr2;
+
+  const uint32_t dtg = hal_tim1_dtg(BOARD_DEAD_TIME_NS, BOARD_SYSCLK_HZ);
+#if BOARD_HAS_BKIN
+  TIM1->AF1 = TIM1_AF1_BKINE; /* BKIN pin only, BKINP = 0 */
+  const uint32_t brk = TIM_BDTR_BKE | (BOARD_BKIN_ACTIVE_HIGH ? TIM_BDTR_BKP : 0u) |
+                       (BOARD_BKIN_FILTER << TIM_BDTR_BKF_Pos);
+#else
+  TIM1->AF1 = 0u;
+  const uint32_t brk = 0u;
+#endif
+  /* One write: dead time, break, off-state selection, LOCK level 1. */
+  TIM1->BDTR = (dtg & TIM_BDTR_DTG_Msk) | TIM_BDTR_OSSI | TIM_BDTR_OSSR | brk |
+               (1u << TIM_BDTR_LOCK_Pos);
+
+  TIM1->CR1 = (1u << TIM_CR1_CMS_Pos) | TIM_CR1_ARPE;
+  TIM1->EGR = TIM_EGR_UG; /* load ARR, CCRx, RCR */
+  TIM1->SR = 0u;
+
+  /* Pins last: the channels already drive the idle (off) level. */
+  for (uint32_t i = 0; i < 6u; i++) {
+    hal_gpio_af(k_pwm_pins[i], BOARD_PWM_HIGH_ACTIVE_LOW ? 1u : 2u);
+  }
+#if BOARD_HAS_BKIN
+  const hal_pin_t bkin = BOARD_BKIN_PIN;
+  hal_gpio_af(bkin, BOARD_BKIN_ACTIVE_HIGH ? 2u : 1u); /* pull to the inactive level */
+#endif
+}
+
+static bool wait_update(void) {
+  for (uint32_t t = 0; t < 100000u; t++) { /* > 2 periods at 170 MHz */
+    if ((TIM1->SR & TIM_SR_UIF) != 0u) {
+      return true;
+    }
+  }
+  return false;
+}
+
+bool hal_tim1_start(void) {
+  /* RM0440 28.3.4: with an odd RCR in centre-aligned mode the update falls
+   * on the underflow if RCR is written after the counter started. Write it
+   * so, then verify with DIR (counting up right after an underflow) and
+   * shift by one half period if needed. */
+  TIM1->CR1 |= TIM_CR1_CEN;
+  TIM1->RCR = 1u;
+  for (uint32_t attempt = 0; attempt < 3u; attempt++) {
+    TIM1->SR = ~TIM_SR_UIF;
+    if (!wait_update()) {
+      return false;
+    }
+    if ((TIM1->CR1 & TIM_CR1_DIR) == 0u) {
+      TIM1->SR = ~TIM_SR_UIF;
+      return true;
+    }
+    /* Update came at the overflow: one update with RCR = 0 moves the
+     * repetition phase by half a period. */
+    TIM1->RCR = 0u;
+    TIM1->SR = ~TIM_SR_UIF;
+    if (!wait_update()) {
+      return false;
+    }
+    TIM1->RCR = 1u;
+  }
+  return false;
+}
+
+HOT void hal_tim1_clear_update(void) {
+  TIM1->SR = ~TIM_SR_UIF; /* rc_w0 */
+}
+
+HOT bool hal_tim1_update_pending(void) {
+  return (TIM1->SR & TIM_SR_UIF) != 0u;
+}
+
+/* ---- hal.h: PWM and hardware fault ---- */
+
+HOT static uint32_t duty_to_ccr(float d) {
+  if (!(d > 0.0f)) { /* also NaN */
+    d = 0.0f;
+  }
+  if (d > BOARD_DUTY_MAX) {
+    d = BOARD_DUTY_MAX;
+  }
+  return (uint32_t)((1.0f - d) * (float)BOARD_PWM_ARR + 0.5f);
+}
+
+HOT void hal_pwm_set_duty(float da, float db, float dc) {
+  TIM1->CCR1 = duty_to_ccr(da);
+  TIM1->CCR2 = duty_to_ccr(db);
+  TIM1->CCR3 = duty_to_ccr(dc);
+}
+
+void hal_pwm_enable(void) {
+  TIM1->BDTR |= TIM_BDTR_MOE; /* refused by hardware while the break is active */
+}
+
+HOT void hal_pwm_disable(void) {
+  TIM1->BDTR &= ~TIM_BDTR_MOE;
+}
+
+bool hal_pwm_is_enabled(void) {
+  return (TIM1->BDTR & TIM_BDTR_MOE) != 0u;
+}
+
+bool hal_fault_hw_tripped(void) {
+  return (TIM1->SR & (TIM_SR_BIF | TIM_SR_SBIF)) != 0u;
+}
+
+void hal_fault_hw_clear(void) {
+  TIM1->SR = ~(TIM_SR_BIF | TIM_SR_SBIF); /* stays set while the input is active */
+}

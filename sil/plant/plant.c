@@ -1,0 +1,134 @@
+/*
+ * plant.c - parameter check, initialisation and the per-period orchestration
+ * of the plant (plant.h). One period: the machine flux linkages, rotor angle
+ * and speed and the DC-link capacitor voltage are integrated together,
+ *   gates on,  PLANT_INV_AVERAGE:   plant_inverter_avg.c
+ *   gates on,  PLANT_INV_SWITCHING: plant_inverter_sw.c
+ *   gates off, either model:        plant_inverter_sw.c (diodes only)
+ * Star-point voltage (plant_adc_t.v_star, w.r.t. the DC-link midpoint): the
+ * star point of the isotropic model sits at the mean of the three leg
+ * potentials. Switching model: taken at the valley from the actual switch /
+ * diode state (gates on and d < 1: all low sides on -> -v_dc/2). Average
+ * model: there is no switching state, it is the period average of the mean
+ * leg potential minus v_dc/2.
+ */
+#include "plant_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+int plant_check(const plant_params_t *p, const char **field) {
+  const char *dummy;
+  const char **f = field != NULL ? field : &dummy;
+  if (!plant_finite_pos(p->ts)) {
+    *f = "ts";
+    return -1;
+  }
+  if (plant_machine_check(&p->machine, f) != 0 ||
+      plant_inverter_check(&p->inverter, p->ts, f) != 0 ||
+      plant_dclink_check(&p->dclink, f) != 0 || plant_mech_check(&p->mech, f) != 0 ||
+      plant_sensors_check(&p->sensors, f) != 0) {
+    return -1;
+  }
+  return 0;
+}
+
+static double wrap_2pi(double a) {
+  a -= PLANT_TWO_PI * floor(a * (1.0 / PLANT_TWO_PI));
+  return a >= PLANT_TWO_PI ? 0.0 : a;
+}
+
+int plant_init(plant_t *pl, const plant_params_t *p, const char **field) {
+  const int rc = plant_check(p, field);
+  if (rc != 0) {
+    return rc;
+  }
+  memset(pl, 0, sizeof *pl);
+  pl->p = *p;
+  plant_aux_t *a = &pl->aux;
+  a->inv_ld = 1.0 / p->machine.ld;
+  a->inv_lq = 1.0 / p->machine.lq;
+  a->inv_j = 1.0 / p->mech.j;
+  a->inv_r = p->dclink.kind == PLANT_DC_RC ? 1.0 / p->dclink.r : 0.0;
+  a->inv_c = p->dclink.kind == PLANT_DC_RC ? 1.0 / p->dclink.c : 0.0;
+  a->kdt = p->inverter.dead_time / p->ts;
+  plant_inverter_init(pl);
+  for (int j = 0; j < 3; j++) {
+    a->edge_t[j] = -1e30; /* no command edge yet */
+    a->edge_cmd[j] = 0;
+    a->cond[j] = -1;
+  }
+  a->all_zero = 0;
+  a->gates_prev = 0;
+  a->v_star = 0.0;
+  pl->t = 0.0;
+  pl->lambda_d = p->machine.lambda_m; /* zero current */
+  pl->lambda_q = 0.0;
+  pl->theta_m = wrap_2pi(p->mech.theta0);
+  pl->omega_m =
+      p->mech.mode == PLANT_MECH_IMPOSED ? profile_eval(&p->mech.speed, 0.0) : p->mech.omega0;
+  pl->v_dc = p->dclink.v_source;
+  plant_sensors_init(pl);
+  return 0;
+}
+
+static double clamp_duty(double d) {
+  if (!(d >= 0.0)) {
+    return d < 0.0 ? 0.0 : 0.5; /* NaN: no voltage, like hal_sil */
+  }
+  return d > 1.0 ? 1.0 : d;
+}
+
+void plant_step(plant_t *pl, const double duty[3], bool gates_on) {
+  const double d[3] = {clamp_duty(duty[0]), clamp_duty(duty[1]), clamp_duty(duty[2])};
+  const double ts = pl->p.ts;
+  double x[X_N] = {pl->lambda_d, pl->lambda_q, pl->theta_m, pl->omega_m, pl->v_dc, 0, 0, 0, 0};
+  const int avg = pl->p.inverter.model == PLANT_INV_AVERAGE;
+  if (gates_on && avg) {
+    plant_inverter_avg_period(pl, d, x);
+    for (int j = 0; j < 3; j++) {
+      pl->aux.cond[j] = -1; /* all legs driven: no diode state */
+    }
+    pl->aux.all_zero = 0;
+    pl->aux.gates_prev = 1;
+  } else {
+    plant_inverter_sw_period(pl, d, gates_on, x);
+  }
+  const double inv_ts = 1.0 / ts;
+  pl->v_abc_avg[0] = x[X_VA] * inv_ts;
+  pl->v_abc_avg[1] = x[X_VB] * inv_ts;
+  pl->v_abc_avg[2] = -(pl->v_abc_avg[0] + pl->v_abc_avg[1]);
+  pl->i_dc_avg = x[X_IDC] * inv_ts;
+  if (avg) {
+    pl->aux.v_star = x[X_VN] * inv_ts;
+  }
+  pl->lambda_d = x[X_LD];
+  pl->lambda_q = x[X_LQ];
+  pl->theta_m = wrap_2pi(x[X_TH]);
+  pl->omega_m = x[X_W];
+  pl->v_dc = pl->p.dclink.kind == PLANT_DC_IDEAL ? pl->p.dclink.v_source : x[X_VC];
+  pl->aux.n_steps++;
+  pl->t = (double)pl->aux.n_steps * ts;
+  if (pl->p.mech.mode == PLANT_MECH_IMPOSED) {
+    pl->omega_m = profile_eval(&pl->p.mech.speed, pl->t); /* exactly the profile */
+  }
+}
+
+void plant_get_state(const plant_t *pl, plant_state_t *out) {
+  const double th_e = wrap_2pi(pl->p.machine.pole_pairs * pl->theta_m);
+  out->t = pl->t;
+  plant_machine_currents(pl, pl->lambda_d, pl->lambda_q, th_e, out->i_dq, out->i_abc);
+  out->lambda_dq[0] = pl->lambda_d;
+  out->lambda_dq[1] = pl->lambda_q;
+  for (int k = 0; k < 3; k++) {
+    out->v_abc[k] = pl->v_abc_avg[k];
+  }
+  out->theta_m = pl->theta_m;
+  out->theta_e = th_e;
+  out->omega_m = pl->omega_m;
+  out->torque = plant_machine_torque(pl, pl->lambda_d, pl->lambda_q);
+  out->load_torque =
+      pl->p.mech.mode == PLANT_MECH_FREE ? profile_eval(&pl->p.mech.load_torque, pl->t) : 0.0;
+  out->v_dc = pl->v_dc;
+  out->i_dc = pl->i_dc_avg;
+}

@@ -1,0 +1,148 @@
+/*
+ * plant.h - the host-side plant: PM synchronous machine, three-phase
+ * two-level inverter with DC link, mechanics and sensors. Plain C, double
+ * precision, no firmware headers: hal/sil and sil/runner bridge it to the
+ * drive.
+ *
+ * Timing (docs/architecture.md): plant_step() advances one PWM period
+ * [t, t+Ts) with one set of duties. The carrier is a triangle with its
+ * valley at t and t+Ts and its peak at t+Ts/2; phase x's high-side switch is
+ * commanded on while carrier > 1 - duty_x (pulse centred at t+Ts/2).
+ * plant_sample() returns the sensors at the valley, i.e. at plant time t.
+ */
+#ifndef FD_PLANT_PLANT_H
+#define FD_PLANT_PLANT_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "profile.h"
+
+typedef struct {
+  int pole_pairs;
+  double rs;       /* stator phase resistance [Ohm] */
+  double ld, lq;   /* [H] */
+  double lambda_m; /* PM flux linkage (peak, per phase) [Vs] */
+} plant_machine_t;
+
+typedef enum { PLANT_INV_AVERAGE, PLANT_INV_SWITCHING } plant_inverter_model_t;
+
+typedef struct {
+  plant_inverter_model_t model;
+  double dead_time;  /* [s] */
+  int substeps;      /* integration steps per PWM period (average model), >= 1 */
+} plant_inverter_t;
+
+typedef enum { PLANT_DC_IDEAL, PLANT_DC_RC } plant_dc_kind_t;
+
+typedef struct {
+  plant_dc_kind_t kind;
+  double v_source; /* source voltage [V] */
+  double r;        /* source resistance [Ohm] (RC only) */
+  double c;        /* DC-link capacitance [F] (RC only) */
+} plant_dclink_t;
+
+typedef enum { PLANT_MECH_FREE, PLANT_MECH_IMPOSED } plant_mech_mode_t;
+
+typedef struct {
+  plant_mech_mode_t mode;
+  double j;              /* inertia [kg m^2] */
+  double b;              /* viscous friction [N m s/rad] */
+  profile_t load_torque; /* load torque opposing motion [N m] (FREE mode) */
+  profile_t speed;       /* imposed mechanical speed [rad/s] (IMPOSED mode) */
+  double theta0;         /* initial mechanical angle [rad] */
+  double omega0;         /* initial mechanical speed [rad/s] (FREE mode) */
+} plant_mech_t;
+
+typedef struct {
+  int adc_bits;          /* e.g. 12 */
+  double i_full_scale;   /* current ADC range is +-i_full_scale [A] */
+  double v_full_scale;   /* DC-link ADC range is 0..v_full_scale [V] */
+  double gain_error[3];  /* relative gain error per current channel */
+  double offset_error[3];/* offset per current channel [A] */
+  double i_noise;        /* white noise rms on each current [A] */
+  double v_noise;        /* white noise rms on the DC-link voltage [V] */
+  int encoder_cpr;       /* encoder counts per mechanical revolution, 0 = ideal */
+  uint32_t seed;         /* noise generator seed */
+} plant_sensors_t;
+
+typedef struct {
+  plant_machine_t machine;
+  plant_inverter_t inverter;
+  plant_dclink_t dclink;
+  plant_mech_t mech;
+  plant_sensors_t sensors;
+  double ts; /* PWM period [s] */
+} plant_params_t;
+
+/* What the sensors deliver at the sampling instant (converted back to SI
+ * with nominal gains, exactly as a board would). */
+typedef struct {
+  double i_abc[3];
+  double v_dc;
+  double v_star;    /* star-point voltage w.r.t. the DC-link midpoint [V] */
+  double enc_angle; /* mechanical angle, quantised, [0, 2pi) */
+} plant_adc_t;
+
+/* True (noise-free) state, for logs and tests. */
+typedef struct {
+  double t;           /* plant time [s] */
+  double i_abc[3];    /* [A] */
+  double i_dq[2];     /* rotor frame currents [A] */
+  double lambda_dq[2];/* rotor frame flux linkages [Vs] */
+  double v_abc[3];    /* period-average phase-to-neutral voltages, last step [V] */
+  double theta_m;     /* mechanical angle [rad], wrapped to [0, 2pi) */
+  double theta_e;     /* electrical angle [rad], wrapped to [0, 2pi) */
+  double omega_m;     /* mechanical speed [rad/s] */
+  double torque;      /* electromagnetic torque [N m] */
+  double load_torque; /* load torque in force [N m] */
+  double v_dc;        /* DC-link capacitor voltage [V] */
+  double i_dc;        /* period-average DC-link current drawn [A] */
+} plant_state_t;
+
+/* Internal working data of plant_t (constants precomputed by plant_init and
+ * the memory of the switching-level inverter). Not part of the API: read the
+ * state through plant_get_state(). */
+typedef struct {
+  /* constants */
+  double inv_ld, inv_lq, inv_j, inv_c, inv_r; /* 1/Ld, 1/Lq, 1/J, 1/C, 1/R */
+  double kdt;      /* dead_time / ts */
+  double inv_band; /* 1 / width of the smooth sign of the average-model dead time [1/A] */
+  uint64_t n_steps; /* periods done: t = n_steps * ts exactly */
+  /* switching-level inverter memory, per leg: time of the last commanded
+   * edge relative to the start of the next period (<= 0), commanded
+   * high-side state after it, diode conduction state of a floating leg */
+  double edge_t[3];
+  int edge_cmd[3];
+  int cond[3];
+  int all_zero;   /* all phase currents blocked by the diodes */
+  int gates_prev; /* gates were on during the last period */
+  double v_star;  /* star-point voltage at the last valley (see plant_sample) */
+} plant_aux_t;
+
+typedef struct {
+  plant_params_t p;
+  /* state */
+  double t;
+  double lambda_d, lambda_q; /* rotor frame flux linkages [Vs] */
+  double theta_m, omega_m;
+  double v_dc;
+  double v_abc_avg[3];
+  double i_dc_avg;
+  uint64_t rng;
+  plant_aux_t aux; /* internal */
+} plant_t;
+
+/* Validates the parameters; on error returns a negative number and sets
+ * *field to the name of the offending parameter (static string). */
+int plant_check(const plant_params_t *p, const char **field);
+/* Initialises (calls plant_check first). Returns 0 or the error. */
+int plant_init(plant_t *pl, const plant_params_t *p, const char **field);
+/* Advances one PWM period with the given duties (clamped to [0, 1]).
+ * gates_on = false: all six switches off, only the diodes conduct. */
+void plant_step(plant_t *pl, const double duty[3], bool gates_on);
+/* Sensor readings at the present plant time (the carrier valley). */
+void plant_sample(plant_t *pl, plant_adc_t *out);
+void plant_get_state(const plant_t *pl, plant_state_t *out);
+
+#endif

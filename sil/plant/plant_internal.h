@@ -1,0 +1,109 @@
+/*
+ * plant_internal.h - shared by the plant_*.c files only: constants, the
+ * integration state vector and the small inline pieces (mechanics, DC link)
+ * that the inner loops of both inverter models call.
+ */
+#ifndef FD_PLANT_INTERNAL_H
+#define FD_PLANT_INTERNAL_H
+
+#include "plant.h"
+
+#include <stddef.h>
+
+#define PLANT_PI       3.14159265358979323846
+#define PLANT_TWO_PI   6.28318530717958647692
+#define PLANT_SQRT3_2  0.86602540378443864676 /* sqrt(3)/2 */
+#define PLANT_INV_SQRT3 0.57735026918962576451 /* 1/sqrt(3) */
+
+/* Integration state vector. The last four entries are integrals over the
+ * period (reset to 0 at its start) from which the period averages are taken. */
+enum {
+  X_LD,  /* lambda_d [Vs] */
+  X_LQ,  /* lambda_q [Vs] */
+  X_TH,  /* theta_m [rad] (not wrapped inside a period) */
+  X_W,   /* omega_m [rad/s] */
+  X_VC,  /* DC-link capacitor voltage [V] (constant v_source for an ideal link) */
+  X_VA,  /* integral of v_an [V s] */
+  X_VB,  /* integral of v_bn [V s] */
+  X_VN,  /* integral of (star point w.r.t. DC midpoint) [V s] */
+  X_IDC, /* integral of the DC-link current drawn by the inverter [A s] */
+  X_N
+};
+
+/* Mechanical input at time t: the imposed speed [rad/s] (IMPOSED) or the
+ * load torque [N m] (FREE). */
+static inline double plant_mech_input(const plant_t *pl, double t) {
+  const plant_mech_t *m = &pl->p.mech;
+  return profile_eval(m->mode == PLANT_MECH_IMPOSED ? &m->speed : &m->load_torque, t);
+}
+
+/* Mechanics (plant_mech.c documents the convention):
+ * FREE:    J dw/dt = T_e - B w - T_load(t), dtheta/dt = w
+ * IMPOSED: w = speed(t) (m), dtheta/dt = speed(t), the state w is set from
+ *          the profile at the end of each step. */
+static inline void plant_mech_deriv(const plant_t *pl, const double *x, double m, double te,
+                                    double *dx) {
+  if (pl->p.mech.mode == PLANT_MECH_IMPOSED) {
+    dx[X_TH] = m;
+    dx[X_W] = 0.0;
+  } else {
+    dx[X_TH] = x[X_W];
+    dx[X_W] = (te - pl->p.mech.b * x[X_W] - m) * pl->aux.inv_j;
+  }
+}
+
+/* Speed in force at a stage. */
+static inline double plant_mech_speed(const plant_t *pl, const double *x, double m) {
+  return pl->p.mech.mode == PLANT_MECH_IMPOSED ? m : x[X_W];
+}
+
+/* DC-link voltage seen by the inverter legs (a capacitor cannot be reverse
+ * biased through the free-wheeling diodes: clamp at 0). */
+static inline double plant_dclink_voltage(const plant_t *pl, const double *x) {
+  if (pl->p.dclink.kind == PLANT_DC_IDEAL) {
+    return pl->p.dclink.v_source;
+  }
+  return x[X_VC] > 0.0 ? x[X_VC] : 0.0;
+}
+
+/* dv_C/dt for a current i_dc drawn by the inverter: C dv/dt = (Vs - v)/R - i_dc. */
+static inline double plant_dclink_deriv(const plant_t *pl, const double *x, double idc) {
+  if (pl->p.dclink.kind == PLANT_DC_IDEAL) {
+    return 0.0;
+  }
+  return ((pl->p.dclink.v_source - x[X_VC]) * pl->aux.inv_r - idc) * pl->aux.inv_c;
+}
+
+/* plant_machine.c */
+int plant_machine_check(const plant_machine_t *m, const char **field);
+void plant_machine_currents(const plant_t *pl, double lambda_d, double lambda_q, double theta_e,
+                            double i_dq[2], double i_abc[3]);
+double plant_machine_torque(const plant_t *pl, double lambda_d, double lambda_q);
+void plant_machine_zero_phase_current(const plant_t *pl, double *x, int leg);
+
+/* plant_inverter.c, plant_inverter_avg.c, plant_inverter_sw.c */
+int plant_inverter_check(const plant_inverter_t *inv, double ts, const char **field);
+void plant_inverter_init(plant_t *pl);
+void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x);
+void plant_inverter_sw_period(plant_t *pl, const double duty[3], bool gates_on, double *x);
+
+/* plant_dclink.c */
+int plant_dclink_check(const plant_dclink_t *d, const char **field);
+
+/* plant_mech.c */
+int plant_mech_check(const plant_mech_t *m, const char **field);
+void plant_mech_end_step(const plant_t *pl, double *x, double t_end);
+
+/* plant_sensors.c */
+int plant_sensors_check(const plant_sensors_t *s, const char **field);
+void plant_sensors_init(plant_t *pl);
+
+/* Small helpers. */
+static inline int plant_finite_pos(double v) {
+  return v > 0.0 && v < 1e300; /* false for NaN and +inf */
+}
+static inline int plant_finite_nonneg(double v) {
+  return v >= 0.0 && v < 1e300;
+}
+
+#endif

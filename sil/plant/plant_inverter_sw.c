@@ -1,0 +1,496 @@
+/*
+ * plant_inverter_sw.c - switching-level two-level inverter with dead time,
+ * and the diode-only circuit (gates off, both inverter models).
+ *
+ * Carrier: triangle, valley at 0 and Ts, peak at Ts/2. Commanded high-side
+ * state H_x = carrier > 1 - d_x, i.e. on over [(1-d)Ts/2, (1+d)Ts/2] for
+ * 0 < d < 1, always for d = 1, never for d = 0. Dead time: the turn-on of
+ * each switch is delayed by td after its command edge (turn-off is
+ * immediate), so after every edge the leg floats for td. Edges within td of
+ * the period end carry over to the next period (per-leg memory).
+ * A floating leg follows its free-wheeling diodes:
+ *   i_x > 0 -> low diode, leg at 0;   i_x < 0 -> high diode, leg at v_dc;
+ *   i_x = 0 -> blocked: the leg floats at the voltage u that keeps
+ *              di_x/dt = 0, valid while 0 <= u <= v_dc.
+ * With two legs blocked all currents are zero ("all-zero" state): the flux
+ * linkages are held at (lambda_m, 0) exactly, the phase voltages are the
+ * back-EMF, and conduction resumes when no star-point potential keeps every
+ * leg within its allowed range (gap > 0), between the two legs that violate
+ * it. This gives extinction without chattering below the rectifier
+ * threshold (line-to-line back-EMF peak < v_dc) and uncontrolled
+ * rectification above it.
+ * Integration: the period is split at every switching event (times exact
+ * from the duties and td), each interval is integrated with RK4 steps of at
+ * most Ts/substeps; diode events inside an interval (current zero crossing,
+ * blocked-leg voltage leaving [0, v_dc], all-zero gap opening) are located
+ * with the Illinois method to 1e-8 Ts and the step is split there.
+ */
+#include "plant_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+enum { LEG_LO, LEG_HI, LEG_FLOAT };
+enum { COND_NONE = -1, COND_LO = 0, COND_HI = 1, COND_BLOCK = 2 };
+enum { EV_CUR0 = 0, EV_U_LO = 3, EV_U_HI = 4, EV_GAP = 5, EV_N = 6 };
+
+#define SW_I_EPS       1e-9 /* a current below this is taken as blocked [A] */
+#define SW_MAX_EVENTS  24   /* diode events handled per integration step */
+#define SW_MAX_EDGES   4
+
+static const double CX[3][2] = {{1.0, 0.0}, {-0.5, PLANT_SQRT3_2}, {-0.5, -PLANT_SQRT3_2}};
+
+typedef struct {
+  int type[3];
+  int cond[3];
+  int all_zero;
+  int blocked; /* the single blocked leg when not all_zero, else -1 */
+} sw_cfg_t;
+
+typedef struct {
+  double u;   /* voltage of the blocked leg [V] */
+  double gap; /* all-zero: > 0 when a diode path must open [V] */
+  double vn0; /* star point w.r.t. the negative rail [V] */
+  double vdc;
+} sw_out_t;
+
+static void phase_currents(const plant_t *pl, const double *x, double i[3], double *ial,
+                           double *ibe) {
+  const double th = pl->p.machine.pole_pairs * x[X_TH];
+  const double c = cos(th), s = sin(th);
+  const double id = (x[X_LD] - pl->p.machine.lambda_m) * pl->aux.inv_ld;
+  const double iq = x[X_LQ] * pl->aux.inv_lq;
+  *ial = id * c - iq * s;
+  *ibe = id * s + iq * c;
+  i[0] = *ial;
+  i[1] = -0.5 * *ial + PLANT_SQRT3_2 * *ibe;
+  i[2] = -i[0] - i[1];
+}
+
+/* Allowed leg potential range for the all-zero state. */
+static void leg_range(int type, double vdc, double *lo, double *hi) {
+  *lo = type == LEG_HI ? vdc : 0.0;
+  *hi = type == LEG_LO ? 0.0 : vdc;
+}
+
+static void backemf(const plant_t *pl, const double *x, double w, double e[3]) {
+  const double pp = (double)pl->p.machine.pole_pairs;
+  const double th = pp * x[X_TH];
+  const double k = pp * w * pl->p.machine.lambda_m;
+  const double eal = -k * sin(th), ebe = k * cos(th);
+  e[0] = eal;
+  e[1] = -0.5 * eal + PLANT_SQRT3_2 * ebe;
+  e[2] = -e[0] - e[1];
+}
+
+static void sw_deriv(const plant_t *pl, const sw_cfg_t *cf, const double *x, double m, double *dx,
+                     sw_out_t *o) {
+  const plant_machine_t *mp = &pl->p.machine;
+  const double pp = (double)mp->pole_pairs;
+  const double vdc = plant_dclink_voltage(pl, x);
+  const double w = plant_mech_speed(pl, x, m);
+  const double we = pp * w;
+  double te = 0.0, idc = 0.0, vn0;
+  if (cf->all_zero) {
+    double e[3], lo_max = -1e300, hi_min = 1e300;
+    backemf(pl, x, w, e);
+    for (int j = 0; j < 3; j++) {
+      double lo, hi;
+      leg_range(cf->type[j], vdc, &lo, &hi);
+      lo_max = fmax(lo_max, lo - e[j]);
+      hi_min = fmin(hi_min, hi - e[j]);
+    }
+    o->gap = lo_max - hi_min;
+    vn0 = o->gap > 0.0 ? 0.5 * (lo_max + hi_min) : fmin(fmax(0.5 * vdc, lo_max), hi_min);
+    o->u = 0.0;
+    dx[X_LD] = 0.0;
+    dx[X_LQ] = 0.0;
+    dx[X_VA] = e[0];
+    dx[X_VB] = e[1];
+  } else {
+    const double th = pp * x[X_TH];
+    const double c = cos(th), s = sin(th);
+    const double id = (x[X_LD] - mp->lambda_m) * pl->aux.inv_ld;
+    const double iq = x[X_LQ] * pl->aux.inv_lq;
+    const double ial = id * c - iq * s, ibe = id * s + iq * c;
+    const double i[3] = {ial, -0.5 * ial + PLANT_SQRT3_2 * ibe, -0.5 * ial - PLANT_SQRT3_2 * ibe};
+    double v[3];
+    for (int j = 0; j < 3; j++) {
+      const int hi = cf->type[j] == LEG_HI || (cf->type[j] == LEG_FLOAT && cf->cond[j] == COND_HI);
+      v[j] = hi ? vdc : 0.0;
+      idc += hi ? i[j] : 0.0;
+    }
+    const double val = (2.0 * v[0] - v[1] - v[2]) * (1.0 / 3.0);
+    const double vbe = (v[1] - v[2]) * PLANT_INV_SQRT3;
+    double dld = val * c + vbe * s - mp->rs * id + we * x[X_LQ];
+    double dlq = -val * s + vbe * c - mp->rs * iq - we * x[X_LD];
+    o->u = 0.0;
+    if (cf->blocked >= 0) {
+      /* leg j blocked: choose its potential u so that di_j/dt = 0;
+       * di_j/dt = p.(D dlambda) + w_e c_j.(J i_ab), p = R(-theta) c_j, and
+       * u enters as dlambda += (2/3) u p. */
+      const int j = cf->blocked;
+      const double p1 = CX[j][0] * c + CX[j][1] * s, p2 = -CX[j][0] * s + CX[j][1] * c;
+      const double dij = p1 * dld * pl->aux.inv_ld + p2 * dlq * pl->aux.inv_lq +
+                         we * (-CX[j][0] * ibe + CX[j][1] * ial);
+      const double g = (2.0 / 3.0) * (p1 * p1 * pl->aux.inv_ld + p2 * p2 * pl->aux.inv_lq);
+      const double u = -dij / g;
+      dld += (2.0 / 3.0) * u * p1;
+      dlq += (2.0 / 3.0) * u * p2;
+      v[j] = u;
+      o->u = u;
+    }
+    o->gap = 0.0;
+    vn0 = (v[0] + v[1] + v[2]) * (1.0 / 3.0);
+    dx[X_LD] = dld;
+    dx[X_LQ] = dlq;
+    dx[X_VA] = v[0] - vn0;
+    dx[X_VB] = v[1] - vn0;
+    te = 1.5 * pp * (x[X_LD] * iq - x[X_LQ] * id);
+  }
+  o->vn0 = vn0;
+  o->vdc = vdc;
+  plant_mech_deriv(pl, x, m, te, dx);
+  dx[X_VC] = plant_dclink_deriv(pl, x, idc);
+  dx[X_VN] = vn0 - 0.5 * vdc;
+  dx[X_IDC] = idc;
+}
+
+static void enter_all_zero(const plant_t *pl, sw_cfg_t *cf, double *x) {
+  x[X_LD] = pl->p.machine.lambda_m;
+  x[X_LQ] = 0.0;
+  cf->all_zero = 1;
+  cf->blocked = -1;
+  for (int j = 0; j < 3; j++) {
+    cf->cond[j] = cf->type[j] == LEG_FLOAT ? COND_BLOCK : COND_NONE;
+  }
+}
+
+/* One RK4 step of size h from (t, x0); keeps the algebraic constraints
+ * (blocked current exactly zero, imposed speed exact). */
+static void sw_rk4(const plant_t *pl, const sw_cfg_t *cf, double t, const double *x0, double h,
+                   double *x1) {
+  const double m0 = plant_mech_input(pl, t), m1 = plant_mech_input(pl, t + 0.5 * h),
+               m2 = plant_mech_input(pl, t + h);
+  double k1[X_N], k2[X_N], k3[X_N], k4[X_N], xs[X_N];
+  sw_out_t o;
+  sw_deriv(pl, cf, x0, m0, k1, &o);
+  for (int i = 0; i < X_N; i++) {
+    xs[i] = x0[i] + 0.5 * h * k1[i];
+  }
+  sw_deriv(pl, cf, xs, m1, k2, &o);
+  for (int i = 0; i < X_N; i++) {
+    xs[i] = x0[i] + 0.5 * h * k2[i];
+  }
+  sw_deriv(pl, cf, xs, m1, k3, &o);
+  for (int i = 0; i < X_N; i++) {
+    xs[i] = x0[i] + h * k3[i];
+  }
+  sw_deriv(pl, cf, xs, m2, k4, &o);
+  for (int i = 0; i < X_N; i++) {
+    x1[i] = x0[i] + h / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
+  }
+  plant_mech_end_step(pl, x1, t + h);
+  if (!cf->all_zero && cf->blocked >= 0) {
+    plant_machine_zero_phase_current(pl, x1, cf->blocked);
+  }
+}
+
+/* Event functions at (t, x); z[e] > 0 means event e has happened. */
+static void sw_events(const plant_t *pl, const sw_cfg_t *cf, double t, const double *x,
+                      double z[EV_N]) {
+  for (int e = 0; e < EV_N; e++) {
+    z[e] = -1e300;
+  }
+  if (cf->all_zero) {
+    double dx[X_N];
+    sw_out_t o;
+    sw_deriv(pl, cf, x, plant_mech_input(pl, t), dx, &o);
+    z[EV_GAP] = o.gap;
+    return;
+  }
+  double i[3], ial, ibe;
+  phase_currents(pl, x, i, &ial, &ibe);
+  for (int j = 0; j < 3; j++) {
+    if (cf->type[j] == LEG_FLOAT && cf->cond[j] == COND_LO) {
+      z[EV_CUR0 + j] = -i[j];
+    } else if (cf->type[j] == LEG_FLOAT && cf->cond[j] == COND_HI) {
+      z[EV_CUR0 + j] = i[j];
+    }
+  }
+  if (cf->blocked >= 0) {
+    double dx[X_N];
+    sw_out_t o;
+    sw_deriv(pl, cf, x, plant_mech_input(pl, t), dx, &o);
+    z[EV_U_LO] = -o.u;
+    z[EV_U_HI] = o.u - o.vdc;
+  }
+}
+
+static void exit_all_zero(const plant_t *pl, sw_cfg_t *cf, double t, const double *x) {
+  double e[3], lo, hi, best_lo = -1e300, best_hi = 1e300;
+  int jx = 0, jy = 1;
+  const double vdc = plant_dclink_voltage(pl, x);
+  backemf(pl, x, plant_mech_speed(pl, x, plant_mech_input(pl, t)), e);
+  for (int j = 0; j < 3; j++) {
+    leg_range(cf->type[j], vdc, &lo, &hi);
+    if (lo - e[j] > best_lo) {
+      best_lo = lo - e[j];
+      jx = j;
+    }
+    if (hi - e[j] < best_hi) {
+      best_hi = hi - e[j];
+      jy = j;
+    }
+  }
+  /* jx sources current into the machine (i > 0: low diode), jy returns it
+   * (i < 0: high diode); jx != jy since gap > 0. */
+  const int jz = 3 - jx - jy;
+  cf->all_zero = 0;
+  cf->cond[jx] = cf->type[jx] == LEG_FLOAT ? COND_LO : COND_NONE;
+  cf->cond[jy] = cf->type[jy] == LEG_FLOAT ? COND_HI : COND_NONE;
+  cf->cond[jz] = cf->type[jz] == LEG_FLOAT ? COND_BLOCK : COND_NONE;
+  cf->blocked = cf->type[jz] == LEG_FLOAT ? jz : -1;
+}
+
+static void sw_transition(const plant_t *pl, sw_cfg_t *cf, double t, double *x, int ev) {
+  if (ev == EV_GAP) {
+    exit_all_zero(pl, cf, t, x);
+  } else if (ev == EV_U_LO || ev == EV_U_HI) {
+    cf->cond[cf->blocked] = ev == EV_U_LO ? COND_LO : COND_HI;
+    cf->blocked = -1;
+  } else {
+    const int j = ev - EV_CUR0;
+    plant_machine_zero_phase_current(pl, x, j);
+    if (cf->blocked >= 0) {
+      enter_all_zero(pl, cf, x); /* two phases blocked: all three currents are zero */
+      return;
+    }
+    cf->cond[j] = COND_BLOCK;
+    cf->blocked = j;
+    double dx[X_N];
+    sw_out_t o;
+    sw_deriv(pl, cf, x, plant_mech_input(pl, t), dx, &o);
+    if (o.u > o.vdc || o.u < 0.0) { /* current reverses into the other diode */
+      cf->cond[j] = o.u > o.vdc ? COND_HI : COND_LO;
+      cf->blocked = -1;
+    }
+  }
+}
+
+/* Locates event ev inside (0, h] (z0 <= 0 < z1) with the Illinois method;
+ * returns the time on the event side of the bracket and the state there. */
+static double sw_locate(const plant_t *pl, const sw_cfg_t *cf, double t, const double *x, double h,
+                        int ev, double z0, double z1, const double *x1, double *xb) {
+  double a = 0.0, b = h, za = z0, zb = z1;
+  int side = 0;
+  memcpy(xb, x1, sizeof(double) * X_N);
+  const double tol = 1e-8 * pl->p.ts;
+  for (int it = 0; it < 60 && b - a > tol; it++) {
+    double tau = a + (b - a) * (-za) / (zb - za);
+    if (!(tau > a && tau < b)) {
+      tau = 0.5 * (a + b);
+    }
+    double xt[X_N], z[EV_N];
+    sw_rk4(pl, cf, t, x, tau, xt);
+    sw_events(pl, cf, t + tau, xt, z);
+    if (z[ev] > 0.0) {
+      b = tau;
+      zb = z[ev];
+      memcpy(xb, xt, sizeof xt);
+      if (side == 1) {
+        za *= 0.5;
+      }
+      side = 1;
+    } else {
+      a = tau;
+      za = z[ev];
+      if (side == -1) {
+        zb *= 0.5;
+      }
+      side = -1;
+    }
+  }
+  return b;
+}
+
+/* Integrates over len with a fixed leg configuration, splitting at diode
+ * events. */
+static void sw_integrate(const plant_t *pl, sw_cfg_t *cf, double *t, double *x, double len) {
+  const double hmax = pl->p.ts / pl->p.inverter.substeps;
+  const int nsub = (int)ceil(len / hmax - 1e-9);
+  const double h = len / (nsub > 0 ? nsub : 1);
+  for (int k = 0; k < (nsub > 0 ? nsub : 1); k++) {
+    double rem = h;
+    for (int guard = 0; rem > 1e-12 * pl->p.ts; guard++) {
+      double x1[X_N], z0[EV_N], z1[EV_N];
+      sw_events(pl, cf, *t, x, z0);
+      sw_rk4(pl, cf, *t, x, rem, x1);
+      sw_events(pl, cf, *t + rem, x1, z1);
+      int best = -1;
+      double fbest = 2.0;
+      for (int e = 0; e < EV_N && guard < SW_MAX_EVENTS; e++) {
+        if (z1[e] > 0.0 || z0[e] > 0.0) {
+          const double f = z0[e] >= 0.0 ? 0.0 : z0[e] / (z0[e] - z1[e]);
+          if (f < fbest) {
+            fbest = f;
+            best = e;
+          }
+        }
+      }
+      if (best < 0) {
+        memcpy(x, x1, sizeof x1);
+        *t += rem;
+        break;
+      }
+      double tau = 0.0;
+      if (z0[best] < 0.0) {
+        double xb[X_N];
+        tau = sw_locate(pl, cf, *t, x, rem, best, z0[best], z1[best], x1, xb);
+        memcpy(x, xb, sizeof xb);
+      }
+      *t += tau;
+      rem -= tau;
+      sw_transition(pl, cf, *t, x, best);
+    }
+  }
+}
+
+/* Sets the leg types for a new interval and the diode state of legs that
+ * start to float. */
+static void sw_setup(const plant_t *pl, sw_cfg_t *cf, double *x, const int type[3]) {
+  double i[3], ial, ibe;
+  phase_currents(pl, x, i, &ial, &ibe);
+  for (int j = 0; j < 3; j++) {
+    if (type[j] == LEG_FLOAT) {
+      if (cf->type[j] != LEG_FLOAT || cf->cond[j] == COND_NONE) {
+        cf->cond[j] = fabs(i[j]) <= SW_I_EPS ? COND_BLOCK : (i[j] > 0.0 ? COND_LO : COND_HI);
+      }
+    } else {
+      cf->cond[j] = COND_NONE;
+    }
+    cf->type[j] = type[j];
+  }
+  if (cf->all_zero) {
+    enter_all_zero(pl, cf, x);
+    return;
+  }
+  int nb = 0, jb = -1;
+  for (int j = 0; j < 3; j++) {
+    if (cf->type[j] == LEG_FLOAT && cf->cond[j] == COND_BLOCK) {
+      nb++;
+      jb = j;
+    }
+  }
+  if (nb >= 2) {
+    enter_all_zero(pl, cf, x);
+  } else if (nb == 1) {
+    cf->blocked = jb;
+    plant_machine_zero_phase_current(pl, x, jb);
+  } else {
+    cf->blocked = -1;
+  }
+}
+
+typedef struct {
+  double te[SW_MAX_EDGES];
+  int cmd[SW_MAX_EDGES];
+  int n;
+} edges_t;
+
+static int leg_type_at(const edges_t *e, double tau, double td) {
+  int k = 0;
+  while (k + 1 < e->n && e->te[k + 1] <= tau) {
+    k++;
+  }
+  if (tau - e->te[k] < td) {
+    return LEG_FLOAT;
+  }
+  return e->cmd[k] ? LEG_HI : LEG_LO;
+}
+
+void plant_inverter_sw_period(plant_t *pl, const double duty[3], bool gates_on, double *x) {
+  plant_aux_t *a = &pl->aux;
+  const double ts = pl->p.ts, td = pl->p.inverter.dead_time;
+  edges_t ed[3];
+  double ev[2 + 3 * 2 * SW_MAX_EDGES];
+  int nev = 0;
+  ev[nev++] = 0.0;
+  ev[nev++] = ts;
+  for (int j = 0; j < 3; j++) {
+    edges_t *e = &ed[j];
+    e->n = 0;
+    e->te[e->n] = a->edge_t[j];
+    e->cmd[e->n++] = a->edge_cmd[j];
+    if (!gates_on) {
+      continue;
+    }
+    const double d = duty[j];
+    const int h0 = d >= 1.0;
+    if (!a->gates_prev || h0 != a->edge_cmd[j]) {
+      e->te[e->n] = 0.0;
+      e->cmd[e->n++] = h0;
+    }
+    if (d > 0.0 && d < 1.0) {
+      e->te[e->n] = 0.5 * (1.0 - d) * ts;
+      e->cmd[e->n++] = 1;
+      e->te[e->n] = 0.5 * (1.0 + d) * ts;
+      e->cmd[e->n++] = 0;
+    }
+    for (int k = 0; k < e->n; k++) {
+      if (e->te[k] > 0.0 && e->te[k] < ts) {
+        ev[nev++] = e->te[k];
+      }
+      if (e->te[k] + td > 0.0 && e->te[k] + td < ts) {
+        ev[nev++] = e->te[k] + td;
+      }
+    }
+  }
+  for (int i = 1; i < nev; i++) { /* insertion sort, <= 26 entries */
+    const double v = ev[i];
+    int k = i - 1;
+    while (k >= 0 && ev[k] > v) {
+      ev[k + 1] = ev[k];
+      k--;
+    }
+    ev[k + 1] = v;
+  }
+
+  sw_cfg_t cf;
+  for (int j = 0; j < 3; j++) {
+    cf.type[j] = a->cond[j] == COND_NONE ? LEG_LO : LEG_FLOAT;
+    cf.cond[j] = a->cond[j];
+  }
+  cf.all_zero = a->all_zero;
+  cf.blocked = -1;
+  double t = pl->t;
+  for (int i = 0; i + 1 < nev; i++) {
+    const double len = ev[i + 1] - ev[i];
+    if (len <= 1e-12 * ts) {
+      continue;
+    }
+    const double mid = 0.5 * (ev[i] + ev[i + 1]);
+    int type[3];
+    for (int j = 0; j < 3; j++) {
+      type[j] = gates_on ? leg_type_at(&ed[j], mid, td) : LEG_FLOAT;
+    }
+    sw_setup(pl, &cf, x, type);
+    sw_integrate(pl, &cf, &t, x, len);
+  }
+
+  /* memory for the next period */
+  for (int j = 0; j < 3; j++) {
+    a->cond[j] = cf.type[j] == LEG_FLOAT ? cf.cond[j] : COND_NONE;
+    if (gates_on) {
+      a->edge_t[j] = ed[j].te[ed[j].n - 1] - ts;
+      a->edge_cmd[j] = ed[j].cmd[ed[j].n - 1];
+    }
+  }
+  a->all_zero = cf.all_zero;
+  a->gates_prev = gates_on;
+  /* star point at the valley that ends the period */
+  double dx[X_N];
+  sw_out_t o;
+  sw_deriv(pl, &cf, x, plant_mech_input(pl, pl->t + ts), dx, &o);
+  a->v_star = o.vn0 - 0.5 * o.vdc;
+}

@@ -1,0 +1,71 @@
+/*
+ * plant_machine.c - PM synchronous machine with constant Ld, Lq, lambda_m,
+ * Rs (SPM: Ld = Lq; IPM: Ld < Lq). State: rotor-frame flux linkages
+ *   lambda_d = Ld i_d + lambda_m,  lambda_q = Lq i_q   (d on the magnet)
+ *   d lambda_d/dt = v_d - Rs i_d + w_e lambda_q
+ *   d lambda_q/dt = v_q - Rs i_q - w_e lambda_d
+ *   T_e = 1.5 p (lambda_d i_q - lambda_q i_d),  theta_e = p theta_m.
+ * Amplitude-invariant Clarke/Park: the alpha axis is phase a, peak phase
+ * current = |i_dq|. The derivatives themselves are evaluated inside the
+ * inverter models (plant_inverter_avg.c, plant_inverter_sw.c) where the
+ * applied voltage is known; only the flux -> current map (a flux map can
+ * replace it later) and the shared transforms live here.
+ */
+#include "plant_internal.h"
+
+#include <math.h>
+
+int plant_machine_check(const plant_machine_t *m, const char **field) {
+  const char *bad = NULL;
+  if (m->pole_pairs < 1 || m->pole_pairs > 1000) {
+    bad = "machine.pole_pairs";
+  } else if (!plant_finite_pos(m->rs)) {
+    bad = "machine.rs";
+  } else if (!plant_finite_pos(m->ld)) {
+    bad = "machine.ld";
+  } else if (!plant_finite_pos(m->lq)) {
+    bad = "machine.lq";
+  } else if (!plant_finite_nonneg(m->lambda_m)) {
+    bad = "machine.lambda_m";
+  }
+  if (bad != NULL) {
+    *field = bad;
+    return -1;
+  }
+  return 0;
+}
+
+void plant_machine_currents(const plant_t *pl, double lambda_d, double lambda_q, double theta_e,
+                            double i_dq[2], double i_abc[3]) {
+  const double id = (lambda_d - pl->p.machine.lambda_m) * pl->aux.inv_ld;
+  const double iq = lambda_q * pl->aux.inv_lq;
+  const double c = cos(theta_e), s = sin(theta_e);
+  const double ia = id * c - iq * s, ib = id * s + iq * c;
+  i_dq[0] = id;
+  i_dq[1] = iq;
+  i_abc[0] = ia;
+  i_abc[1] = -0.5 * ia + PLANT_SQRT3_2 * ib;
+  i_abc[2] = -0.5 * ia - PLANT_SQRT3_2 * ib;
+}
+
+double plant_machine_torque(const plant_t *pl, double lambda_d, double lambda_q) {
+  const double id = (lambda_d - pl->p.machine.lambda_m) * pl->aux.inv_ld;
+  const double iq = lambda_q * pl->aux.inv_lq;
+  return 1.5 * pl->p.machine.pole_pairs * (lambda_d * iq - lambda_q * id);
+}
+
+/* Projects the flux state so that phase `leg`'s current is exactly zero,
+ * moving lambda_dq along the gradient of that current (smallest change).
+ * Used when a free-wheeling diode blocks: i_x = k . (lambda - lambda_m e_d)
+ * with k = diag(1/Ld, 1/Lq) R(-theta_e) c_x. */
+void plant_machine_zero_phase_current(const plant_t *pl, double *x, int leg) {
+  static const double cx[3][2] = {{1.0, 0.0}, {-0.5, PLANT_SQRT3_2}, {-0.5, -PLANT_SQRT3_2}};
+  const double th = pl->p.machine.pole_pairs * x[X_TH];
+  const double c = cos(th), s = sin(th);
+  const double k1 = (cx[leg][0] * c + cx[leg][1] * s) * pl->aux.inv_ld;
+  const double k2 = (-cx[leg][0] * s + cx[leg][1] * c) * pl->aux.inv_lq;
+  const double ix = k1 * (x[X_LD] - pl->p.machine.lambda_m) + k2 * x[X_LQ];
+  const double n2 = k1 * k1 + k2 * k2;
+  x[X_LD] -= ix * k1 / n2;
+  x[X_LQ] -= ix * k2 / n2;
+}

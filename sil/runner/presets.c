@@ -1,0 +1,82 @@
+/*
+ * presets.c - built-in machines (see presets.h).
+ */
+#include "presets.h"
+
+#include <string.h>
+
+#define RPM (3.14159265358979 / 30.0)
+
+static const machine_preset_t presets[] = {
+    {
+        .name = "rubino2020_spm",
+        .source = "Rubino et al. 2020, Table I",
+        .machine = {.pole_pairs = 21, .rs = 7.1, .ld = 0.057, .lq = 0.057, .lambda_m = 0.19},
+        .inertia = 0.021,
+        .friction = 1e-3,
+        .v_dc = 310.0,
+        .i_rated = 2.5,
+        .torque_rated = 20.0,
+        .speed_max = 1200.0 * RPM,
+    },
+    {
+        .name = "fabbri2022_t51",
+        .source = "Fabbri 2022, Table 5.1 (inertia and rating assumed, docs/scenarios.md)",
+        .machine = {.pole_pairs = 8, .rs = 2.2, .ld = 394e-6, .lq = 475e-6, .lambda_m = 0.1186},
+        .inertia = 2e-4,
+        .friction = 1e-5,
+        .v_dc = 24.0,
+        .i_rated = 2.0,
+        .torque_rated = 0.8,
+        .speed_max = 1500.0 * RPM,
+    },
+    {
+        .name = "fabbri2022_ebike",
+        .source = "Fabbri 2022, Table 5.4 (inertia and rating assumed, docs/scenarios.md)",
+        .machine = {.pole_pairs = 23, .rs = 0.069, .ld = 103e-6, .lq = 149e-6, .lambda_m = 0.0236},
+        .inertia = 0.05,
+        .friction = 1e-3,
+        .v_dc = 24.0,
+        .i_rated = 15.0,
+        .torque_rated = 15.0,
+        .speed_max = 300.0 * RPM,
+    },
+};
+
+const machine_preset_t *preset_find(const char *name) {
+  for (size_t i = 0; i < sizeof presets / sizeof presets[0]; ++i) {
+    if (strcmp(presets[i].name, name) == 0) {
+      return &presets[i];
+    }
+  }
+  return NULL;
+}
+
+const char *preset_names(void) {
+  return "rubino2020_spm, fabbri2022_t51, fabbri2022_ebike";
+}
+
+void preset_apply(const machine_preset_t *p, plant_params_t *plant, drive_config_t *drive) {
+  plant->machine = p->machine;
+  plant->mech.j = p->inertia;
+  plant->mech.b = p->friction;
+  plant->dclink.v_source = p->v_dc;
+
+  drive->pole_pairs = (float)p->machine.pole_pairs;
+  drive->rs = (float)p->machine.rs;
+  drive->ld = (float)p->machine.ld;
+  drive->lq = (float)p->machine.lq;
+  drive->lambda_m = (float)p->machine.lambda_m;
+  drive->inertia = (float)p->inertia;
+  drive->i_max = (float)(p->i_rated * 1.41421356237);
+  drive->i_trip = 2.0f * drive->i_max;
+  drive->torque_max = (float)p->torque_rated;
+  drive->speed_max = (float)p->speed_max;
+  drive->speed_trip = 1.25f * drive->speed_max;
+  drive->v_dc_max = (float)(1.3 * p->v_dc);
+  drive->v_dc_min = (float)(0.5 * p->v_dc);
+  drive->accel_max = drive->speed_max; /* 0 -> max speed in 1 s */
+  drive->flux_min = 0.2f * drive->lambda_m;
+  plant->sensors.i_full_scale = 2.5 * drive->i_trip;
+  plant->sensors.v_full_scale = 2.0 * p->v_dc;
+}

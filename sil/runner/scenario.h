@@ -1,0 +1,39 @@
+/*
+ * scenario.h - a SIL scenario: plant, controller parameters, reference
+ * profiles, injected sensor faults, logging. Loaded from JSON (schema in
+ * docs/scenarios.md); every error names the field and the reason.
+ */
+#ifndef FD_SIL_SCENARIO_H
+#define FD_SIL_SCENARIO_H
+
+#include <stddef.h>
+
+#include "drive_config.h"
+#include "plant.h"
+#include "profile.h"
+
+typedef struct {
+  char name[96];
+  double duration; /* simulated time [s] */
+  plant_params_t plant;
+  drive_config_t drive; /* the controller's parameters (estimates) */
+  double hw_trip;       /* hardware overcurrent comparator level [A], 0 = none */
+  double enable_at;     /* enable command time [s] */
+  double disable_at;    /* disable command time [s], <= enable_at = never */
+  struct {
+    profile_t torque; /* [N m] */
+    profile_t speed;  /* mechanical [rad/s] */
+    profile_t id, iq; /* [A] */
+    profile_t flux;   /* [Vs], 0 = automatic */
+  } ref;
+  profile_t v_source;      /* DC source voltage [V] */
+  profile_t encoder_error; /* added to the encoder reading [rad mech] */
+  int log_decimation;      /* log every n-th sample */
+} scenario_t;
+
+/* Loads a scenario from JSON text; `origin` prefixes error messages (the
+ * file name). Returns 0, or -1 with a message in err. */
+int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *err, size_t errlen);
+int scenario_load_file(const char *path, scenario_t *sc, char *err, size_t errlen);
+
+#endif

@@ -1,0 +1,13 @@
+/*
+ * summary.h - the run's metrics as a JSON object (docs/log-format.md).
+ */
+#ifndef FD_SIL_SUMMARY_H
+#define FD_SIL_SUMMARY_H
+
+#include "scenario.h"
+#include "sil_run.h"
+
+/* Returns a malloc'ed, formatted JSON string (caller frees), or NULL. */
+char *summary_json(const scenario_t *sc, const sil_result_t *res);
+
+#endif

@@ -1,0 +1,12 @@
+# pytest (tools package) with the venv from scripts/setup.sh; the SIL test
+# uses this build's fluxdrive-sil.
+set(FD_PYTHON "" CACHE FILEPATH "Python of the tools venv (scripts/setup.sh)")
+if(FD_PYTHON)
+  add_test(NAME python/pytest
+           COMMAND ${FD_PYTHON} -m pytest -q ${CMAKE_CURRENT_SOURCE_DIR}/python
+           WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  set_tests_properties(python/pytest PROPERTIES LABELS python TIMEOUT 900
+    ENVIRONMENT "FLUXDRIVE_SIL=$<TARGET_FILE:fluxdrive-sil>")
+else()
+  message(STATUS "FD_PYTHON not set: pytest not registered (scripts/test.sh sets it)")
+endif()

@@ -1,0 +1,124 @@
+/*
+ * Bad scenario files get an error naming the field and the reason; the
+ * parser never crashes (run under ASan/UBSan), also on truncated input.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "scenario.h"
+
+typedef struct {
+  const char *json;
+  const char *expect; /* substring of the error message */
+} bad_case_t;
+
+static const bad_case_t cases[] = {
+    {"{", "line 1: not valid JSON"},
+    {"[1, 2]", "(top level): must be an object"},
+    {"{\"name\": \"x\"}", "duration: required"},
+    {"{\"duration\": -1}", "duration: must be in"},
+    {"{\"duration\": \"1\"}", "duration: must be a number"},
+    {"{\"duration\": 1, \"machne\": {}}", "machne: unknown field"},
+    {"{\"duration\": 1, \"machine\": {\"preset\": \"nope\"}}", "machine.preset: unknown preset"},
+    {"{\"duration\": 1, \"machine\": {\"rs\": -7.1}}", "machine.rs: must be in"},
+    {"{\"duration\": 1, \"machine\": {\"pole_pairs\": 2.5}}",
+     "machine.pole_pairs: must be an integer"},
+    {"{\"duration\": 1, \"machine\": {\"ls\": 0.01, \"ld\": 0.01}}", "machine.ls: give either"},
+    {"{\"duration\": 1, \"inverter\": {\"model\": \"svm\"}}",
+     "inverter.model: must be one of: average, switching"},
+    {"{\"duration\": 1, \"inverter\": {\"substeps\": 0}}", "inverter.substeps: must be in"},
+    {"{\"duration\": 1, \"mechanics\": {\"mode\": \"imposed\"}}", "mechanics.speed: required"},
+    {"{\"duration\": 1, \"mechanics\": {\"load_torque\": [{\"type\": \"ramp\", \"t0\": 1, \"t1\": "
+     "0.5, \"value\": 1}]}}",
+     "mechanics.load_torque[0].t1: a ramp needs t1 > t0"},
+    {"{\"duration\": 1, \"mechanics\": {\"load_torque\": [{\"value\": 1}]}}",
+     "mechanics.load_torque[0].type: missing"},
+    {"{\"duration\": 1, \"mechanics\": {\"load_torque\": [{\"type\": \"sine\", \"amplitude\": "
+     "1}]}}",
+     "mechanics.load_torque[0].freq: a sine needs freq > 0"},
+    {"{\"duration\": 1, \"mechanics\": {\"load_torque\": \"high\"}}",
+     "mechanics.load_torque: must be a number, an array"},
+    {"{\"duration\": 1, \"references\": {\"speed\": {\"unit\": \"mph\", \"terms\": []}}}",
+     "references.speed.unit: must be one of"},
+    {"{\"duration\": 1, \"references\": {\"speed\": {\"unit\": \"rpm\", \"terms\": 3}}}",
+     "references.speed.terms: must be an array"},
+    {"{\"duration\": 1, \"sensors\": {\"gain_error\": [0.1, 0.2]}}",
+     "sensors.gain_error: must be an array of 3"},
+    {"{\"duration\": 1, \"sensors\": {\"adc_bits\": 4}}", "sensors.adc_bits: must be in"},
+    {"{\"duration\": 1, \"controller\": {\"law\": \"magic\"}}",
+     "controller.law: must be one of: foc, pi_dfvc, db_dfvc"},
+    {"{\"duration\": 1, \"controller\": {\"i_max\": 10, \"i_trip\": 5}}",
+     "controller.i_trip: invalid controller parameter"},
+    {"{\"duration\": 1, \"controller\": {\"current_bw\": 20000}}",
+     "controller.current_bw: invalid controller parameter"},
+    {"{\"duration\": 1, \"controller\": {\"law\": \"db_dfvc\", \"mode\": \"current\"}}",
+     "controller.mode: invalid"},
+    {"{\"duration\": 1, \"controller\": {\"estimates\": {\"ls_scale\": 0}}}",
+     "controller.estimates.ls_scale: must be in"},
+    {"{\"duration\": 1, \"inverter\": {\"dead_time\": 5e-5}}",
+     "inverter.dead_time: invalid plant parameter"},
+    {"{\"duration\": 1, \"log\": {\"decimation\": 0}}", "log.decimation: must be in"},
+};
+
+static void bad_scenarios_name_the_field(void **state) {
+  (void)state;
+  static scenario_t sc;
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+    char err[512] = "";
+    int r = scenario_parse(cases[i].json, "bad.json", &sc, err, sizeof err);
+    if (r == 0 || strstr(err, cases[i].expect) == NULL || strncmp(err, "bad.json: ", 10) != 0) {
+      fprintf(stderr, "case %zu: got \"%s\", want \"%s\"\n", i, err, cases[i].expect);
+      fail();
+    }
+  }
+}
+
+static void truncated_inputs_never_crash(void **state) {
+  (void)state;
+  static scenario_t sc;
+  FILE *f = fopen(FD_DEFAULT_SCENARIO, "rb");
+  assert_non_null(f);
+  static char buf[1 << 16];
+  size_t n = fread(buf, 1, sizeof buf - 1, f);
+  fclose(f);
+  char err[512];
+  buf[n] = '\0';
+  assert_int_equal(scenario_parse(buf, "default.json", &sc, err, sizeof err), 0);
+  for (size_t cut = 0; cut < n; cut += 7) {
+    char c = buf[cut];
+    buf[cut] = '\0';
+    assert_int_not_equal(scenario_parse(buf, "cut.json", &sc, err, sizeof err), 0);
+    assert_true(strlen(err) > 0);
+    buf[cut] = c;
+  }
+}
+
+static void good_scenario_sets_fields(void **state) {
+  (void)state;
+  static scenario_t sc;
+  char err[512];
+  const char *js = "{\"duration\": 0.5, \"machine\": {\"preset\": \"rubino2020_spm\"},"
+                   " \"controller\": {\"law\": \"foc\", \"estimates\": {\"ls_scale\": 1.2}},"
+                   " \"references\": {\"speed\": {\"unit\": \"rpm\", \"terms\": [{\"type\": "
+                   "\"step\", \"t\": 0.1, \"value\": 600}]}}}";
+  assert_int_equal(scenario_parse(js, "ok.json", &sc, err, sizeof err), 0);
+  assert_int_equal(sc.plant.machine.pole_pairs, 21);
+  assert_true(fabs(sc.drive.ld - 0.057 * 1.2) < 1e-6);
+  assert_true(fabs(sc.plant.machine.ld - 0.057) < 1e-12);
+  assert_true(fabs(profile_eval(&sc.ref.speed, 0.2) - 600.0 * 3.14159265358979 / 30.0) < 1e-9);
+  assert_true(fabs(profile_eval(&sc.ref.speed, 0.05)) < 1e-12);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {cmocka_unit_test(bad_scenarios_name_the_field),
+                                     cmocka_unit_test(truncated_inputs_never_crash),
+                                     cmocka_unit_test(good_scenario_sets_fields)};
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,7 @@
+"""Allow `python -m fluxdrive ...`."""
+
+import sys
+
+from fluxdrive.cli import main
+
+sys.exit(main())

@@ -1,0 +1,204 @@
+"""``fluxdrive`` command line: run, plot, summary, bench."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from fluxdrive import __version__
+from fluxdrive.errors import EXIT_USAGE, FluxdriveError
+
+PROG = "fluxdrive"
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {value}")
+    return value
+
+
+def _existing_file(path: str, what: str) -> Path:
+    p = Path(path)
+    if not p.exists():
+        raise FluxdriveError(f"{what} not found: {p}")
+    if not p.is_file():
+        raise FluxdriveError(f"{what} is not a file: {p}")
+    return p
+
+
+# --------------------------------------------------------------------- run
+def cmd_run(args: argparse.Namespace) -> int:
+    from fluxdrive import logs, sil
+    from fluxdrive.summary import format_summary, load_summary
+
+    scenario = _existing_file(args.scenario, "scenario")
+    groups = logs.parse_groups(args.signals)
+    runner = sil.locate_sil(args.sil)
+
+    out_dir = Path(args.out) if args.out else Path("out") / scenario.stem
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise FluxdriveError(f"cannot create output directory {out_dir}: {exc}") from None
+    log_path = out_dir / "log.npy"
+    summary_path = out_dir / "summary.json"
+    plot_path = Path(args.plot) if args.plot else out_dir / "plot.png"
+    for stale in (log_path, summary_path):  # never report a previous run's output
+        stale.unlink(missing_ok=True)
+
+    argv = sil.build_argv(runner, scenario, log_path, summary_path, args.decimate)
+    result = sil.run_sil(argv)
+    sil.relay_stderr(result)
+    if not result.ok:
+        print(f"{PROG}: SIL runner failed (exit code {result.returncode})", file=sys.stderr)
+        return result.returncode
+
+    if summary_path.is_file():
+        summary = load_summary(summary_path)
+    else:
+        summary = sil.parse_summary_stdout(result.stdout)
+        if summary is None:
+            raise FluxdriveError(
+                "SIL runner wrote no summary file and printed no summary JSON", exit_code=1
+            )
+        summary_path.write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
+
+    name = sil.scenario_name(scenario)
+    print(format_summary(summary, title=f"scenario: {name}"))
+    print()
+    print(f"log:     {log_path}")
+    print(f"summary: {summary_path}")
+    if not args.no_plot:
+        from fluxdrive.plotting import plot_log
+
+        if not log_path.is_file():
+            raise FluxdriveError(f"SIL runner did not write the log {log_path}", exit_code=1)
+        log = logs.load_log(log_path)
+        plot_log(log, groups, plot_path, title=name)
+        print(f"plot:    {plot_path}")
+    return 0
+
+
+# -------------------------------------------------------------------- plot
+def cmd_plot(args: argparse.Namespace) -> int:
+    from fluxdrive import logs
+    from fluxdrive.plotting import plot_log
+
+    groups = logs.parse_groups(args.signals)
+    log = logs.load_log(args.log)
+    logs.check_signals(log, groups)
+    log = logs.time_window(log, args.t0, args.t1)
+    src = Path(args.log)
+    out = Path(args.out) if args.out else src.with_suffix(".png")
+    title = args.title or (src.parent.name if src.stem == "log" and src.parent.name else src.stem)
+    plot_log(log, groups, out, title=title)
+    print(f"plot: {out}")
+    return 0
+
+
+# ----------------------------------------------------------------- summary
+def cmd_summary(args: argparse.Namespace) -> int:
+    from fluxdrive.summary import format_summary, load_summary
+
+    data = load_summary(args.summary)
+    if args.json:
+        print(json.dumps(data, indent=2, sort_keys=False))
+    else:
+        print(format_summary(data, title=str(args.summary)))
+    return 0
+
+
+# ------------------------------------------------------------------- bench
+def cmd_bench(args: argparse.Namespace) -> int:
+    from fluxdrive import bench, sil
+
+    scenario = _existing_file(args.scenario, "scenario")
+    runner = sil.locate_sil(args.sil)
+    runs: list[bench.BenchRun] = []
+    for i in range(1, args.repeat + 1):
+        result, run = bench.bench_once(runner, scenario)
+        if run is None:
+            sil.relay_stderr(result)
+            print(f"{PROG}: SIL runner failed (exit code {result.returncode})", file=sys.stderr)
+            return result.returncode
+        runs.append(run)
+        print(bench.format_run(i, run), flush=True)
+    print(bench.format_report(bench.BenchReport(runs)))
+    return 0
+
+
+# ------------------------------------------------------------------ parser
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog=PROG,
+        description="fluxdrive host tools: run SIL scenarios, plot logs, print summaries, benchmark.",
+    )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    sig_help = (
+        "signals to plot; ',' separates signals in one subplot, ';' separates subplots "
+        "(default: speed,speed_ref;torque,torque_ref;i_a,i_b,i_c)"
+    )
+    sil_help = (
+        "path of the fluxdrive-sil binary (default: $FLUXDRIVE_SIL, else "
+        "build/host-release/sil/fluxdrive-sil in the repo)"
+    )
+
+    p = sub.add_parser("run", help="run a SIL scenario, write log + summary + plot")
+    p.add_argument("scenario", metavar="SCENARIO", help="scenario JSON file")
+    p.add_argument("--sil", metavar="PATH", help=sil_help)
+    p.add_argument("--out", metavar="DIR", help="output directory (default: out/<scenario stem>/)")
+    p.add_argument("--plot", metavar="PNG", help="plot file (default: <out>/plot.png)")
+    p.add_argument("--no-plot", action="store_true", help="do not draw a plot")
+    p.add_argument("--signals", metavar="GROUPS", help=sig_help)
+    p.add_argument("--decimate", type=_positive_int, metavar="N", help="log every N-th step")
+    p.set_defaults(func=cmd_run)
+
+    p = sub.add_parser("plot", help="plot signals from a log (.npy)")
+    p.add_argument("log", metavar="LOG.npy")
+    p.add_argument("--signals", metavar="GROUPS", help=sig_help)
+    p.add_argument("--out", metavar="PNG", help="plot file (default: LOG with .png suffix)")
+    p.add_argument("--t0", type=float, metavar="S", help="start time [s]")
+    p.add_argument("--t1", type=float, metavar="S", help="end time [s]")
+    p.add_argument("--title", help="plot title (default: from the log path)")
+    p.set_defaults(func=cmd_plot)
+
+    p = sub.add_parser("summary", help="pretty-print a summary JSON")
+    p.add_argument("summary", metavar="SUMMARY.json")
+    p.add_argument("--json", action="store_true", help="print indented JSON instead of a table")
+    p.set_defaults(func=cmd_summary)
+
+    p = sub.add_parser("bench", help="benchmark a scenario (real-time factor)")
+    p.add_argument("scenario", metavar="SCENARIO", help="scenario JSON file")
+    p.add_argument("--sil", metavar="PATH", help=sil_help)
+    p.add_argument("--repeat", type=_positive_int, default=3, metavar="N", help="runs (default 3)")
+    p.set_defaults(func=cmd_bench)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except FluxdriveError as exc:
+        print(f"{PROG}: error: {exc.message}", file=sys.stderr)
+        if exc.hint:
+            print(f"{PROG}: hint: {exc.hint}", file=sys.stderr)
+        return exc.exit_code
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:  # e.g. `fluxdrive summary x.json | head`
+        return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -32,6 +32,13 @@ static void refs_from_cmd(drive_t *drv) {
   drv->ref.flux = drv->cmd.flux;
 }
 
+static void speed_cfg_from(speed_ctrl_cfg_t *scfg, const drive_config_t *cfg) {
+  speed_ctrl_design(scfg, cfg->inertia, cfg->speed_bw);
+  scfg->ts = cfg->ts * (float)cfg->slow_div;
+  scfg->accel_max = cfg->accel_max;
+  scfg->torque_max = cfg->torque_max;
+}
+
 int drive_init(drive_t *drv, const drive_config_t *cfg, const char **field) {
   const char *dummy = "";
   if (field == 0) {
@@ -55,10 +62,7 @@ int drive_init(drive_t *drv, const drive_config_t *cfg, const char **field) {
   angle_pll_init(&drv->pll, cfg->pll_bw, cfg->ts);
 
   speed_ctrl_cfg_t scfg;
-  speed_ctrl_design(&scfg, cfg->inertia, cfg->speed_bw);
-  scfg.ts = cfg->ts * (float)cfg->slow_div;
-  scfg.accel_max = cfg->accel_max;
-  scfg.torque_max = cfg->torque_max;
+  speed_cfg_from(&scfg, cfg);
   speed_ctrl_init(&drv->speed, &scfg);
   drv->torque_min_avail = -cfg->torque_max;
   drv->torque_max_avail = cfg->torque_max;
@@ -337,6 +341,58 @@ void drive_cmd_current(drive_t *drv, float id, float iq) {
 
 void drive_cmd_flux(drive_t *drv, float flux) {
   drv->cmd.flux = clampf(flux, 0.0f, 10.0f);
+}
+
+int drive_set_config(drive_t *drv, const drive_config_t *cfg, const char **field) {
+  const char *dummy = "";
+  if (field == 0) {
+    field = &dummy;
+  }
+  const bool enabled = drv->state == DRIVE_STATE_RUN || drv->state == DRIVE_STATE_OFFSET_CAL;
+  drive_config_t next = *cfg;
+  if (enabled) {
+    next = drv->cfg;
+    next.i_trip = cfg->i_trip;
+    next.v_dc_max = cfg->v_dc_max;
+    next.v_dc_min = cfg->v_dc_min;
+    next.speed_trip = cfg->speed_trip;
+    next.offset_max = cfg->offset_max;
+    next.speed_max = cfg->speed_max;
+    next.torque_max = cfg->torque_max;
+    next.accel_max = cfg->accel_max;
+    next.speed_bw = cfg->speed_bw;
+  }
+  int err = drive_config_check(&next, field);
+  if (err != 0) {
+    return err;
+  }
+  speed_ctrl_cfg_t scfg;
+  speed_cfg_from(&scfg, &next);
+  if (enabled) {
+    /* live: new gains and limits, the integral and ramp carry on */
+    drv->speed.cfg.kp = scfg.kp;
+    drv->speed.cfg.ki = scfg.ki;
+    drv->speed.cfg.j_ff = scfg.j_ff;
+    drv->speed.cfg.accel_max = scfg.accel_max;
+    drv->speed.cfg.torque_max = fabsf(scfg.torque_max);
+    drv->speed.pi.kp = scfg.kp;
+    drv->speed.pi.ki = scfg.ki;
+    drv->ctrl.torque_max = next.torque_max;
+  } else {
+    drive_law_t law = drv->ctrl.law;
+    if (ctrl_init(&drv->ctrl, &next) != 0) {
+      /* the laws refused: restore the previous (valid) set */
+      (void)ctrl_init(&drv->ctrl, &drv->cfg);
+      drv->ctrl.law = law;
+      *field = "law parameters";
+      return -1;
+    }
+    drv->ctrl.law = law;
+    angle_pll_init(&drv->pll, next.pll_bw, next.ts);
+    speed_ctrl_init(&drv->speed, &scfg);
+  }
+  drv->cfg = next;
+  return 0;
 }
 
 void drive_raise_fault(drive_t *drv, uint32_t fault_bits) {

@@ -142,6 +142,16 @@ void drive_cmd_speed(drive_t *drv, float speed_m);
 void drive_cmd_current(drive_t *drv, float id, float iq);
 void drive_cmd_flux(drive_t *drv, float flux);
 
+/* Replace the parameter set from the slow context (CAN parameter writes).
+ * cfg is validated by drive_config_check (on failure nothing changes and
+ * *field names the parameter). With the gates off (idle, fault) everything
+ * is re-derived: control laws, PLL and speed loop (their states reset).
+ * While enabled (offset calibration, run) only the live parameters are
+ * taken from cfg - i_trip, v_dc_max, v_dc_min, speed_trip, offset_max,
+ * speed_max, torque_max, accel_max, speed_bw (the speed loop keeps its
+ * integral) - and the others keep their values. Returns 0 or negative. */
+int drive_set_config(drive_t *drv, const drive_config_t *cfg, const char **field);
+
 /* Latch a fault from outside the ISR (e.g. the CAN command timeout):
  * gates off at once. */
 void drive_raise_fault(drive_t *drv, uint32_t fault_bits);

@@ -49,7 +49,7 @@ static adc_regs_t *adc_of(uint32_t n) {
   return (n == 1u) ? ADC1 : ADC2;
 }
 
-static bool wait_flag(reg32_t *reg, uint32_t mask, bool set) {
+static bool wait_flag(const reg32_t *reg, uint32_t mask, bool set) {
   for (uint32_t t = 0; t < 1000000u; t++) {
     if (((*reg & mask) != 0u) == set) {
       return true;
@@ -65,21 +65,21 @@ static void opamp_init(void) {
    * ADC input; configure first, then enable (RM0440 25.3). */
   RCC->APB2ENR |= RCC_APB2ENR_SYSCFGEN; /* OPAMP registers sit on the SYSCFG clock */
   (void)RCC->APB2ENR;
-  const uint32_t csr = (0u << OPAMP_CSR_VP_SEL_Pos) | (2u << OPAMP_CSR_VM_SEL_Pos) |
+  const uint32_t csr = /* VP_SEL = 00 */ (2u << OPAMP_CSR_VM_SEL_Pos) |
                        ((uint32_t)BOARD_OPAMP_PGA_GAIN_CODE << OPAMP_CSR_PGA_GAIN_Pos) |
                        OPAMP_CSR_OPAHSM;
   for (uint32_t i = 0; i < 3u; i++) {
     OPAMP->CSR[i] = csr;
-    OPAMP->CSR[i] = csr | OPAMP_CSR_OPAEN;
+    OPAMP->CSR[i] |= OPAMP_CSR_OPAEN;
   }
 #endif
 }
 
 static bool adc_power_up(adc_regs_t *adc) {
-  adc->CR = 0u;               /* DEEPPWD = 0 */
-  adc->CR = ADC_CR_ADVREGEN;  /* regulator on */
-  hal_delay_cycles(170u * 25u); /* t_ADCVREG_STUP = 20 us */
-  adc->DIFSEL = 0u;             /* all single ended */
+  adc->CR = 0u;                             /* DEEPPWD = 0 */
+  adc->CR = ADC_CR_ADVREGEN;                /* regulator on */
+  hal_delay_cycles(170u * 25u);             /* t_ADCVREG_STUP = 20 us */
+  adc->DIFSEL = 0u;                         /* all single ended */
   adc->CR = ADC_CR_ADVREGEN | ADC_CR_ADCAL; /* ADCALDIF = 0 */
   if (!wait_flag(&adc->CR, ADC_CR_ADCAL, false)) {
     return false;
@@ -133,9 +133,8 @@ bool hal_adc_init(void) {
     if (len[a] == 0u) {
       continue;
     }
-    /* JEXTSEL = 0: TIM1_TRGO; JEXTEN = 01: rising edge; JL = length - 1 */
-    adc->JSQR = jsqr[a] | (0u << ADC_JSQR_JEXTSEL_Pos) | (1u << ADC_JSQR_JEXTEN_Pos) |
-                ((len[a] - 1u) << ADC_JSQR_JL_Pos);
+    /* JEXTSEL = 0 (left at 0): TIM1_TRGO; JEXTEN = 01: rising edge; JL = length - 1 */
+    adc->JSQR = jsqr[a] | (1u << ADC_JSQR_JEXTEN_Pos) | ((len[a] - 1u) << ADC_JSQR_JL_Pos);
   }
   return len[0] >= len[1]; /* the interrupt comes from ADC1: it must finish last */
 }

@@ -14,7 +14,8 @@
 #define PLL_N         85u
 #define READY_TIMEOUT 200000u
 
-_Static_assert(BOARD_HSE_HZ == 0u || BOARD_HSE_HZ % PLL_IN_HZ == 0u, "HSE must be a multiple of 4 MHz");
+_Static_assert(BOARD_HSE_HZ == 0u || BOARD_HSE_HZ % PLL_IN_HZ == 0u,
+               "HSE must be a multiple of 4 MHz");
 _Static_assert((BOARD_HSE_HZ == 0u ? 16000000u : BOARD_HSE_HZ) / PLL_IN_HZ <= 16u, "PLLM range");
 
 void hal_delay_cycles(uint32_t n) {
@@ -23,7 +24,7 @@ void hal_delay_cycles(uint32_t n) {
   }
 }
 
-static int wait_set(reg32_t *reg, uint32_t mask) {
+static int wait_set(const reg32_t *reg, uint32_t mask) {
   for (uint32_t t = 0; t < READY_TIMEOUT; t++) {
     if ((*reg & mask) != 0u) {
       return 0;
@@ -67,8 +68,8 @@ int hal_clock_init(void) {
   RCC->CR &= ~RCC_CR_PLLON;
   for (uint32_t t = 0; t < READY_TIMEOUT && (RCC->CR & RCC_CR_PLLRDY) != 0u; t++) {
   }
-  RCC->PLLCFGR = src | ((pllm - 1u) << RCC_PLLCFGR_M_Pos) | (PLL_N << RCC_PLLCFGR_N_Pos) |
-                 (0u << RCC_PLLCFGR_R_Pos);
+  RCC->PLLCFGR =
+      src | ((pllm - 1u) << RCC_PLLCFGR_M_Pos) | (PLL_N << RCC_PLLCFGR_N_Pos); /* PLLR = 00: /2 */
   RCC->CR |= RCC_CR_PLLON;
   if (wait_set(&RCC->CR, RCC_CR_PLLRDY) != 0) {
     return -1;
@@ -85,7 +86,7 @@ int hal_clock_init(void) {
       break;
     }
   }
-  hal_delay_cycles(400u); /* >= 1 us at 85 MHz */
-  RCC->CFGR = (RCC->CFGR & ~RCC_CFGR_HPRE_Msk) | (RCC_CFGR_HPRE_DIV1 << RCC_CFGR_HPRE_Pos);
+  hal_delay_cycles(400u);          /* >= 1 us at 85 MHz */
+  RCC->CFGR &= ~RCC_CFGR_HPRE_Msk; /* HPRE = 0000: /1 */
   return (((RCC->CFGR & RCC_CFGR_SWS_Msk) >> RCC_CFGR_SWS_Pos) == RCC_CFGR_SW_PLL) ? 0 : -1;
 }

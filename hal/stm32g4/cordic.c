@@ -50,7 +50,7 @@ HOT float cordic_hw_atan2f(float y, float x) {
   const int32_t qy = to_q31(y * k);
   const uint32_t pm = hal_irq_save();
   CORDIC->CSR = (CORDIC_FUNC_PHASE << CORDIC_CSR_FUNC_Pos) |
-                (PRECISION << CORDIC_CSR_PRECISION_Pos) | (0u << CORDIC_CSR_SCALE_Pos) |
+                (PRECISION << CORDIC_CSR_PRECISION_Pos) | /* SCALE = 0 */
                 CORDIC_CSR_NARGS; /* two arguments (x, y), one result, q1.31 */
   CORDIC->WDATA = (uint32_t)qx;
   CORDIC->WDATA = (uint32_t)qy;
@@ -76,9 +76,9 @@ HOT void cordic_hw_sincosf(float theta, float *s, float *c) {
   }
   const int32_t qa = to_q31(t);
   const uint32_t pm = hal_irq_save();
-  CORDIC->CSR = (CORDIC_FUNC_COSINE << CORDIC_CSR_FUNC_Pos) |
-                (PRECISION << CORDIC_CSR_PRECISION_Pos) | (0u << CORDIC_CSR_SCALE_Pos) |
-                CORDIC_CSR_NARGS | CORDIC_CSR_NRES; /* (angle, modulus) -> (cos, sin) */
+  CORDIC->CSR =                                 /* FUNC = 0: cosine */
+      (PRECISION << CORDIC_CSR_PRECISION_Pos) | /* SCALE = 0 */
+      CORDIC_CSR_NARGS | CORDIC_CSR_NRES;       /* (angle, modulus) -> (cos, sin) */
   CORDIC->WDATA = (uint32_t)qa;
   CORDIC->WDATA = 0x7FFFFFFFu; /* modulus 1 */
   const int32_t rc = (int32_t)CORDIC->RDATA;

@@ -48,11 +48,11 @@ void hal_can_set_node_filter(uint32_t node_id, uint32_t mask) {
    * SFEC = 001 store in Rx FIFO 0, SFID1 = id, SFID2 = mask. */
   const uint32_t std = (2u << 30) | (1u << 27);
   SRAM_WORD(SRAMCAN_FLSSA + 0u) = std | ((node_id & 0x7FFu) << 16) | (mask & 0x7FFu);
-  SRAM_WORD(SRAMCAN_FLSSA + 4u) = std | (0u << 16) | (mask & 0x7FFu);
+  SRAM_WORD(SRAMCAN_FLSSA + 4u) = std | (mask & 0x7FFu); /* SFID1 = 0 */
   /* Extended filter element: F0 = EFEC 001 | EFID1, F1 = EFT 10 | EFID2. */
   SRAM_WORD(SRAMCAN_FLESA + 0u) = (1u << 29) | (node_id & 0x1FFFFFFFu);
   SRAM_WORD(SRAMCAN_FLESA + 4u) = (2u << 30) | (mask & 0x1FFFFFFFu);
-  SRAM_WORD(SRAMCAN_FLESA + 8u) = (1u << 29) | 0u;
+  SRAM_WORD(SRAMCAN_FLESA + 8u) = (1u << 29); /* EFID1 = 0 */
   SRAM_WORD(SRAMCAN_FLESA + 12u) = (2u << 30) | (mask & 0x1FFFFFFFu);
 }
 
@@ -61,8 +61,8 @@ bool hal_fdcan_init(uint32_t bitrate, uint32_t node_id, uint32_t mask) {
   if (!hal_fdcan_timing(bitrate, &bt)) {
     return false;
   }
-  RCC->CCIPR = (RCC->CCIPR & ~RCC_CCIPR_FDCANSEL_Msk) |
-               (RCC_CCIPR_FDCANSEL_PCLK1 << RCC_CCIPR_FDCANSEL_Pos);
+  RCC->CCIPR =
+      (RCC->CCIPR & ~RCC_CCIPR_FDCANSEL_Msk) | (RCC_CCIPR_FDCANSEL_PCLK1 << RCC_CCIPR_FDCANSEL_Pos);
   RCC->APB1ENR1 |= RCC_APB1ENR1_FDCANEN;
   (void)RCC->APB1ENR1;
   const hal_pin_t rx = BOARD_CAN_RX_PIN;
@@ -78,8 +78,8 @@ bool hal_fdcan_init(uint32_t bitrate, uint32_t node_id, uint32_t mask) {
   FDCAN1->CCCR |= FDCAN_CCCR_CCE;
   FDCAN1->CCCR &= ~(FDCAN_CCCR_FDOE | FDCAN_CCCR_BRSE | FDCAN_CCCR_DAR); /* classic, retransmit */
 
-  FDCAN1->NBTP = ((bt.sjw - 1u) << 25) | ((bt.brp - 1u) << 16) | ((bt.tseg1 - 1u) << 8) |
-                 (bt.tseg2 - 1u);
+  FDCAN1->NBTP =
+      ((bt.sjw - 1u) << 25) | ((bt.brp - 1u) << 16) | ((bt.tseg1 - 1u) << 8) | (bt.tseg2 - 1u);
 
   for (uint32_t o = 0; o < SRAMCAN_SIZE; o += 4u) {
     SRAM_WORD(o) = 0u;
@@ -88,8 +88,8 @@ bool hal_fdcan_init(uint32_t bitrate, uint32_t node_id, uint32_t mask) {
   /* 2 standard, 2 extended filters; non-matching frames and all remote
    * frames rejected. */
   FDCAN1->RXGFC = (2u << FDCAN_RXGFC_LSS_Pos) | (2u << FDCAN_RXGFC_LSE_Pos) |
-                  (2u << FDCAN_RXGFC_ANFS_Pos) | (2u << FDCAN_RXGFC_ANFE_Pos) |
-                  FDCAN_RXGFC_RRFS | FDCAN_RXGFC_RRFE;
+                  (2u << FDCAN_RXGFC_ANFS_Pos) | (2u << FDCAN_RXGFC_ANFE_Pos) | FDCAN_RXGFC_RRFS |
+                  FDCAN_RXGFC_RRFE;
   FDCAN1->XIDAM = 0x1FFFFFFFu;
   FDCAN1->TXBC = 0u; /* Tx FIFO mode */
   FDCAN1->IE = 0u;   /* polled */
@@ -113,8 +113,7 @@ bool hal_can_send(const hal_can_frame_t *f) {
   const uint32_t base = SRAMCAN_TFQSA + idx * SRAMCAN_ELEM_SIZE;
   /* Tx buffer element (RM0440 44.3.4): T0 = XTD | ID (standard in 28:18),
    * T1 = DLC in 19:16, FDF = BRS = EFC = 0. */
-  const uint32_t t0 = f->extended ? ((1u << 30) | (f->id & 0x1FFFFFFFu))
-                                  : ((f->id & 0x7FFu) << 18);
+  const uint32_t t0 = f->extended ? ((1u << 30) | (f->id & 0x1FFFFFFFu)) : ((f->id & 0x7FFu) << 18);
   SRAM_WORD(base + 0u) = t0;
   SRAM_WORD(base + 4u) = (uint32_t)f->dlc << 16;
   SRAM_WORD(base + 8u) = (uint32_t)f->data[0] | ((uint32_t)f->data[1] << 8) |

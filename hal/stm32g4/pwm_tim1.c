@@ -62,12 +62,14 @@ void hal_tim1_init(void) {
                 (TIM_OCM_PWM2 << TIM_CCMR_OC2M_Pos) | TIM_CCMR_OC2PE;
   TIM1->CCMR2 = (TIM_OCM_PWM2 << TIM_CCMR_OC1M_Pos) | TIM_CCMR_OC1PE; /* channel 3 */
 
-  const uint32_t hp = BOARD_PWM_HIGH_ACTIVE_LOW ? TIM_CCER_CC1P : 0u;
-  const uint32_t lp = BOARD_PWM_LOW_ACTIVE_LOW ? TIM_CCER_CC1NP : 0u;
-  uint32_t ccer = 0u;
-  for (uint32_t ch = 0; ch < 3u; ch++) {
-    ccer |= (TIM_CCER_CC1E | TIM_CCER_CC1NE | hp | lp) << (4u * ch);
-  }
+  uint32_t chan = TIM_CCER_CC1E | TIM_CCER_CC1NE;
+#if BOARD_PWM_HIGH_ACTIVE_LOW
+  chan |= TIM_CCER_CC1P;
+#endif
+#if BOARD_PWM_LOW_ACTIVE_LOW
+  chan |= TIM_CCER_CC1NP;
+#endif
+  const uint32_t ccer = chan | (chan << 4) | (chan << 8);
   TIM1->CCER = ccer;
 
   /* TRGO = update; idle levels (MOE = 0) = switch off. */
@@ -78,18 +80,19 @@ void hal_tim1_init(void) {
   }
   TIM1->CR2 = cr2;
 
-  const uint32_t dtg = hal_tim1_dtg(BOARD_DEAD_TIME_NS, BOARD_SYSCLK_HZ);
+  /* One BDTR write: dead time, break, off-state selection, LOCK level 1. */
+  uint32_t bdtr = (hal_tim1_dtg(BOARD_DEAD_TIME_NS, BOARD_SYSCLK_HZ) & TIM_BDTR_DTG_Msk) |
+                  TIM_BDTR_OSSI | TIM_BDTR_OSSR | (1u << TIM_BDTR_LOCK_Pos);
 #if BOARD_HAS_BKIN
   TIM1->AF1 = TIM1_AF1_BKINE; /* BKIN pin only, BKINP = 0 */
-  const uint32_t brk = TIM_BDTR_BKE | (BOARD_BKIN_ACTIVE_HIGH ? TIM_BDTR_BKP : 0u) |
-                       (BOARD_BKIN_FILTER << TIM_BDTR_BKF_Pos);
-#else
-  TIM1->AF1 = 0u;
-  const uint32_t brk = 0u;
+  bdtr |= TIM_BDTR_BKE | (BOARD_BKIN_FILTER << TIM_BDTR_BKF_Pos);
+#if BOARD_BKIN_ACTIVE_HIGH
+  bdtr |= TIM_BDTR_BKP;
 #endif
-  /* One write: dead time, break, off-state selection, LOCK level 1. */
-  TIM1->BDTR = (dtg & TIM_BDTR_DTG_Msk) | TIM_BDTR_OSSI | TIM_BDTR_OSSR | brk |
-               (1u << TIM_BDTR_LOCK_Pos);
+#else
+  TIM1->AF1 = 0u; /* no break source: BKE stays 0 */
+#endif
+  TIM1->BDTR = bdtr;
 
   TIM1->CR1 = (1u << TIM_CR1_CMS_Pos) | TIM_CR1_ARPE;
   TIM1->EGR = TIM_EGR_UG; /* load ARR, CCRx, RCR */

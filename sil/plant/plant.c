@@ -18,16 +18,15 @@
 #include <string.h>
 
 int plant_check(const plant_params_t *p, const char **field) {
-  const char *dummy;
+  const char *dummy = NULL;
   const char **f = field != NULL ? field : &dummy;
   if (!plant_finite_pos(p->ts)) {
     *f = "ts";
     return -1;
   }
   if (plant_machine_check(&p->machine, f) != 0 ||
-      plant_inverter_check(&p->inverter, p->ts, f) != 0 ||
-      plant_dclink_check(&p->dclink, f) != 0 || plant_mech_check(&p->mech, f) != 0 ||
-      plant_sensors_check(&p->sensors, f) != 0) {
+      plant_inverter_check(&p->inverter, p->ts, f) != 0 || plant_dclink_check(&p->dclink, f) != 0 ||
+      plant_mech_check(&p->mech, f) != 0 || plant_sensors_check(&p->sensors, f) != 0) {
     return -1;
   }
   return 0;

@@ -29,8 +29,8 @@ typedef enum { PLANT_INV_AVERAGE, PLANT_INV_SWITCHING } plant_inverter_model_t;
 
 typedef struct {
   plant_inverter_model_t model;
-  double dead_time;  /* [s] */
-  int substeps;      /* integration steps per PWM period (average model), >= 1 */
+  double dead_time; /* [s] */
+  int substeps;     /* integration steps per PWM period (average model), >= 1 */
 } plant_inverter_t;
 
 typedef enum { PLANT_DC_IDEAL, PLANT_DC_RC } plant_dc_kind_t;
@@ -55,15 +55,15 @@ typedef struct {
 } plant_mech_t;
 
 typedef struct {
-  int adc_bits;          /* e.g. 12 */
-  double i_full_scale;   /* current ADC range is +-i_full_scale [A] */
-  double v_full_scale;   /* DC-link ADC range is 0..v_full_scale [V] */
-  double gain_error[3];  /* relative gain error per current channel */
-  double offset_error[3];/* offset per current channel [A] */
-  double i_noise;        /* white noise rms on each current [A] */
-  double v_noise;        /* white noise rms on the DC-link voltage [V] */
-  int encoder_cpr;       /* encoder counts per mechanical revolution, 0 = ideal */
-  uint32_t seed;         /* noise generator seed */
+  int adc_bits;           /* e.g. 12 */
+  double i_full_scale;    /* current ADC range is +-i_full_scale [A] */
+  double v_full_scale;    /* DC-link ADC range is 0..v_full_scale [V] */
+  double gain_error[3];   /* relative gain error per current channel */
+  double offset_error[3]; /* offset per current channel [A] */
+  double i_noise;         /* white noise rms on each current [A] */
+  double v_noise;         /* white noise rms on the DC-link voltage [V] */
+  int encoder_cpr;        /* encoder counts per mechanical revolution, 0 = ideal */
+  uint32_t seed;          /* noise generator seed */
 } plant_sensors_t;
 
 typedef struct {
@@ -86,18 +86,18 @@ typedef struct {
 
 /* True (noise-free) state, for logs and tests. */
 typedef struct {
-  double t;           /* plant time [s] */
-  double i_abc[3];    /* [A] */
-  double i_dq[2];     /* rotor frame currents [A] */
-  double lambda_dq[2];/* rotor frame flux linkages [Vs] */
-  double v_abc[3];    /* period-average phase-to-neutral voltages, last step [V] */
-  double theta_m;     /* mechanical angle [rad], wrapped to [0, 2pi) */
-  double theta_e;     /* electrical angle [rad], wrapped to [0, 2pi) */
-  double omega_m;     /* mechanical speed [rad/s] */
-  double torque;      /* electromagnetic torque [N m] */
-  double load_torque; /* load torque in force [N m] */
-  double v_dc;        /* DC-link capacitor voltage [V] */
-  double i_dc;        /* period-average DC-link current drawn [A] */
+  double t;            /* plant time [s] */
+  double i_abc[3];     /* [A] */
+  double i_dq[2];      /* rotor frame currents [A] */
+  double lambda_dq[2]; /* rotor frame flux linkages [Vs] */
+  double v_abc[3];     /* period-average phase-to-neutral voltages, last step [V] */
+  double theta_m;      /* mechanical angle [rad], wrapped to [0, 2pi) */
+  double theta_e;      /* electrical angle [rad], wrapped to [0, 2pi) */
+  double omega_m;      /* mechanical speed [rad/s] */
+  double torque;       /* electromagnetic torque [N m] */
+  double load_torque;  /* load torque in force [N m] */
+  double v_dc;         /* DC-link capacitor voltage [V] */
+  double i_dc;         /* period-average DC-link current drawn [A] */
 } plant_state_t;
 
 /* Internal working data of plant_t (constants precomputed by plant_init and
@@ -106,8 +106,8 @@ typedef struct {
 typedef struct {
   /* constants */
   double inv_ld, inv_lq, inv_j, inv_c, inv_r; /* 1/Ld, 1/Lq, 1/J, 1/C, 1/R */
-  double kdt;      /* dead_time / ts */
-  double inv_band; /* 1 / width of the smooth sign of the average-model dead time [1/A] */
+  double kdt;                                 /* dead_time / ts */
+  double inv_band;  /* 1 / width of the smooth sign of the average-model dead time [1/A] */
   uint64_t n_steps; /* periods done: t = n_steps * ts exactly */
   /* switching-level inverter memory, per leg: time of the last commanded
    * edge relative to the start of the next period (<= 0), commanded

@@ -10,9 +10,9 @@
 
 #include <stddef.h>
 
-#define PLANT_PI       3.14159265358979323846
-#define PLANT_TWO_PI   6.28318530717958647692
-#define PLANT_SQRT3_2  0.86602540378443864676 /* sqrt(3)/2 */
+#define PLANT_PI        3.14159265358979323846
+#define PLANT_TWO_PI    6.28318530717958647692
+#define PLANT_SQRT3_2   0.86602540378443864676 /* sqrt(3)/2 */
 #define PLANT_INV_SQRT3 0.57735026918962576451 /* 1/sqrt(3) */
 
 /* Integration state vector. The last four entries are integrals over the

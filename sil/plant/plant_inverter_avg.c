@@ -30,12 +30,39 @@ static inline double eff_duty(double d, double kdt, double i_norm) {
   return e < 0.0 ? 0.0 : (e > 1.0 ? 1.0 : e);
 }
 
-static inline void avg_deriv(const plant_t *pl, const double *d, const double *x, double m,
-                             double *dx) {
+/* Rotor angle reference: the stage angles differ from the reference angle
+ * by dth <= w_e h, so cos/sin are obtained by angle addition with a Taylor
+ * series of dth (|dth| < 0.3 rad: truncation < 3e-17), and libm is called
+ * once per period (the reference is carried from step to step the same
+ * way; its rounding error grows by ~1e-16 per substep and restarts each
+ * period). */
+typedef struct {
+  double th, c, s;
+} angle_ref_t;
+
+static inline void stage_cos_sin(const angle_ref_t *r, double th, double *c, double *s) {
+  const double dt = th - r->th;
+  if (dt > 0.3 || dt < -0.3) {
+    *c = cos(th);
+    *s = sin(th);
+    return;
+  }
+  const double z = dt * dt, z2 = z * z, z4 = z2 * z2;
+  /* Taylor coefficients, Estrin evaluation (short dependency chains) */
+  const double sd = dt * ((1.0 - z * (1.0 / 6.0)) + z2 * ((1.0 / 120.0) - z * (1.0 / 5040.0)) +
+                          z4 * ((1.0 / 362880.0) - z * (1.0 / 39916800.0)));
+  const double cd = (1.0 - z * 0.5) + z2 * ((1.0 / 24.0) - z * (1.0 / 720.0)) +
+                    z4 * ((1.0 / 40320.0) - z * (1.0 / 3628800.0) + z2 * (1.0 / 479001600.0));
+  *c = r->c * cd - r->s * sd;
+  *s = r->s * cd + r->c * sd;
+}
+
+static inline void avg_deriv(const plant_t *pl, const angle_ref_t *ar, const double *d,
+                             const double *x, double m, double *dx) {
   const plant_machine_t *mp = &pl->p.machine;
   const double pp = (double)mp->pole_pairs;
-  const double th = pp * x[X_TH];
-  const double c = cos(th), s = sin(th);
+  double c, s;
+  stage_cos_sin(ar, pp * x[X_TH], &c, &s);
   const double id = (x[X_LD] - mp->lambda_m) * pl->aux.inv_ld;
   const double iq = x[X_LQ] * pl->aux.inv_lq;
   const double ial = id * c - iq * s, ibe = id * s + iq * c;
@@ -71,23 +98,35 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x) {
   const double h = pl->p.ts / n, h2 = 0.5 * h, h6 = h / 6.0;
   double t = pl->t;
   double m0 = plant_mech_input(pl, t);
+  angle_ref_t ar;
+  ar.th = pl->p.machine.pole_pairs * x[X_TH];
+  ar.c = cos(ar.th);
+  ar.s = sin(ar.th);
   for (int k = 0; k < n; k++) {
     const double m1 = plant_mech_input(pl, t + h2);
     const double m2 = plant_mech_input(pl, t + h);
     double k1[X_N], k2[X_N], k3[X_N], k4[X_N], xs[X_N];
-    avg_deriv(pl, duty, x, m0, k1);
+    if (k > 0) { /* carry the reference angle: libm once per period at speed */
+      double c, s;
+      const double th = pl->p.machine.pole_pairs * x[X_TH];
+      stage_cos_sin(&ar, th, &c, &s);
+      ar.th = th;
+      ar.c = c;
+      ar.s = s;
+    }
+    avg_deriv(pl, &ar, duty, x, m0, k1);
     for (int i = 0; i < X_N; i++) {
       xs[i] = x[i] + h2 * k1[i];
     }
-    avg_deriv(pl, duty, xs, m1, k2);
+    avg_deriv(pl, &ar, duty, xs, m1, k2);
     for (int i = 0; i < X_N; i++) {
       xs[i] = x[i] + h2 * k2[i];
     }
-    avg_deriv(pl, duty, xs, m1, k3);
+    avg_deriv(pl, &ar, duty, xs, m1, k3);
     for (int i = 0; i < X_N; i++) {
       xs[i] = x[i] + h * k3[i];
     }
-    avg_deriv(pl, duty, xs, m2, k4);
+    avg_deriv(pl, &ar, duty, xs, m2, k4);
     for (int i = 0; i < X_N; i++) {
       x[i] += h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
     }

@@ -34,9 +34,9 @@ enum { LEG_LO, LEG_HI, LEG_FLOAT };
 enum { COND_NONE = -1, COND_LO = 0, COND_HI = 1, COND_BLOCK = 2 };
 enum { EV_CUR0 = 0, EV_U_LO = 3, EV_U_HI = 4, EV_GAP = 5, EV_N = 6 };
 
-#define SW_I_EPS       1e-9 /* a current below this is taken as blocked [A] */
-#define SW_MAX_EVENTS  24   /* diode events handled per integration step */
-#define SW_MAX_EDGES   4
+#define SW_I_EPS      1e-9 /* a current below this is taken as blocked [A] */
+#define SW_MAX_EVENTS 24   /* diode events handled per integration step */
+#define SW_MAX_EDGES  4
 
 static const double CX[3][2] = {{1.0, 0.0}, {-0.5, PLANT_SQRT3_2}, {-0.5, -PLANT_SQRT3_2}};
 

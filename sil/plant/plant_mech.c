@@ -8,9 +8,9 @@
  *   that always opposes motion by giving it the sign of the speed.
  * IMPOSED mode (dynamometer): w = mech.speed(t) exactly, theta_m is the
  *   integral of the profile (RK4 quadrature, exact for constant and ramp
- *   profiles except within the step that holds a ramp corner or a step); J, B and the load are not used.
- * Rotor angle and speed are integrated in the same RK4 as the flux linkages
- * (inline derivative in plant_internal.h).
+ *   profiles except within the step that holds a ramp corner or a step); J, B and the load are not
+ * used. Rotor angle and speed are integrated in the same RK4 as the flux linkages (inline
+ * derivative in plant_internal.h).
  */
 #include "plant_internal.h"
 
@@ -19,13 +19,13 @@
 
 int plant_mech_check(const plant_mech_t *m, const char **field) {
   static const char *const load_names[] = {
-      "mech.load_torque.n",    "mech.load_torque.term.kind", "mech.load_torque.term.value",
-      "mech.load_torque.term.t0", "mech.load_torque.term.t1", "mech.load_torque.term.freq",
+      "mech.load_torque.n",         "mech.load_torque.term.kind", "mech.load_torque.term.value",
+      "mech.load_torque.term.t0",   "mech.load_torque.term.t1",   "mech.load_torque.term.freq",
       "mech.load_torque.term.phase"};
   static const char *const speed_names[] = {
-      "mech.speed.n",    "mech.speed.term.kind", "mech.speed.term.value", "mech.speed.term.t0",
+      "mech.speed.n",       "mech.speed.term.kind", "mech.speed.term.value", "mech.speed.term.t0",
       "mech.speed.term.t1", "mech.speed.term.freq", "mech.speed.term.phase"};
-  static const char *const member[] = {"n",  "term.kind", "term.value", "term.t0",
+  static const char *const member[] = {"n",       "term.kind", "term.value", "term.t0",
                                        "term.t1", "term.freq", "term.phase"};
   const char *bad = NULL;
   if (m->mode != PLANT_MECH_FREE && m->mode != PLANT_MECH_IMPOSED) {

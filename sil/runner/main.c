@@ -2,8 +2,11 @@
  * main.c - fluxdrive-sil: run one scenario.
  *
  *   fluxdrive-sil SCENARIO.json [--log PATH.npy] [--summary PATH.json]
- *                 [--decimate N] [--bench]
+ *                 [--decimate N] [--bench] [--print-config]
  *
+ * --print-config prints the resolved parameters (JSON) and exits.
+ * --record-isr PATH.bin records every ISR's inputs and outputs for the PIL
+ * replay (sil/runner/isr_record.h, docs/pil.md).
  * Exit codes: 0 ran (faults are results, reported in the summary),
  * 1 I/O error, 2 bad scenario or usage.
  */
@@ -11,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "isr_record.h"
 #include "log_npy.h"
 #include "scenario.h"
 #include "sil_run.h"
@@ -18,13 +22,14 @@
 
 static int usage(void) {
   fprintf(stderr, "usage: fluxdrive-sil SCENARIO.json [--log PATH.npy] [--summary PATH.json]\n"
-                  "                     [--decimate N] [--bench]\n");
+                  "                     [--decimate N] [--bench] [--print-config]\n"
+                  "                     [--record-isr PATH.bin]\n");
   return 2;
 }
 
 int main(int argc, char **argv) {
-  const char *scenario = NULL, *log_path = NULL, *summary_path = NULL;
-  int decimate = 0, bench = 0;
+  const char *scenario = NULL, *log_path = NULL, *summary_path = NULL, *record_path = NULL;
+  int decimate = 0, bench = 0, print_config = 0;
   for (int i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--log") == 0 && i + 1 < argc) {
       log_path = argv[++i];
@@ -38,8 +43,12 @@ int main(int argc, char **argv) {
         return 2;
       }
       decimate = (int)v;
+    } else if (strcmp(argv[i], "--record-isr") == 0 && i + 1 < argc) {
+      record_path = argv[++i];
     } else if (strcmp(argv[i], "--bench") == 0) {
       bench = 1;
+    } else if (strcmp(argv[i], "--print-config") == 0) {
+      print_config = 1;
     } else if (argv[i][0] == '-' || scenario != NULL) {
       return usage();
     } else {
@@ -55,6 +64,15 @@ int main(int argc, char **argv) {
     fprintf(stderr, "fluxdrive-sil: %s\n", err);
     return 2;
   }
+  if (print_config) {
+    char *js = config_json(&sc);
+    if (js == NULL) {
+      return 1;
+    }
+    printf("%s\n", js);
+    free(js);
+    return 0;
+  }
   if (decimate > 0) {
     sc.log_decimation = decimate;
   }
@@ -64,9 +82,25 @@ int main(int argc, char **argv) {
     fprintf(stderr, "fluxdrive-sil: %s: cannot write the log\n", log_path);
     return 1;
   }
+  sil_observer_fn obs = logging ? log_npy_observer : NULL;
+  void *obs_user = logging ? &lg : NULL;
+  static isr_record_t rec;
+  if (record_path != NULL) {
+    if (isr_record_open(&rec, record_path) != 0) {
+      fprintf(stderr, "fluxdrive-sil: %s: cannot write the ISR record\n", record_path);
+      return 1;
+    }
+    rec.next = obs;
+    rec.next_user = obs_user;
+    obs = isr_record_observer;
+    obs_user = &rec;
+  }
   sil_result_t res;
-  int r =
-      sil_run(&sc, logging ? log_npy_observer : NULL, logging ? &lg : NULL, &res, err, sizeof err);
+  int r = sil_run(&sc, obs, obs_user, &res, err, sizeof err);
+  if (record_path != NULL && isr_record_close(&rec) != 0) {
+    fprintf(stderr, "fluxdrive-sil: %s: writing the ISR record failed\n", record_path);
+    return 1;
+  }
   if (logging && log_npy_close(&lg) != 0) {
     fprintf(stderr, "fluxdrive-sil: %s: writing the log failed\n", log_path);
     return 1;

@@ -46,3 +46,36 @@ char *summary_json(const scenario_t *sc, const sil_result_t *r) {
   cJSON_Delete(o);
   return s;
 }
+
+char *config_json(const scenario_t *sc) {
+  const plant_machine_t *m = &sc->plant.machine;
+  const drive_config_t *d = &sc->drive;
+  cJSON *o = cJSON_CreateObject();
+  cJSON_AddStringToObject(o, "scenario", sc->name);
+  cJSON *pm = cJSON_AddObjectToObject(o, "machine");
+  cJSON_AddNumberToObject(pm, "pole_pairs", m->pole_pairs);
+  cJSON_AddNumberToObject(pm, "rs", m->rs);
+  cJSON_AddNumberToObject(pm, "ld", m->ld);
+  cJSON_AddNumberToObject(pm, "lq", m->lq);
+  cJSON_AddNumberToObject(pm, "lambda_m", m->lambda_m);
+  cJSON_AddNumberToObject(pm, "j", sc->plant.mech.j);
+  cJSON_AddNumberToObject(o, "v_dc", sc->plant.dclink.v_source);
+  cJSON_AddNumberToObject(o, "ts", sc->plant.ts);
+  cJSON_AddNumberToObject(o, "dead_time", sc->plant.inverter.dead_time);
+  cJSON *c = cJSON_AddObjectToObject(o, "controller");
+  cJSON_AddStringToObject(c, "law", law_names[d->law]);
+  cJSON_AddNumberToObject(c, "rs", d->rs);
+  cJSON_AddNumberToObject(c, "ld", d->ld);
+  cJSON_AddNumberToObject(c, "lq", d->lq);
+  cJSON_AddNumberToObject(c, "lambda_m", d->lambda_m);
+  cJSON_AddNumberToObject(c, "i_max", d->i_max);
+  cJSON_AddNumberToObject(c, "torque_max", d->torque_max);
+  cJSON_AddNumberToObject(c, "speed_max", d->speed_max);
+  cJSON_AddNumberToObject(c, "v_margin", d->v_margin);
+  cJSON_AddNumberToObject(c, "delta_max", d->delta_max);
+  cJSON_AddNumberToObject(c, "vsd_max", d->vsd_max);
+  cJSON_AddNumberToObject(c, "flux_min", d->flux_min);
+  char *s = cJSON_Print(o);
+  cJSON_Delete(o);
+  return s;
+}

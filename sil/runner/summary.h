@@ -10,4 +10,8 @@
 /* Returns a malloc'ed, formatted JSON string (caller frees), or NULL. */
 char *summary_json(const scenario_t *sc, const sil_result_t *res);
 
+/* The resolved parameters of a scenario (plant and controller), as JSON:
+ * what offline tools (tools/: capability curves) compute from. Caller frees. */
+char *config_json(const scenario_t *sc);
+
 #endif

@@ -35,12 +35,11 @@ static inline void spm_plant_init(spm_plant_t *m, double r, double l, double lm,
 
 /* Exact one-period solution from (i0, theta0) under v, speed w. */
 static inline double complex spm_plant_exact(double r, double l, double lm, double ts, double w,
-                                             double complex i0, double theta0,
-                                             double complex v) {
+                                             double complex i0, double theta0, double complex v) {
   const double f = r / l;
   const double k = exp(-f * ts);
-  const double complex emf = -I * w * lm * cexp(I * theta0) * (cexp(I * w * ts) - k) /
-                             (l * (f + I * w));
+  const double complex emf =
+      -I * w * lm * cexp(I * theta0) * (cexp(I * w * ts) - k) / (l * (f + I * w));
   return k * i0 + (1.0 - k) / r * v + emf;
 }
 
@@ -52,7 +51,7 @@ static inline double complex spm_plant_rk4(double r, double l, double lm, double
   double complex i = i0;
   for (int s = 0; s < n; ++s) {
     const double t = s * h;
-#define SPM_DI(ii, tt) ((v - r * (ii) - I * w * lm * cexp(I * (theta0 + w * (tt)))) / l)
+#define SPM_DI(ii, tt) ((v - r * (ii)-I * w * lm * cexp(I * (theta0 + w * (tt)))) / l)
     const double complex k1 = SPM_DI(i, t);
     const double complex k2 = SPM_DI(i + 0.5 * h * k1, t + 0.5 * h);
     const double complex k3 = SPM_DI(i + 0.5 * h * k2, t + 0.5 * h);

@@ -37,9 +37,9 @@ static double worst_error(current_predictor_mode_t mode, double we) {
     const double complex want = spm_plant_exact(RS, LS, LM, TS, we, i0, th, v);
     const double complex rk = spm_plant_rk4(RS, LS, LM, TS, we, i0, th, v, 200);
     assert_true(cabs(want - rk) < 1e-9); /* the closed form is the ODE solution */
-    const ab_t got = current_predictor_step(&p, (ab_t){(float)creal(i0), (float)cimag(i0)},
-                                            (ab_t){(float)creal(v), (float)cimag(v)}, (float)th,
-                                            (float)we);
+    const ab_t got =
+        current_predictor_step(&p, (ab_t){(float)creal(i0), (float)cimag(i0)},
+                               (ab_t){(float)creal(v), (float)cimag(v)}, (float)th, (float)we);
     const double e = cabs((got.alpha + I * got.beta) - want);
     worst = (e > worst) ? e : worst;
   }

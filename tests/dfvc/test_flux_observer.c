@@ -29,8 +29,8 @@
 
 static flux_observer_t make_obs(double lm_model) {
   flux_observer_t o;
-  const flux_observer_cfg_t cfg = {(float)RS,        (float)LS, (float)lm_model, (float)P,
-                                   (float)TS,        (float)WC, 1000.0f};
+  const flux_observer_cfg_t cfg = {(float)RS, (float)LS, (float)lm_model, (float)P,
+                                   (float)TS, (float)WC, 1000.0f};
   assert_int_equal(flux_observer_init(&o, &cfg), 0);
   return o;
 }
@@ -74,8 +74,8 @@ static void test_crossover(void **state) {
     double rt = 0.0, rc = 0.0;
     run_detuned(ws[n], &rt, &rc);
     const double h = h_mag(ws[n]);
-    printf("  w = %7.1f rad/s: |est - true|/|cm - true| = %.4f (|H| = %.4f, analog %.4f)\n",
-           ws[n], rt, h, 1.0 / sqrt(1.0 + (ws[n] / WC) * (ws[n] / WC)));
+    printf("  w = %7.1f rad/s: |est - true|/|cm - true| = %.4f (|H| = %.4f, analog %.4f)\n", ws[n],
+           rt, h, 1.0 / sqrt(1.0 + (ws[n] / WC) * (ws[n] / WC)));
     assert_true(fabs(rt - h) < 0.005);
   }
   double rt = 0.0, rc = 0.0;
@@ -107,14 +107,12 @@ static double run_exact(double rpm, int paper_drop) {
   double complex prev_pred = 0.0;
   for (int k = 0; k < 4000; ++k) {
     /* back-EMF plus a q-ish component: i_qs ~ 0.34 A after the transient */
-    const double complex v =
-        I * w * LM * cexp(I * m.theta) * 1.02 + 12.0 * I * cexp(I * m.theta);
+    const double complex v = I * w * LM * cexp(I * m.theta) * 1.02 + 12.0 * I * cexp(I * m.theta);
     const double complex inext =
         paper_drop ? m.i : spm_plant_exact(RS, LS, LM, TS, w, m.i, m.theta, v);
     flux_observer_update(&o, (ab_t){(float)creal(m.i), (float)cimag(m.i)},
                          (ab_t){(float)creal(inext), (float)cimag(inext)},
-                         (ab_t){(float)creal(v), (float)cimag(v)}, (float)m.theta, (float)w,
-                         &out);
+                         (ab_t){(float)creal(v), (float)cimag(v)}, (float)m.theta, (float)w, &out);
     const double complex lam = spm_plant_flux(&m);
     const double complex lh = out.lambda.alpha + I * out.lambda.beta;
     worst_now = fmax(worst_now, cabs(lh - lam));
@@ -164,11 +162,13 @@ static void test_init_and_reset(void **state) {
   cfg.omega_s_bw = 1000.0f;
   assert_int_equal(flux_observer_init(&o, &cfg), 0);
   flux_observer_out_t out;
-  flux_observer_update(&o, (ab_t){1.0f, 0.0f}, (ab_t){1.0f, 0.0f}, (ab_t){100.0f, 0.0f}, 0.0f, 0.0f, &out);
+  flux_observer_update(&o, (ab_t){1.0f, 0.0f}, (ab_t){1.0f, 0.0f}, (ab_t){100.0f, 0.0f}, 0.0f, 0.0f,
+                       &out);
   /* first update: the current model, LS*1 + LM */
   assert_true(fabsf(out.lambda.alpha - 0.247f) < 1e-6f);
   flux_observer_reset(&o);
-  flux_observer_update(&o, (ab_t){0.0f, 0.0f}, (ab_t){0.0f, 0.0f}, (ab_t){0.0f, 0.0f}, 1.5707963f, 0.0f, &out);
+  flux_observer_update(&o, (ab_t){0.0f, 0.0f}, (ab_t){0.0f, 0.0f}, (ab_t){0.0f, 0.0f}, 1.5707963f,
+                       0.0f, &out);
   assert_true(fabsf(out.lambda.beta - 0.19f) < 1e-6f && fabsf(out.lambda.alpha) < 1e-6f);
 }
 

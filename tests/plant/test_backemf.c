@@ -62,8 +62,9 @@ static void test_short_circuit(void **state) {
     plant_state_t s;
     plant_get_state(&pl, &s);
     const double err = hypot(s.i_dq[0] - id, s.i_dq[1] - iq);
-    print_message("model %d: short circuit i_dq = (%.6f, %.6f), analytic (%.6f, %.6f), err %.2e A\n",
-                  model, s.i_dq[0], s.i_dq[1], id, iq, err);
+    print_message(
+        "model %d: short circuit i_dq = (%.6f, %.6f), analytic (%.6f, %.6f), err %.2e A\n", model,
+        s.i_dq[0], s.i_dq[1], id, iq, err);
     /* zero vector all the time in both models: only integration error */
     assert_true(err < 1e-6 * hypot(id, iq));
   }

@@ -77,8 +77,8 @@ static void rectify(int model, double ratio, double *torque, double *max_i, doub
       /* trapezoid over the period for the state quantities; i_dc is the
        * exact period average */
       const double te = 0.5 * (s.torque + s0.torque);
-      const double i2 = 0.5 * (s.i_dq[0] * s.i_dq[0] + s.i_dq[1] * s.i_dq[1] + s0.i_dq[0] * s0.i_dq[0] +
-                               s0.i_dq[1] * s0.i_dq[1]);
+      const double i2 = 0.5 * (s.i_dq[0] * s.i_dq[0] + s.i_dq[1] * s.i_dq[1] +
+                               s0.i_dq[0] * s0.i_dq[0] + s0.i_dq[1] * s0.i_dq[1]);
       tsum += te;
       e_mech += -te * w * p.ts;
       e_dc += -s.v_dc * s.i_dc * p.ts;

@@ -24,7 +24,7 @@ static void test_quantisation(void **state) {
     plant_adc_t a;
     plant_sample(&pl, &a);
     const double q = a.i_abc[0] / lsb;
-    assert_true(fabs(q - nearbyint(q)) < 1e-9);    /* on the code grid */
+    assert_true(fabs(q - nearbyint(q)) < 1e-9);             /* on the code grid */
     assert_true(fabs(a.i_abc[0] - i) <= 0.5 * lsb + 1e-12); /* rounding */
     assert_true(fabs(a.i_abc[1] + 0.5 * i) <= 0.5 * lsb + 1e-12);
   }

@@ -45,7 +45,7 @@ int dfvc_init(dfvc_t *c, const dfvc_cfg_t *cfg) {
          k->omega_delta_mode == DFVC_OMEGA_DELTA_OBSERVED))) {
     return -1;
   }
-  const flux_observer_cfg_t oc = {k->rs, k->ls, k->lambda_m, k->pole_pairs,
+  const flux_observer_cfg_t oc = {k->rs, k->ls,      k->lambda_m,  k->pole_pairs,
                                   k->ts, k->omega_c, k->omega_s_bw};
   const current_predictor_cfg_t pc = {k->rs, k->ls, k->lambda_m, k->ts, k->mpe_mode};
   const dfvc_refs_cfg_t rc = {k->rs,    k->ls,        k->lambda_m,   k->pole_pairs,
@@ -89,8 +89,8 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
   }
 
   /* MPE, eq. (21): current at tau+1 */
-  const ab_t i1 = current_predictor_step(&c->mpe, in->i_ab, in->v_ab_applied, in->theta_r,
-                                         in->omega_r);
+  const ab_t i1 =
+      current_predictor_step(&c->mpe, in->i_ab, in->v_ab_applied, in->theta_r, in->omega_r);
 
   /* stator flux at tau and its prediction at tau+1, Fig. 3, eqs. (19)-(20) */
   flux_observer_out_t o;
@@ -117,7 +117,7 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
     di.i_dqs_next = i1_dqs;
     di.omega_r = in->omega_r;
     di.omega_delta = (k->omega_delta_mode == DFVC_OMEGA_DELTA_TARGET)
-                         ? dfvc_deadbeat_omega_delta_target(&c->db, r.iqs_ref, delta1)
+                         ? dfvc_deadbeat_omega_delta_target(&c->db, r.iqs_ref, i1_dqs.q, delta1)
                          : frames_wrap_pi(delta1 - o.delta) / k->ts;
     di.v_max = v_max;
     dfvc_deadbeat_out_t dout;

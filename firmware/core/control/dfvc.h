@@ -38,6 +38,11 @@
  *  - i_max = 2.5 sqrt(2) A (Table I rated rms current, as amplitude).
  *  - MPE form: exact back-EMF term (current_predictor.h) instead of the
  *    back-EMF held at tau; CURRENT_PREDICTOR_EQ21 gives the printed (21).
+ *  - flux prediction (19): resistive drop averaged over the period with the
+ *    MPE current (flux_observer.h); the printed Rs i(tau) is a 0.1 % (100 rpm)
+ *    to 1.5 % (1200 rpm) flux bias.
+ *  - PI-DFVC anti-windup: integral tracks its steady-state value while
+ *    saturated (dfvc_pi.h); math/pi_ctrl is not used.
  *  - omega_delta in (33): predicted from the i_qs reference (see
  *    dfvc_deadbeat.h); DFVC_OMEGA_DELTA_OBSERVED gives the observed rate.
  *  - rot_advance = 0.5: the (ds, qs) -> (alpha, beta) rotation uses
@@ -78,12 +83,12 @@ typedef struct {
   float omega_c;    /* crossover current model / back-EMF [rad/s] (125) */
   float omega_s_bw; /* omega_s derivative filter [rad/s] (1000) */
   /* limits and references */
-  float i_max;      /* phase current amplitude limit [A] */
-  float delta_max;  /* load-angle limit [rad] (80 deg) */
-  float v_sd_max;   /* d_s voltage limit [V] (60) */
-  float lambda_min; /* minimum flux reference [Vs] */
+  float i_max;           /* phase current amplitude limit [A] */
+  float delta_max;       /* load-angle limit [rad] (80 deg) */
+  float v_sd_max;        /* d_s voltage limit [V] (60) */
+  float lambda_min;      /* minimum flux reference [Vs] */
   float lambda_collapse; /* observed flux below this is a fault [Vs] */
-  float v_margin;   /* fraction of v_dc/sqrt(3) used by the flux-weakening law (0.95) */
+  float v_margin;        /* fraction of v_dc/sqrt(3) used by the flux-weakening law (0.95) */
   /* PI-DFVC */
   float pi_bw_flux; /* [rad/s] (2 pi 1000) */
   float pi_bw_iqs;  /* [rad/s] (2 pi 1000) */
@@ -94,20 +99,20 @@ typedef struct {
 } dfvc_cfg_t;
 
 typedef struct {
-  dfvc_law_t law;     /* DFVC_LAW_DEADBEAT or DFVC_LAW_PI (may change between calls) */
-  ab_t i_ab;          /* measured current at tau [A] */
-  ab_t v_ab_applied;  /* voltage applied over [tau, tau+1) [V] */
-  float theta_r;      /* electrical rotor angle at tau [rad] */
-  float omega_r;      /* electrical rotor speed at tau [rad/s] */
-  float v_dc;         /* DC-link voltage [V] */
-  float torque_ref;   /* T* [N m] */
-  float lambda_ref;   /* flux reference override [Vs]; 0 = automatic (MTPA/FW) */
+  dfvc_law_t law;    /* DFVC_LAW_DEADBEAT or DFVC_LAW_PI (may change between calls) */
+  ab_t i_ab;         /* measured current at tau [A] */
+  ab_t v_ab_applied; /* voltage applied over [tau, tau+1) [V] */
+  float theta_r;     /* electrical rotor angle at tau [rad] */
+  float omega_r;     /* electrical rotor speed at tau [rad/s] */
+  float v_dc;        /* DC-link voltage [V] */
+  float torque_ref;  /* T* [N m] */
+  float lambda_ref;  /* flux reference override [Vs]; 0 = automatic (MTPA/FW) */
 } dfvc_in_t;
 
 /* Fault bits (values only; nothing is latched or switched off here). */
 enum {
-  DFVC_FAULT_INPUT = 1u << 0,   /* non-finite input or unknown law: output 0, state held */
-  DFVC_FAULT_STATE = 1u << 1,   /* non-finite internal result: output 0, states reset */
+  DFVC_FAULT_INPUT = 1u << 0,        /* non-finite input or unknown law: output 0, state held */
+  DFVC_FAULT_STATE = 1u << 1,        /* non-finite internal result: output 0, states reset */
   DFVC_FAULT_FLUX_COLLAPSE = 1u << 2 /* observed |lambda_s| < lambda_collapse */
 };
 
@@ -123,21 +128,21 @@ typedef struct {
   ab_t i_ab_pred2; /* predicted current at tau+2 with v_ab_ref [A] */
   ab_t i_ab_mid;   /* (pred + pred2)/2: mean over [tau+1, tau+2), for dead-time comp [A] */
   /* telemetry at tau unless stated */
-  float lambda_s;      /* observed flux amplitude [Vs] */
-  float lambda_s_pred; /* predicted at tau+1 [Vs] */
-  float lambda_ref;    /* lambda* [Vs] */
-  float theta_s;       /* flux angle [rad] */
-  float omega_s;       /* flux-frame speed (filtered) [rad/s] */
-  float delta;         /* load angle [rad] */
-  float i_ds, i_qs;    /* stator-flux frame currents [A] */
-  float i_qs_ref;      /* limited i_qs* [A] */
-  float i_qs_pred;     /* predicted at tau+1 [A] */
-  float torque;        /* 3/2 p lambda_s i_qs [N m] */
-  float torque_pred;   /* predicted at tau+1 [N m] */
+  float lambda_s;               /* observed flux amplitude [Vs] */
+  float lambda_s_pred;          /* predicted at tau+1 [Vs] */
+  float lambda_ref;             /* lambda* [Vs] */
+  float theta_s;                /* flux angle [rad] */
+  float omega_s;                /* flux-frame speed (filtered) [rad/s] */
+  float delta;                  /* load angle [rad] */
+  float i_ds, i_qs;             /* stator-flux frame currents [A] */
+  float i_qs_ref;               /* limited i_qs* [A] */
+  float i_qs_pred;              /* predicted at tau+1 [A] */
+  float torque;                 /* 3/2 p lambda_s i_qs [N m] */
+  float torque_pred;            /* predicted at tau+1 [N m] */
   float torque_min, torque_max; /* deliverable now [N m] (dfvc_refs.h) */
-  dq_t v_dqs;          /* (ds, qs) voltage reference [V] */
-  uint32_t limits;     /* DFVC_REFS_* | DFVC_LIMIT_* */
-  uint32_t fault;      /* DFVC_FAULT_* */
+  dq_t v_dqs;                   /* (ds, qs) voltage reference [V] */
+  uint32_t limits;              /* DFVC_REFS_* | DFVC_LIMIT_* */
+  uint32_t fault;               /* DFVC_FAULT_* */
 } dfvc_out_t;
 
 typedef struct {

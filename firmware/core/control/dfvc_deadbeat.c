@@ -28,10 +28,14 @@ void dfvc_deadbeat_reset(dfvc_deadbeat_t *db) {
   db->ls_ts = db->cfg.ls / db->cfg.ts;
 }
 
-float dfvc_deadbeat_omega_delta_target(const dfvc_deadbeat_t *db, float iqs_ref,
+float dfvc_deadbeat_omega_delta_target(const dfvc_deadbeat_t *db, float iqs_ref, float iqs_next,
                                        float delta_next) {
-  /* q_s row of Rubino 2020, eq. (16): Ls i_qs = lambda_m sin(delta) */
-  float s = db->cfg.ls * iqs_ref / db->cfg.lambda_m;
+  /* q_s row of Rubino 2020, eq. (16): Ls i_qs = lambda_m sin(delta), used
+   * incrementally from the predicted state: sin(delta*) = sin(delta(t+1))
+   * + Ls (i_qs* - i_qs(t+1)) / lambda_m. With exact parameters this is
+   * asin(Ls i_qs* / lambda_m); with detuned ones the error scales the step
+   * only and vanishes in steady state (no bias on v_qs). */
+  float s = sinf(delta_next) + db->cfg.ls * (iqs_ref - iqs_next) / db->cfg.lambda_m;
   s = fminf(fmaxf(s, -1.0f), 1.0f);
   return frames_wrap_pi(asinf(s) - delta_next) * db->inv_ts;
 }

@@ -18,10 +18,12 @@
  * omega_delta over [tau+1, tau+2) (the paper writes w~_delta^{tau+1} and
  * leaves its computation open). Two estimates are offered to the caller:
  *  - dfvc_deadbeat_omega_delta_target(): (delta* - delta(t+1)) / Ts with
- *    delta* = asin(Ls i_qs* / lambda_m), the load angle at which an SPM
- *    machine carries i_qs* (q_s row of (16), the relation behind (26)). It
- *    predicts the load-angle step that the commanded i_qs step causes in
- *    the very interval the voltage acts (default in dfvc.h).
+ *    sin(delta*) = sin(delta(t+1)) + Ls (i_qs* - i_qs(t+1)) / lambda_m, the
+ *    load angle at which an SPM machine carries i_qs* (q_s row of (16), the
+ *    relation behind (26)), taken as an increment from the predicted state
+ *    so that detuned Ls, lambda_m scale the step instead of biasing v_qs.
+ *    It predicts the load-angle step that the commanded i_qs step causes
+ *    in the very interval the voltage acts (default in dfvc.h).
  *  - the observed rate (delta(t+1) - delta(t)) / Ts (one interval late).
  */
 #ifndef FD_CONTROL_DFVC_DEADBEAT_H
@@ -37,8 +39,8 @@ typedef struct {
 
 typedef struct {
   dfvc_deadbeat_cfg_t cfg;
-  float inv_ts;   /* 1/Ts */
-  float ls_ts;    /* Ls/Ts */
+  float inv_ts; /* 1/Ts */
+  float ls_ts;  /* Ls/Ts */
 } dfvc_deadbeat_t;
 
 typedef struct {
@@ -67,7 +69,7 @@ int dfvc_deadbeat_init(dfvc_deadbeat_t *db, const dfvc_deadbeat_cfg_t *cfg);
 /* No dynamic state: recomputes the derived constants. */
 void dfvc_deadbeat_reset(dfvc_deadbeat_t *db);
 /* (delta* - delta_next)/Ts, delta* = asin(Ls i_qs* / lambda_m) [rad/s]. */
-float dfvc_deadbeat_omega_delta_target(const dfvc_deadbeat_t *db, float iqs_ref,
+float dfvc_deadbeat_omega_delta_target(const dfvc_deadbeat_t *db, float iqs_ref, float iqs_next,
                                        float delta_next);
 /* Eqs. (29) and (33) with the limits. */
 void dfvc_deadbeat_step(const dfvc_deadbeat_t *db, const dfvc_deadbeat_in_t *in,

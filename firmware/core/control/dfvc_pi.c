@@ -73,8 +73,8 @@ void dfvc_pi_step(dfvc_pi_t *c, const dfvc_pi_in_t *in, dfvc_pi_out_t *out) {
   /* i_qs loop on Rubino 2020, eq. (32) */
   const float vq_max = sqrtf(fmaxf(vmax * vmax - vd * vd, 0.0f));
   const float ff_q = in->omega_r * in->lambda_s + in->omega_delta * k->ls * in->i_dqs.d;
-  const float vq = dfvc_pi_axis(&c->integ_q, c->kp_iqs, c->ki_iqs, k->ts,
-                                in->iqs_ref - in->i_dqs.q, ff_q, vq_max, k->rs * in->i_dqs.q, &sq);
+  const float vq = dfvc_pi_axis(&c->integ_q, c->kp_iqs, c->ki_iqs, k->ts, in->iqs_ref - in->i_dqs.q,
+                                ff_q, vq_max, k->rs * in->i_dqs.q, &sq);
 
   out->v_dqs.d = vd;
   out->v_dqs.q = vq;

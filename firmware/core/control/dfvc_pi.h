@@ -40,11 +40,11 @@
 #include "math/frames.h"
 
 typedef struct {
-  float rs, ls;     /* [Ohm], [H] */
-  float ts;         /* [s] */
-  float bw_flux;    /* flux loop bandwidth [rad/s] */
-  float bw_iqs;     /* i_qs loop bandwidth [rad/s] */
-  float v_sd_max;   /* d_s voltage limit [V] */
+  float rs, ls;   /* [Ohm], [H] */
+  float ts;       /* [s] */
+  float bw_flux;  /* flux loop bandwidth [rad/s] */
+  float bw_iqs;   /* i_qs loop bandwidth [rad/s] */
+  float v_sd_max; /* d_s voltage limit [V] */
 } dfvc_pi_cfg_t;
 
 typedef struct {
@@ -56,13 +56,13 @@ typedef struct {
 } dfvc_pi_t;
 
 typedef struct {
-  float lambda_ref; /* [Vs] */
-  float iqs_ref;    /* [A] */
-  float lambda_s;   /* observed amplitude at tau [Vs] */
-  dq_t i_dqs;       /* measured current in the flux frame at tau [A] */
-  float omega_r;    /* [rad/s] */
+  float lambda_ref;  /* [Vs] */
+  float iqs_ref;     /* [A] */
+  float lambda_s;    /* observed amplitude at tau [Vs] */
+  dq_t i_dqs;        /* measured current in the flux frame at tau [A] */
+  float omega_r;     /* [rad/s] */
   float omega_delta; /* filtered load-angle rate omega_s - omega_r [rad/s] */
-  float v_max;      /* available voltage amplitude [V] */
+  float v_max;       /* available voltage amplitude [V] */
 } dfvc_pi_in_t;
 
 typedef struct {

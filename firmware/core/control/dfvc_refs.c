@@ -63,8 +63,8 @@ void dfvc_refs_update(const dfvc_refs_t *r, const dfvc_refs_in_t *in, dfvc_refs_
   unsigned lim = 0u;
 
   /* Fig. 5: flux reference */
-  out->lambda_mtpa = (in->lambda_override > 0.0f) ? in->lambda_override
-                                                  : dfvc_refs_lambda_mtpa(r, in->torque_ref);
+  out->lambda_mtpa =
+      (in->lambda_override > 0.0f) ? in->lambda_override : dfvc_refs_lambda_mtpa(r, in->torque_ref);
   out->lambda_vlim = dfvc_refs_lambda_vlim(r, in->v_dc, in->omega_r, in->i_ds, in->i_qs);
   float lref = out->lambda_mtpa;
   if (out->lambda_vlim < lref) {

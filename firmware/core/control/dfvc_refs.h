@@ -38,23 +38,23 @@ typedef struct {
 
 typedef struct {
   dfvc_refs_cfg_t cfg;
-  float iqs_max_delta; /* eq. (26) [A] */
+  float iqs_max_delta;   /* eq. (26) [A] */
   float torque_mtpa_max; /* 1.5 p lambda_m I_max [N m] */
 } dfvc_refs_t;
 
 typedef struct {
-  float torque_ref;  /* T* [N m] */
+  float torque_ref;      /* T* [N m] */
   float lambda_override; /* > 0: replaces lambda_MTPA [Vs]; 0 = automatic */
-  float omega_r;     /* electrical rotor speed [rad/s] */
-  float v_dc;        /* [V] */
-  float i_ds, i_qs;  /* stator-flux frame currents at tau [A] */
+  float omega_r;         /* electrical rotor speed [rad/s] */
+  float v_dc;            /* [V] */
+  float i_ds, i_qs;      /* stator-flux frame currents at tau [A] */
 } dfvc_refs_in_t;
 
 enum {
-  DFVC_REFS_FLUX_VLIM = 1u << 0,   /* lambda* set by the voltage limit (23) */
-  DFVC_REFS_FLUX_MIN = 1u << 1,    /* lambda* set by lambda_min */
-  DFVC_REFS_IQS_IMAX = 1u << 2,    /* i_qs* clipped by the current limit (25) */
-  DFVC_REFS_IQS_DELTA = 1u << 3    /* i_qs* clipped by the load-angle limit (26) */
+  DFVC_REFS_FLUX_VLIM = 1u << 0, /* lambda* set by the voltage limit (23) */
+  DFVC_REFS_FLUX_MIN = 1u << 1,  /* lambda* set by lambda_min */
+  DFVC_REFS_IQS_IMAX = 1u << 2,  /* i_qs* clipped by the current limit (25) */
+  DFVC_REFS_IQS_DELTA = 1u << 3  /* i_qs* clipped by the load-angle limit (26) */
 };
 
 typedef struct {

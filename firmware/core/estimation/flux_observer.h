@@ -42,11 +42,11 @@ typedef struct {
 
 typedef struct {
   flux_observer_cfg_t cfg;
-  float alpha_s;     /* 1 - exp(-omega_s_bw Ts) */
-  ab_t lambda_hat;   /* estimate at the next update's sample [Vs] */
+  float alpha_s;   /* 1 - exp(-omega_s_bw Ts) */
+  ab_t lambda_hat; /* estimate at the next update's sample [Vs] */
   float theta_s_prev;
-  float omega_s;     /* filtered flux-frame speed [rad/s] */
-  int started;       /* 0 until the first update */
+  float omega_s; /* filtered flux-frame speed [rad/s] */
+  int started;   /* 0 until the first update */
 } flux_observer_t;
 
 typedef struct {
@@ -59,10 +59,10 @@ typedef struct {
   float lambda_s_next; /* [Vs] */
   float theta_s_next;  /* [rad] */
   sincos_t sc_s_next;
-  float omega_s;       /* filtered d theta_s / dt [rad/s] */
-  float delta;         /* load angle theta_s - theta_r at t, wrapped [rad] */
-  dq_t i_dqs;          /* current in the stator-flux frame at t [A] */
-  float torque;        /* 3/2 p lambda_s i_qs [N m] */
+  float omega_s; /* filtered d theta_s / dt [rad/s] */
+  float delta;   /* load angle theta_s - theta_r at t, wrapped [rad] */
+  dq_t i_dqs;    /* current in the stator-flux frame at t [A] */
+  float torque;  /* 3/2 p lambda_s i_qs [N m] */
 } flux_observer_out_t;
 
 /* Returns 0, or -1 for invalid parameters (rs >= 0, ls > 0, lambda_m >= 0,

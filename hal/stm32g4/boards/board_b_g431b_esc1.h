@@ -20,8 +20,11 @@
 #define BOARD_DEAD_TIME_NS 500u /* starting value; check the gate timing on a scope */
 #define BOARD_DUTY_MAX     0.95f
 #define BOARD_PWM_PINS                                                                             \
-  {{PORT_A, 8, 6}, {PORT_A, 9, 6}, {PORT_A, 10, 6}, {PORT_C, 13, 4}, {PORT_A, 12, 6},              \
-   {PORT_B, 15, 4}}
+  {                                                                                                \
+    {PORT_A, 8, 6}, {PORT_A, 9, 6}, {PORT_A, 10, 6}, {PORT_C, 13, 4}, {PORT_A, 12, 6}, {           \
+      PORT_B, 15, 4                                                                                \
+    }                                                                                              \
+  }
 #define BOARD_PWM_HIGH_ACTIVE_LOW 0
 #define BOARD_PWM_LOW_ACTIVE_LOW  0
 
@@ -33,8 +36,10 @@
 #define BOARD_HAS_BKIN 0
 
 /* FDCAN1: PA11 RX / PB9 TX (AF9), transceiver on the ESC board. */
-#define BOARD_CAN_RX_PIN {PORT_A, 11, 9}
-#define BOARD_CAN_TX_PIN {PORT_B, 9, 9}
+#define BOARD_CAN_RX_PIN                                                                           \
+  { PORT_A, 11, 9 }
+#define BOARD_CAN_TX_PIN                                                                           \
+  { PORT_B, 9, 9 }
 #define BOARD_CAN_BITRATE 500000u
 #define BOARD_CAN_NODE_ID 1u
 
@@ -45,17 +50,26 @@
  *   W: OPAMP3 VINP0 PB0, VINM0 PB2, VOUT PB1 = ADC1_IN12
  *   V_bus: divider to PA0 = ADC1_IN1
  * The kit has no star-point sensing: v_star is reported as 0. */
-#define BOARD_ADC_IA    {1u, 3u, ADC_SMP_12_5}
-#define BOARD_ADC_IB    {2u, 3u, ADC_SMP_12_5}
-#define BOARD_ADC_IC    {1u, 12u, ADC_SMP_12_5}
-#define BOARD_ADC_VDC   {1u, 1u, ADC_SMP_47_5}
-#define BOARD_ADC_VSTAR {0u, 0u, 0u}
+#define BOARD_ADC_IA                                                                               \
+  { 1u, 3u, ADC_SMP_12_5 }
+#define BOARD_ADC_IB                                                                               \
+  { 2u, 3u, ADC_SMP_12_5 }
+#define BOARD_ADC_IC                                                                               \
+  { 1u, 12u, ADC_SMP_12_5 }
+#define BOARD_ADC_VDC                                                                              \
+  { 1u, 1u, ADC_SMP_47_5 }
+#define BOARD_ADC_VSTAR                                                                            \
+  { 0u, 0u, 0u }
 #define BOARD_ADC_PINS                                                                             \
-  {{PORT_A, 1, 0}, {PORT_A, 2, 0}, {PORT_A, 3, 0}, {PORT_A, 5, 0}, {PORT_A, 6, 0},                 \
-   {PORT_A, 7, 0}, {PORT_B, 0, 0}, {PORT_B, 1, 0}, {PORT_B, 2, 0}, {PORT_A, 0, 0}}
+  {                                                                                                \
+    {PORT_A, 1, 0}, {PORT_A, 2, 0}, {PORT_A, 3, 0}, {PORT_A, 5, 0}, {PORT_A, 6, 0},                \
+        {PORT_A, 7, 0}, {PORT_B, 0, 0}, {PORT_B, 1, 0}, {PORT_B, 2, 0}, {                          \
+      PORT_A, 0, 0                                                                                 \
+    }                                                                                              \
+  }
 #define BOARD_ADC_NPINS 10
 
-#define BOARD_USE_OPAMP_PGA 1
+#define BOARD_USE_OPAMP_PGA       1
 #define BOARD_OPAMP_PGA_GAIN_CODE 0x0Bu /* PGA_GAIN = 01011: x16, bias/input on VINM0 */
 
 /* Shunt 3 mOhm; total gain shunt -> ADC pin 9.14 V/V (external resistor
@@ -67,9 +81,9 @@
 #define BOARD_VSTAR_RATIO 0.0f
 
 /* Protections: 6S LiPo (25.2 V) max, kit rated 40 A peak. */
-#define BOARD_I_TRIP    30.0f
-#define BOARD_V_DC_MAX  28.0f
-#define BOARD_V_DC_MIN  7.0f
+#define BOARD_I_TRIP   30.0f
+#define BOARD_V_DC_MAX 28.0f
+#define BOARD_V_DC_MIN 7.0f
 
 #define BOARD_IWDG_TIMEOUT_MS 50u
 

@@ -25,46 +25,61 @@
 #define BOARD_DUTY_MAX     0.95f /* keeps the low side on >= 3 us around the valley */
 /* TIM1 CH1, CH2, CH3, CH1N, CH2N, CH3N (STM32G474 datasheet, alternate functions) */
 #define BOARD_PWM_PINS                                                                             \
-  {{PORT_A, 8, 6}, {PORT_A, 9, 6}, {PORT_A, 10, 6}, {PORT_B, 13, 6}, {PORT_B, 14, 6},              \
-   {PORT_B, 15, 4}}
+  {                                                                                                \
+    {PORT_A, 8, 6}, {PORT_A, 9, 6}, {PORT_A, 10, 6}, {PORT_B, 13, 6}, {PORT_B, 14, 6}, {           \
+      PORT_B, 15, 4                                                                                \
+    }                                                                                              \
+  }
 #define BOARD_PWM_HIGH_ACTIVE_LOW 0
 #define BOARD_PWM_LOW_ACTIVE_LOW  0
 
 /* Hardware over-current: BKIN pin, active low, digital filter fCK/32 N=8. */
-#define BOARD_HAS_BKIN         1
-#define BOARD_BKIN_PIN         {PORT_A, 6, 6}
+#define BOARD_HAS_BKIN 1
+#define BOARD_BKIN_PIN                                                                             \
+  { PORT_A, 6, 6 }
 #define BOARD_BKIN_ACTIVE_HIGH 0
 #define BOARD_BKIN_FILTER      0x3u /* BKF: fCK_INT, N = 8 (47 ns at 170 MHz) */
 
 /* FDCAN1: PA11 RX / PA12 TX (AF9) */
-#define BOARD_CAN_RX_PIN {PORT_A, 11, 9}
-#define BOARD_CAN_TX_PIN {PORT_A, 12, 9}
+#define BOARD_CAN_RX_PIN                                                                           \
+  { PORT_A, 11, 9 }
+#define BOARD_CAN_TX_PIN                                                                           \
+  { PORT_A, 12, 9 }
 #define BOARD_CAN_BITRATE 500000u
 #define BOARD_CAN_NODE_ID 1u
 
 /* Analog front end: {ADC (1, 2; 0 = absent), channel, sample time} */
-#define BOARD_ADC_IA    {1u, 1u, ADC_SMP_12_5}  /* PA0  ADC1_IN1 */
-#define BOARD_ADC_IB    {2u, 2u, ADC_SMP_12_5}  /* PA1  ADC2_IN2 */
-#define BOARD_ADC_IC    {1u, 7u, ADC_SMP_12_5}  /* PC1  ADC1_IN7 */
-#define BOARD_ADC_VDC   {1u, 15u, ADC_SMP_47_5} /* PB0  ADC1_IN15 */
-#define BOARD_ADC_VSTAR {2u, 17u, ADC_SMP_47_5} /* PA4  ADC2_IN17 */
+#define BOARD_ADC_IA                                                                               \
+  { 1u, 1u, ADC_SMP_12_5 } /* PA0  ADC1_IN1 */
+#define BOARD_ADC_IB                                                                               \
+  { 2u, 2u, ADC_SMP_12_5 } /* PA1  ADC2_IN2 */
+#define BOARD_ADC_IC                                                                               \
+  { 1u, 7u, ADC_SMP_12_5 } /* PC1  ADC1_IN7 */
+#define BOARD_ADC_VDC                                                                              \
+  { 1u, 15u, ADC_SMP_47_5 } /* PB0  ADC1_IN15 */
+#define BOARD_ADC_VSTAR                                                                            \
+  { 2u, 17u, ADC_SMP_47_5 } /* PA4  ADC2_IN17 */
 #define BOARD_ADC_PINS                                                                             \
-  {{PORT_A, 0, 0}, {PORT_A, 1, 0}, {PORT_C, 1, 0}, {PORT_B, 0, 0}, {PORT_A, 4, 0}}
+  {                                                                                                \
+    {PORT_A, 0, 0}, {PORT_A, 1, 0}, {PORT_C, 1, 0}, {PORT_B, 0, 0}, {                              \
+      PORT_A, 4, 0                                                                                 \
+    }                                                                                              \
+  }
 #define BOARD_ADC_NPINS 5
 
-#define BOARD_VDDA       3.3f
-#define BOARD_I_MID_V    1.65f                 /* amplifier output at zero current [V] */
-#define BOARD_I_A_PER_V  (1.0f / (0.010f * 8.0f)) /* 1 / (R_shunt * gain) [A/V] */
-#define BOARD_VDC_RATIO  20.0f                 /* V_dc / V_adc */
-#define BOARD_VSTAR_RATIO 20.0f                /* V_star(to ground) / V_adc */
+#define BOARD_VDDA        3.3f
+#define BOARD_I_MID_V     1.65f                    /* amplifier output at zero current [V] */
+#define BOARD_I_A_PER_V   (1.0f / (0.010f * 8.0f)) /* 1 / (R_shunt * gain) [A/V] */
+#define BOARD_VDC_RATIO   20.0f                    /* V_dc / V_adc */
+#define BOARD_VSTAR_RATIO 20.0f                    /* V_star(to ground) / V_adc */
 
 /* Internal OPAMPs in PGA mode: not used on this board. */
 #define BOARD_USE_OPAMP_PGA 0
 
 /* Protections handed to drive_config (the power stage's ratings). */
-#define BOARD_I_TRIP    20.0f
-#define BOARD_V_DC_MAX  60.0f
-#define BOARD_V_DC_MIN  8.0f
+#define BOARD_I_TRIP   20.0f
+#define BOARD_V_DC_MAX 60.0f
+#define BOARD_V_DC_MIN 8.0f
 
 #define BOARD_IWDG_TIMEOUT_MS 50u
 

@@ -180,7 +180,34 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--sil", metavar="PATH", help=sil_help)
     p.add_argument("--repeat", type=_positive_int, default=3, metavar="N", help="runs (default 3)")
     p.set_defaults(func=cmd_bench)
+
+    p = sub.add_parser("capability", help="torque/power capability vs speed from the machine model")
+    p.add_argument("scenario", metavar="SCENARIO", help="scenario JSON file (machine, limits)")
+    p.add_argument("--sil", metavar="PATH", help=sil_help)
+    p.add_argument("--min-rpm", type=float, default=100.0)
+    p.add_argument("--max-rpm", type=float, default=1200.0)
+    p.add_argument("--points", type=_positive_int, default=23)
+    p.set_defaults(func=_cmd_capability)
+
+    p = sub.add_parser("rubino2020", help="reproduce Rubino 2020 in SIL: figures + results table")
+    p.add_argument("--sil", metavar="PATH", help=sil_help)
+    p.add_argument("--out", metavar="DIR", help="logs (default: out/rubino2020)")
+    p.add_argument("--figures", metavar="DIR", help="figures (default: docs/figures)")
+    p.add_argument("--doc", metavar="MD", help="markdown file whose results table is replaced")
+    p.set_defaults(func=_cmd_rubino)
     return parser
+
+
+def _cmd_capability(args: argparse.Namespace) -> int:
+    from fluxdrive.capability import main_capability
+
+    return main_capability(args)
+
+
+def _cmd_rubino(args: argparse.Namespace) -> int:
+    from fluxdrive.rubino2020 import main_rubino
+
+    return main_rubino(args)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,0 +1,433 @@
+/*
+ * can_proto.c - commands, parameters, status, telemetry and the command
+ * timeout over CAN (see can_proto.h for the rules).
+ */
+#include "can_proto.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "drive_params.h"
+#include "hal.h"
+
+#define RPM_PER_RADS 9.54929659f /* 60 / (2 pi) */
+#define NO_SIGNAL    ((can_sig_t)CAN_SIG_COUNT)
+
+void can_proto_cfg_default(can_proto_cfg_t *cfg) {
+  *cfg = (can_proto_cfg_t){0};
+  cfg->node = 1;
+  cfg->timeout_ms = 500;
+  cfg->ramp_ms = 200;
+  cfg->period_ms[CAN_PERIOD_STATUS] = 100;
+  cfg->period_ms[CAN_PERIOD_HEARTBEAT] = 500;
+  cfg->period_ms[CAN_PERIOD_TM_SPEED] = 10;
+  cfg->period_ms[CAN_PERIOD_TM_TORQUE] = 10;
+  cfg->period_ms[CAN_PERIOD_TM_PHASE] = 10;
+  cfg->period_ms[CAN_PERIOD_TM_DQ] = 10;
+  cfg->period_ms[CAN_PERIOD_TM_FLUX] = 10;
+}
+
+int can_proto_init(can_proto_t *p, const can_proto_cfg_t *cfg) {
+  if (cfg->node > CAN_NODE_MAX) {
+    return -1;
+  }
+  *p = (can_proto_t){0};
+  p->cfg = *cfg;
+  p->st_state = DRIVE_STATE_IDLE;
+  return 0;
+}
+
+static void frame_init(hal_can_frame_t *f, can_msg_t m, uint8_t node) {
+  memset(f, 0, sizeof *f);
+  f->id = can_codec_id(m, node);
+  f->dlc = can_codec_msg(m)->dlc;
+}
+
+/* ---------------------------------------------------------------- params */
+bool can_proto_param_get(const can_proto_t *p, uint8_t id, float *value) {
+  if (id == CAN_PROTO_PARAM_FIRST) {
+    *value = (float)p->cfg.node;
+  } else if (id == CAN_PROTO_PARAM_FIRST + 1u) {
+    *value = (float)p->cfg.timeout_ms;
+  } else if (id == CAN_PROTO_PARAM_FIRST + 2u) {
+    *value = (float)p->cfg.ramp_ms;
+  } else if (id >= CAN_PROTO_PARAM_FIRST + 3u &&
+             id < CAN_PROTO_PARAM_FIRST + CAN_PROTO_PARAM_COUNT) {
+    *value = (float)p->cfg.period_ms[id - CAN_PROTO_PARAM_FIRST - 3u];
+  } else {
+    return false;
+  }
+  return true;
+}
+
+can_result_t can_proto_param_set(can_proto_t *p, uint8_t id, float value) {
+  float dummy;
+  if (!can_proto_param_get(p, id, &dummy)) {
+    return CAN_RESULT_UNKNOWN_PARAM;
+  }
+  if (id == CAN_PROTO_PARAM_FIRST) {
+    return CAN_RESULT_READ_ONLY; /* the node is set at start-up */
+  }
+  if (!isfinite(value) || value < 0.0f || value > 60000.0f || fabsf(value - roundf(value)) > 0.0f) {
+    return CAN_RESULT_OUT_OF_RANGE;
+  }
+  uint16_t v = (uint16_t)value;
+  if (id == CAN_PROTO_PARAM_FIRST + 1u) {
+    p->cfg.timeout_ms = v;
+  } else if (id == CAN_PROTO_PARAM_FIRST + 2u) {
+    p->cfg.ramp_ms = v;
+  } else {
+    p->cfg.period_ms[id - CAN_PROTO_PARAM_FIRST - 3u] = v;
+  }
+  return CAN_RESULT_OK;
+}
+
+/* --------------------------------------------------------------- receive */
+typedef struct {
+  can_result_t result;
+  can_sig_t signal; /* NO_SIGNAL: none */
+  uint8_t param;
+  float value;
+} reply_t;
+
+static bool enabled_state(const drive_t *drv) {
+  return drv->state == DRIVE_STATE_RUN || drv->state == DRIVE_STATE_OFFSET_CAL;
+}
+
+/* First signal of message m outside its DBC range, NO_SIGNAL if none. */
+static can_sig_t first_out_of_range(can_msg_t m, const uint8_t data[8]) {
+  const can_msg_desc_t *md = can_codec_msg(m);
+  for (unsigned i = 0; i < md->n_signals; ++i) {
+    can_sig_t s = (can_sig_t)((unsigned)md->first + i);
+    if (!can_codec_in_range(s, data)) {
+      return s;
+    }
+  }
+  return NO_SIGNAL;
+}
+
+static void reply_error(reply_t *r, can_result_t res, can_sig_t s) {
+  r->result = res;
+  r->signal = s;
+}
+
+static void handle_param(can_proto_t *p, drive_t *drv, const uint8_t *d, reply_t *r) {
+  uint8_t id = (uint8_t)can_codec_get_raw(CAN_SIG_PARAM_ID, d);
+  bool set = can_codec_get_raw(CAN_SIG_PARAM_OP, d) == 1u;
+  float v = can_codec_get(CAN_SIG_PARAM_VALUE, d);
+  r->param = id;
+  bool proto = id >= CAN_PROTO_PARAM_FIRST;
+  float now;
+  bool known =
+      proto ? can_proto_param_get(p, id, &now) : drive_params_get(drv, id, &now) == DRIVE_PARAM_OK;
+  if (!known) {
+    reply_error(r, CAN_RESULT_UNKNOWN_PARAM, CAN_SIG_PARAM_ID);
+    return;
+  }
+  r->value = now;
+  if (!set) {
+    return;
+  }
+  can_result_t res;
+  if (proto) {
+    res = can_proto_param_set(p, id, v);
+  } else {
+    switch (drive_params_set(drv, id, v, NULL)) {
+    case DRIVE_PARAM_OK:
+      res = CAN_RESULT_OK;
+      break;
+    case DRIVE_PARAM_READ_ONLY:
+      res = CAN_RESULT_READ_ONLY;
+      break;
+    case DRIVE_PARAM_RANGE:
+      res = CAN_RESULT_OUT_OF_RANGE;
+      break;
+    case DRIVE_PARAM_RUNNING:
+      res = CAN_RESULT_NOT_WHILE_RUNNING;
+      break;
+    case DRIVE_PARAM_INCONSISTENT:
+      res = CAN_RESULT_INCONSISTENT;
+      break;
+    case DRIVE_PARAM_UNKNOWN:
+    default:
+      res = CAN_RESULT_UNKNOWN_PARAM;
+      break;
+    }
+  }
+  if (res != CAN_RESULT_OK) {
+    reply_error(r, res, res == CAN_RESULT_UNKNOWN_PARAM ? CAN_SIG_PARAM_ID : CAN_SIG_PARAM_VALUE);
+  }
+  if (proto) {
+    (void)can_proto_param_get(p, id, &r->value);
+  } else {
+    (void)drive_params_get(drv, id, &r->value);
+  }
+}
+
+/* Applies a CMD_* frame (DLC and DBC ranges already checked). */
+static void handle_cmd(const can_proto_t *p, drive_t *drv, can_msg_t m, const uint8_t *d,
+                       reply_t *r) {
+  const drive_config_t *c = &drv->cfg;
+  switch (m) {
+  case CAN_MSG_CMD_STATE: {
+    uint32_t en = can_codec_get_raw(CAN_SIG_ENABLE, d);
+    uint32_t mode = can_codec_get_raw(CAN_SIG_MODE, d);
+    uint32_t law = can_codec_get_raw(CAN_SIG_LAW, d);
+    if (!p->ramp) {
+      if (can_codec_get_raw(CAN_SIG_CLEAR_FAULT, d) == 1u) {
+        drive_cmd_clear_fault(drv);
+      }
+      if (law < (uint32_t)DRIVE_LAW_COUNT) {
+        (void)drive_cmd_set_law(drv, (drive_law_t)law);
+      }
+      if (mode < (uint32_t)DRIVE_MODE_COUNT) {
+        (void)drive_cmd_set_mode(drv, (drive_mode_t)mode);
+      }
+      if (en <= 1u) {
+        drive_cmd_enable(drv, en == 1u);
+      }
+    }
+    r->value = drv->cmd.enable ? 1.0f : 0.0f;
+    return;
+  }
+  case CAN_MSG_CMD_TORQUE: {
+    float t = can_codec_get(CAN_SIG_CMD_TORQUE, d);
+    if (fabsf(t) > c->torque_max) {
+      reply_error(r, CAN_RESULT_OUT_OF_RANGE, CAN_SIG_CMD_TORQUE);
+    } else if (!p->ramp) {
+      drive_cmd_torque(drv, t);
+    }
+    r->value = drv->cmd.torque;
+    return;
+  }
+  case CAN_MSG_CMD_SPEED: {
+    float rpm = can_codec_get(CAN_SIG_CMD_SPEED_RPM, d);
+    if (fabsf(rpm) > c->speed_max * RPM_PER_RADS * (1.0f + 1e-6f)) {
+      reply_error(r, CAN_RESULT_OUT_OF_RANGE, CAN_SIG_CMD_SPEED_RPM);
+    } else if (!p->ramp) {
+      drive_cmd_speed(drv, rpm / RPM_PER_RADS);
+    }
+    r->value = drv->cmd.speed * RPM_PER_RADS;
+    return;
+  }
+  case CAN_MSG_CMD_CURRENT: {
+    float id = can_codec_get(CAN_SIG_CMD_ID, d);
+    float iq = can_codec_get(CAN_SIG_CMD_IQ, d);
+    if (fabsf(id) > c->i_max) {
+      reply_error(r, CAN_RESULT_OUT_OF_RANGE, CAN_SIG_CMD_ID);
+    } else if (fabsf(iq) > c->i_max) {
+      reply_error(r, CAN_RESULT_OUT_OF_RANGE, CAN_SIG_CMD_IQ);
+    } else if (!p->ramp) {
+      drive_cmd_current(drv, id, iq);
+    }
+    r->value = drv->cmd.id;
+    return;
+  }
+  case CAN_MSG_CMD_FLUX:
+  default:
+    if (!p->ramp) {
+      drive_cmd_flux(drv, can_codec_get(CAN_SIG_CMD_FLUX, d));
+    }
+    r->value = drv->cmd.flux;
+    return;
+  }
+}
+
+static void encode_reply(const can_proto_t *p, can_msg_t req, const reply_t *r,
+                         hal_can_frame_t *f) {
+  frame_init(f, CAN_MSG_REPLY, p->cfg.node);
+  can_codec_set_raw(CAN_SIG_REPLY_REQ, f->data, (uint32_t)req);
+  can_codec_set_raw(CAN_SIG_REPLY_RESULT, f->data, (uint32_t)r->result);
+  can_codec_set_raw(CAN_SIG_REPLY_SIGNAL, f->data,
+                    r->signal == NO_SIGNAL ? 0u : (uint32_t)r->signal + 1u);
+  can_codec_set_raw(CAN_SIG_REPLY_PARAM, f->data, r->param);
+  can_codec_set(CAN_SIG_REPLY_VALUE, f->data, r->value);
+}
+
+/* Handles one received frame; returns true and fills `out` when it needs a
+ * reply. */
+static bool handle_frame(can_proto_t *p, drive_t *drv, const hal_can_frame_t *f, uint32_t now,
+                         hal_can_frame_t *out) {
+  can_msg_t m = can_codec_lookup(f->id, f->extended, p->cfg.node);
+  const can_msg_desc_t *md = can_codec_msg(m);
+  if (md == NULL || !md->to_drive) {
+    p->stats.rx_ignored++;
+    return false;
+  }
+  reply_t r = {CAN_RESULT_OK, NO_SIGNAL, 0, 0.0f};
+  if (f->dlc != md->dlc) {
+    reply_error(&r, CAN_RESULT_BAD_DLC, NO_SIGNAL);
+  } else {
+    p->last_rx_us = now; /* well-formed: the host is alive */
+    if (m == CAN_MSG_HOST_HB) {
+      p->stats.rx_ok++;
+      return false;
+    }
+    can_sig_t bad = first_out_of_range(m, f->data);
+    if (bad != NO_SIGNAL) {
+      reply_error(&r, CAN_RESULT_OUT_OF_RANGE, bad);
+    } else if (m == CAN_MSG_PARAM_REQ) {
+      handle_param(p, drv, f->data, &r);
+    } else {
+      handle_cmd(p, drv, m, f->data, &r);
+      if (r.result == CAN_RESULT_OK && p->ramp) {
+        r.result = CAN_RESULT_TIMED_OUT;
+      }
+    }
+  }
+  if (r.result == CAN_RESULT_OK) {
+    p->stats.rx_ok++;
+  } else {
+    p->stats.rx_errors++;
+  }
+  if (m == CAN_MSG_HOST_HB) {
+    return false; /* a bad heartbeat is counted, not answered */
+  }
+  if (r.result != CAN_RESULT_OK && m != CAN_MSG_PARAM_REQ && r.signal == NO_SIGNAL &&
+      r.result != CAN_RESULT_BAD_DLC) {
+    r.signal = md->first;
+  }
+  encode_reply(p, m, &r, out);
+  return true;
+}
+
+/* -------------------------------------------------------------- timeout */
+static void timeout_step(can_proto_t *p, drive_t *drv, uint32_t now) {
+  const bool enabled = enabled_state(drv);
+  if (!p->ramp) {
+    if (!enabled || p->cfg.timeout_ms == 0u ||
+        now - p->last_rx_us < (uint32_t)p->cfg.timeout_ms * 1000u) {
+      return;
+    }
+    p->ramp = true;
+    p->ramp_t0_us = now;
+    p->ramp_torque0 = drv->tm.torque_ref;
+    p->ramp_mode = drv->cmd.mode;
+    (void)drive_cmd_set_mode(drv, DRIVE_MODE_TORQUE);
+  }
+  if (!enabled) { /* the drive stopped on its own (fault, disable) */
+    p->ramp = false;
+    return;
+  }
+  const uint32_t elapsed = now - p->ramp_t0_us;
+  const uint32_t ramp_us = (uint32_t)p->cfg.ramp_ms * 1000u;
+  if (elapsed >= ramp_us) {
+    drive_cmd_torque(drv, 0.0f);
+    drive_cmd_speed(drv, 0.0f);
+    drive_cmd_current(drv, 0.0f, 0.0f);
+    (void)drive_cmd_set_mode(drv, p->ramp_mode);
+    drive_cmd_enable(drv, false);
+    drive_raise_fault(drv, DRIVE_FAULT_CMD_TIMEOUT);
+    p->ramp = false;
+    p->stats.timeouts++;
+    return;
+  }
+  drive_cmd_torque(drv, p->ramp_torque0 * (1.0f - (float)elapsed / (float)ramp_us));
+}
+
+/* ------------------------------------------------------------- transmit */
+static void send_periodic(can_proto_t *p, can_period_t which, const drive_t *drv) {
+  const drive_telemetry_t *tm = drive_telemetry(drv);
+  const uint8_t node = p->cfg.node;
+  hal_can_frame_t f;
+  switch (which) {
+  case CAN_PERIOD_STATUS:
+    frame_init(&f, CAN_MSG_STATUS, node);
+    can_codec_set_raw(CAN_SIG_STATE, f.data, (uint32_t)tm->state);
+    can_codec_set_raw(CAN_SIG_CTRL_MODE, f.data, (uint32_t)drv->ref.mode);
+    can_codec_set_raw(CAN_SIG_CTRL_LAW, f.data, (uint32_t)drv->ref.law);
+    can_codec_set_raw(CAN_SIG_FAULTS, f.data, tm->faults);
+    can_codec_set(CAN_SIG_V_DC, f.data, tm->v_dc);
+    can_codec_set_raw(CAN_SIG_TIMEOUT_RAMP, f.data, p->ramp ? 1u : 0u);
+    can_codec_set_raw(CAN_SIG_CMD_ENABLED, f.data, drv->cmd.enable ? 1u : 0u);
+    can_codec_set_raw(CAN_SIG_ERR_COUNT, f.data, p->stats.rx_errors & 0xFFu);
+    p->st_state = tm->state;
+    p->st_faults = tm->faults;
+    p->st_ramp = p->ramp;
+    break;
+  case CAN_PERIOD_HEARTBEAT:
+    frame_init(&f, CAN_MSG_HEARTBEAT, node);
+    can_codec_set_raw(CAN_SIG_HB_COUNT, f.data, p->hb_count++);
+    can_codec_set_raw(CAN_SIG_HB_STATE, f.data, (uint32_t)tm->state);
+    break;
+  case CAN_PERIOD_TM_SPEED:
+    frame_init(&f, CAN_MSG_TM_SPEED, node);
+    can_codec_set(CAN_SIG_SPEED_RPM, f.data, tm->omega_m * RPM_PER_RADS);
+    can_codec_set(CAN_SIG_SPEED_REF_RPM, f.data, tm->speed_ref * RPM_PER_RADS);
+    break;
+  case CAN_PERIOD_TM_TORQUE:
+    frame_init(&f, CAN_MSG_TM_TORQUE, node);
+    can_codec_set(CAN_SIG_TORQUE_EST, f.data, tm->torque_est);
+    can_codec_set(CAN_SIG_TORQUE_REF, f.data, tm->torque_ref);
+    break;
+  case CAN_PERIOD_TM_PHASE:
+    frame_init(&f, CAN_MSG_TM_PHASE, node);
+    can_codec_set(CAN_SIG_I_A, f.data, tm->i_abc[0]);
+    can_codec_set(CAN_SIG_I_B, f.data, tm->i_abc[1]);
+    can_codec_set(CAN_SIG_I_C, f.data, tm->i_abc[2]);
+    break;
+  case CAN_PERIOD_TM_DQ:
+    frame_init(&f, CAN_MSG_TM_DQ, node);
+    can_codec_set(CAN_SIG_I_D, f.data, tm->i_dq[0]);
+    can_codec_set(CAN_SIG_I_Q, f.data, tm->i_dq[1]);
+    can_codec_set(CAN_SIG_I_DS, f.data, tm->law_tm.i_ds);
+    can_codec_set(CAN_SIG_I_QS, f.data, tm->law_tm.i_qs);
+    break;
+  case CAN_PERIOD_TM_FLUX:
+  default:
+    frame_init(&f, CAN_MSG_TM_FLUX, node);
+    can_codec_set(CAN_SIG_FLUX, f.data, tm->law_tm.flux);
+    can_codec_set(CAN_SIG_FLUX_REF, f.data, tm->law_tm.flux_ref);
+    can_codec_set(CAN_SIG_DELTA, f.data, tm->law_tm.delta);
+    can_codec_set(CAN_SIG_I_QS_REF, f.data, tm->law_tm.i_qs_ref);
+    break;
+  }
+  if (!hal_can_send(&f)) {
+    p->stats.tx_dropped++;
+  }
+}
+
+void can_proto_poll(can_proto_t *p, drive_t *drv, uint32_t now_us) {
+  if (!p->started) {
+    p->started = true;
+    p->last_rx_us = now_us;
+    for (unsigned i = 0; i < (unsigned)CAN_PERIOD_COUNT; ++i) {
+      p->last_tx_us[i] = now_us - (uint32_t)p->cfg.period_ms[i] * 1000u;
+    }
+  }
+  /* 1. a reply that did not fit last time goes first */
+  bool blocked = false;
+  if (p->pending) {
+    blocked = !hal_can_send(&p->pending_frame);
+    p->pending = blocked;
+  }
+  /* 2. at most CAN_PROTO_RX_MAX received frames */
+  hal_can_frame_t in, out;
+  for (unsigned n = 0; !blocked && n < CAN_PROTO_RX_MAX && hal_can_receive(&in); ++n) {
+    p->stats.rx_frames++;
+    if (in.dlc > 8u) {
+      in.dlc = 9u; /* never a valid length; keep the data untouched */
+    }
+    if (handle_frame(p, drv, &in, now_us, &out) && !hal_can_send(&out)) {
+      p->pending_frame = out;
+      p->pending = true;
+      blocked = true;
+    }
+  }
+  /* 3. command timeout */
+  timeout_step(p, drv, now_us);
+  /* 4. status at once on a change, then periodic transmissions */
+  const drive_telemetry_t *tm = drive_telemetry(drv);
+  bool changed = tm->state != p->st_state || tm->faults != p->st_faults || p->ramp != p->st_ramp;
+  for (unsigned i = 0; i < (unsigned)CAN_PERIOD_COUNT; ++i) {
+    uint32_t period = (uint32_t)p->cfg.period_ms[i] * 1000u;
+    bool due = period > 0u && now_us - p->last_tx_us[i] >= period;
+    if (i == (unsigned)CAN_PERIOD_STATUS && changed) {
+      due = true;
+    }
+    if (due) {
+      p->last_tx_us[i] = now_us;
+      send_periodic(p, (can_period_t)i, drv);
+    }
+  }
+}

@@ -1,0 +1,119 @@
+/*
+ * pil_main.c - processor-in-the-loop replay (docs/pil.md).
+ *
+ * Reads pil_in.bin (an isr_stream recorded by `fluxdrive-sil --record-isr`)
+ * through semihosting, initialises the drive with the recorded
+ * configuration and replays the exact call sequence of the SIL run: per
+ * record, drive_slow_loop() with the staged commands when the record says
+ * so, then drive_isr() on the recorded HAL sample. Writes one
+ * isr_stream_out_t per ISR to pil_out.bin.
+ *
+ * Exit status: 0 done, 2 input file, 3 stream format, 4 drive_init
+ * rejected the configuration, 5 output file, 70 fault exception.
+ *
+ * Instruction counting (`fluxdrive pil`): drive_isr() is called only from
+ * pil_step(), so an ISR spans the trace lines from drive_isr's entry to the
+ * first line back in pil_step.
+ */
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "drive.h"
+#include "hal_pil.h"
+#include "isr_stream.h"
+#include "semihost.h"
+
+#define CHUNK 64 /* records per semihosting transfer */
+
+typedef struct {
+  isr_stream_in_t in;
+  isr_stream_out_t host_out; /* the host's outputs: compared on the host */
+} record_t;
+
+static drive_t drv;
+static record_t rec[CHUNK];
+static isr_stream_out_t out[CHUNK];
+
+static int fail(int code, const char *msg) {
+  sh_puts("fluxdrive-pil: ");
+  sh_puts(msg);
+  sh_puts("\n");
+  return code;
+}
+
+static void apply_commands(drive_t *d, const isr_stream_in_t *in) {
+  d->cmd.enable = (in->flags & ISR_IN_CMD_ENABLE) != 0u;
+  d->cmd.clear_fault = (in->flags & ISR_IN_CMD_CLEAR) != 0u;
+  d->cmd.law = (drive_law_t)in->cmd_law;
+  d->cmd.mode = (drive_mode_t)in->cmd_mode;
+  d->cmd.torque = in->cmd_torque;
+  d->cmd.speed = in->cmd_speed;
+  d->cmd.id = in->cmd_id;
+  d->cmd.iq = in->cmd_iq;
+  d->cmd.flux = in->cmd_flux;
+}
+
+/* One period of the SIL loop: slow loop (if due), external faults, ISR. */
+__attribute__((noinline)) static void pil_step(const isr_stream_in_t *in, isr_stream_out_t *o) {
+  if ((in->flags & ISR_IN_SLOW) != 0u) {
+    apply_commands(&drv, in);
+    drive_slow_loop(&drv);
+  }
+  if (in->raise_fault != 0u) {
+    drive_raise_fault(&drv, in->raise_fault);
+  }
+  hal_pil_set_input(in);
+  drive_isr(&drv);
+  bool on = false;
+  hal_pil_get_output(o->duty, &on);
+  o->flags = on ? ISR_OUT_GATES_ON : 0u;
+  o->faults = drv.faults;
+  o->state = (uint32_t)drv.state;
+}
+
+int main(void) {
+  const int32_t fin = sh_open("pil_in.bin", "rb");
+  if (fin < 0) {
+    return fail(2, "cannot open pil_in.bin");
+  }
+  isr_stream_header_t h;
+  if (sh_read(fin, &h, sizeof h) != 0) {
+    return fail(3, "pil_in.bin: short header");
+  }
+  if (h.magic != ISR_STREAM_MAGIC || h.version != ISR_STREAM_VERSION || h.header_size != sizeof h ||
+      h.config_size != 4u * ISR_STREAM_CONFIG_WORDS || h.in_size != sizeof(isr_stream_in_t) ||
+      h.out_size != sizeof(isr_stream_out_t)) {
+    return fail(3, "pil_in.bin: not an isr_stream of this version/layout");
+  }
+  static uint32_t words[ISR_STREAM_CONFIG_WORDS];
+  if (sh_read(fin, words, sizeof words) != 0) {
+    return fail(3, "pil_in.bin: short configuration");
+  }
+  static drive_config_t cfg;
+  isr_stream_config_get(&cfg, words);
+  const char *field = "";
+  if (drive_init(&drv, &cfg, &field) != 0) {
+    sh_puts(field);
+    return fail(4, ": drive_init rejected the recorded configuration");
+  }
+  const int32_t fout = sh_open("pil_out.bin", "wb");
+  if (fout < 0) {
+    return fail(5, "cannot open pil_out.bin");
+  }
+  for (uint32_t done = 0; done < h.count;) {
+    const uint32_t n = (h.count - done) < CHUNK ? (h.count - done) : CHUNK;
+    if (sh_read(fin, rec, n * sizeof rec[0]) != 0) {
+      return fail(3, "pil_in.bin: short record");
+    }
+    for (uint32_t i = 0; i < n; ++i) {
+      pil_step(&rec[i].in, &out[i]);
+    }
+    if (sh_write(fout, out, n * sizeof out[0]) != 0) {
+      return fail(5, "pil_out.bin: write failed");
+    }
+    done += n;
+  }
+  sh_close(fout);
+  sh_close(fin);
+  return 0;
+}

@@ -1,0 +1,43 @@
+/*
+ * isr_record.h - records, per ISR, the drive's inputs (HAL sample, staged
+ * commands at each slow loop, hardware trip) and its outputs (duties, gate
+ * state, faults) into an isr_stream file (isr_stream.h, docs/pil.md), for
+ * the processor-in-the-loop replay on QEMU (pil/, `fluxdrive pil`).
+ *
+ * It is a sil_run observer; it can chain to another observer (the log).
+ * The outputs of ISR k are completed at period k+1 (the duties the HAL
+ * holds after ISR k are those acting over [t_k+1, t_k+2)), so the last ISR
+ * of a run is not recorded.
+ */
+#ifndef FD_SIL_ISR_RECORD_H
+#define FD_SIL_ISR_RECORD_H
+
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "isr_stream.h"
+#include "sil_run.h"
+
+typedef struct {
+  FILE *f;
+  uint32_t count;
+  int failed;
+  bool started; /* header and config written */
+  bool pending; /* rec holds ISR k-1, waiting for its duties */
+  isr_stream_in_t in;
+  isr_stream_out_t out;
+  uint32_t prev_faults;
+  drive_state_t prev_state;
+  sil_observer_fn next; /* chained observer (may be NULL) */
+  void *next_user;
+} isr_record_t;
+
+/* Opens the file. Returns 0 or -1. */
+int isr_record_open(isr_record_t *r, const char *path);
+/* sil_run observer. */
+void isr_record_observer(void *user, const sil_step_t *st);
+/* Patches the record count into the header and closes. Returns 0 or -1. */
+int isr_record_close(isr_record_t *r);
+
+#endif

@@ -6,7 +6,9 @@
  * configuration and replays the exact call sequence of the SIL run: per
  * record, drive_slow_loop() with the staged commands when the record says
  * so, then drive_isr() on the recorded HAL sample. Writes one
- * isr_stream_out_t per ISR to pil_out.bin.
+ * isr_stream_out_t per ISR to pil_out.bin. With ISR_STREAM_FORCE_APPLIED in
+ * the header, the law's applied-voltage memory is set to the host's before
+ * each ISR (outside the counted ISR; docs/pil.md explains why).
  *
  * Exit status: 0 done, 2 input file, 3 stream format, 4 drive_init
  * rejected the configuration, 5 output file, 70 fault exception.
@@ -54,6 +56,8 @@ static void apply_commands(drive_t *d, const isr_stream_in_t *in) {
 }
 
 /* One period of the SIL loop: slow loop (if due), external faults, ISR. */
+static bool force_applied;
+
 __attribute__((noinline)) static void pil_step(const isr_stream_in_t *in, isr_stream_out_t *o) {
   if ((in->flags & ISR_IN_SLOW) != 0u) {
     apply_commands(&drv, in);
@@ -63,6 +67,9 @@ __attribute__((noinline)) static void pil_step(const isr_stream_in_t *in, isr_st
     drive_raise_fault(&drv, in->raise_fault);
   }
   hal_pil_set_input(in);
+  if (force_applied) {
+    drv.ctrl.v_applied = (ab_t){in->v_applied[0], in->v_applied[1]};
+  }
   drive_isr(&drv);
   bool on = false;
   hal_pil_get_output(o->duty, &on);
@@ -85,6 +92,7 @@ int main(void) {
       h.out_size != sizeof(isr_stream_out_t)) {
     return fail(3, "pil_in.bin: not an isr_stream of this version/layout");
   }
+  force_applied = (h.flags & ISR_STREAM_FORCE_APPLIED) != 0u;
   static uint32_t words[ISR_STREAM_CONFIG_WORDS];
   if (sh_read(fin, words, sizeof words) != 0) {
     return fail(3, "pil_in.bin: short configuration");

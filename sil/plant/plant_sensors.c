@@ -70,11 +70,23 @@ static double rng_uniform(uint64_t *s) {
   return (double)(((x * 0x2545F4914F6CDD1Dull) >> 11) + 1u) * 0x1.0p-53;
 }
 
+/* Two independent standard normals, Marsaglia's polar method (no trig).
+ * A pair is accepted with probability pi/4; after 32 rejections (chance
+ * 1e-21) it returns zeros, so the loop is bounded. */
 static void rng_normal2(uint64_t *s, double *z0, double *z1) {
-  const double r = sqrt(-2.0 * log(rng_uniform(s)));
-  const double a = PLANT_TWO_PI * rng_uniform(s);
-  *z0 = r * cos(a);
-  *z1 = r * sin(a);
+  for (int attempt = 0; attempt < 32; ++attempt) {
+    const double u = 2.0 * rng_uniform(s) - 1.0;
+    const double v = 2.0 * rng_uniform(s) - 1.0;
+    const double q = u * u + v * v;
+    if (q > 0.0 && q < 1.0) {
+      const double f = sqrt(-2.0 * log(q) / q);
+      *z0 = u * f;
+      *z1 = v * f;
+      return;
+    }
+  }
+  *z0 = 0.0;
+  *z1 = 0.0;
 }
 
 static double adc_round(double x, double lsb, double code_min, double code_max, double code_off) {

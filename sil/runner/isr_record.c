@@ -123,6 +123,10 @@ void isr_record_observer(void *user, const sil_step_t *st) {
   in->v_star = st->adc->v_star;
   in->enc_angle = st->adc->enc_angle;
   in->raise_fault = faults & ~r->prev_faults & DRIVE_FAULT_CMD_TIMEOUT;
+  in->v_applied[0] = r->prev_v_applied[0];
+  in->v_applied[1] = r->prev_v_applied[1];
+  r->prev_v_applied[0] = drv->ctrl.v_applied.alpha;
+  r->prev_v_applied[1] = drv->ctrl.v_applied.beta;
 
   r->out.flags = st->gates_on ? ISR_OUT_GATES_ON : 0u;
   r->out.faults = faults;

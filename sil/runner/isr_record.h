@@ -29,7 +29,8 @@ typedef struct {
   isr_stream_out_t out;
   uint32_t prev_faults;
   drive_state_t prev_state;
-  sil_observer_fn next; /* chained observer (may be NULL) */
+  float prev_v_applied[2]; /* drive_t.ctrl.v_applied after the last ISR */
+  sil_observer_fn next;    /* chained observer (may be NULL) */
   void *next_user;
 } isr_record_t;
 

@@ -22,6 +22,11 @@
 #define ISR_STREAM_MAGIC   0x52534946u /* "FISR" */
 #define ISR_STREAM_VERSION 1u
 
+/* isr_stream_header_t.flags: the replay sets the law's applied-voltage
+ * memory (drive_t.ctrl.v_applied) to the host's before each ISR, see
+ * docs/pil.md ("Why the applied voltage is forced"). */
+#define ISR_STREAM_FORCE_APPLIED (1u << 0)
+
 /* isr_stream_in_t.flags */
 #define ISR_IN_SLOW       (1u << 0) /* drive_slow_loop() before this ISR, with cmd_* */
 #define ISR_IN_CMD_ENABLE (1u << 1) /* cmd.enable */
@@ -40,7 +45,7 @@ typedef struct {
   uint32_t in_size;     /* sizeof(isr_stream_in_t) */
   uint32_t out_size;    /* sizeof(isr_stream_out_t) */
   uint32_t count;       /* records */
-  uint32_t reserved;
+  uint32_t flags;       /* ISR_STREAM_FORCE_APPLIED (set by the PIL runner) */
 } isr_stream_header_t;
 
 /* Everything the drive sees before and during one ISR. */
@@ -59,6 +64,7 @@ typedef struct {
   float cmd_iq;
   float cmd_flux;
   uint32_t raise_fault; /* drive_raise_fault() bits raised before this ISR */
+  float v_applied[2];   /* host drive_t.ctrl.v_applied before this ISR (alpha, beta) */
 } isr_stream_in_t;
 
 /* What one ISR produced. */
@@ -70,7 +76,7 @@ typedef struct {
 } isr_stream_out_t;
 
 _Static_assert(sizeof(isr_stream_header_t) == 32, "isr_stream_header_t layout");
-_Static_assert(sizeof(isr_stream_in_t) == 64, "isr_stream_in_t layout");
+_Static_assert(sizeof(isr_stream_in_t) == 72, "isr_stream_in_t layout");
 _Static_assert(sizeof(isr_stream_out_t) == 24, "isr_stream_out_t layout");
 
 /* Every drive_config_t field, in file order: FLT(name) for float fields,

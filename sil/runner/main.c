@@ -7,13 +7,25 @@
  * --print-config prints the resolved parameters (JSON) and exits.
  * --record-isr PATH.bin records every ISR's inputs and outputs for the PIL
  * replay (sil/runner/isr_record.h, docs/pil.md).
+ * --can socketcand:PORT | socketcan:IFACE [--node N] [--can-timeout MS]:
+ * the drive is commanded over CAN (docs/can.md) and the scenario's
+ * references are not applied. socketcand listens on 127.0.0.1:PORT (0: a
+ * free port, printed on stderr); the simulation starts when the first
+ * client is in raw mode. --realtime paces the simulation to the wall clock
+ * (interactive use, the CAN tests); without it the simulation runs as fast
+ * as it can and all CAN times (timestamps, timeout) are simulated time.
+ * SIGINT/SIGTERM end the run early (the summary is still printed).
  * Exit codes: 0 ran (faults are results, reported in the summary),
  * 1 I/O error, 2 bad scenario or usage.
  */
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "can_proto.h"
+#include "can_socketcan.h"
+#include "can_socketcand.h"
 #include "isr_record.h"
 #include "log_npy.h"
 #include "scenario.h"
@@ -23,13 +35,55 @@
 static int usage(void) {
   fprintf(stderr, "usage: fluxdrive-sil SCENARIO.json [--log PATH.npy] [--summary PATH.json]\n"
                   "                     [--decimate N] [--bench] [--print-config]\n"
-                  "                     [--record-isr PATH.bin]\n");
+                  "                     [--record-isr PATH.bin] [--realtime]\n"
+                  "                     [--can socketcand:PORT | --can socketcan:IFACE]\n"
+                  "                     [--node N] [--can-timeout MS]\n");
   return 2;
+}
+
+static volatile int stop_flag;
+
+static void on_signal(int sig) {
+  (void)sig;
+  stop_flag = 1;
+}
+
+/* The transports behind sil_opts_t's callbacks. */
+static can_socketcand_t scd;
+static can_socketcan_t sck;
+
+static void io_socketcand(void *user, hal_sil_t *hal, double t) {
+  (void)user;
+  can_socketcand_poll(&scd, hal, t);
+}
+
+static bool ready_socketcand(void *user) {
+  (void)user;
+  return can_socketcand_clients(&scd) > 0;
+}
+
+static void io_socketcan(void *user, hal_sil_t *hal, double t) {
+  (void)user;
+  (void)t;
+  can_socketcan_poll(&sck, hal);
+}
+
+static int parse_long(const char *opt, const char *s, long lo, long hi, long *out) {
+  char *end = NULL;
+  long v = strtol(s, &end, 10);
+  if (end == s || *end != '\0' || v < lo || v > hi) {
+    fprintf(stderr, "fluxdrive-sil: %s: must be an integer in [%ld, %ld]\n", opt, lo, hi);
+    return -1;
+  }
+  *out = v;
+  return 0;
 }
 
 int main(int argc, char **argv) {
   const char *scenario = NULL, *log_path = NULL, *summary_path = NULL, *record_path = NULL;
-  int decimate = 0, bench = 0, print_config = 0;
+  int decimate = 0, bench = 0, print_config = 0, realtime = 0;
+  const char *can = NULL;
+  long node = -1, can_timeout = -1;
   for (int i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--log") == 0 && i + 1 < argc) {
       log_path = argv[++i];
@@ -47,6 +101,18 @@ int main(int argc, char **argv) {
       record_path = argv[++i];
     } else if (strcmp(argv[i], "--bench") == 0) {
       bench = 1;
+    } else if (strcmp(argv[i], "--realtime") == 0) {
+      realtime = 1;
+    } else if (strcmp(argv[i], "--can") == 0 && i + 1 < argc) {
+      can = argv[++i];
+    } else if (strcmp(argv[i], "--node") == 0 && i + 1 < argc) {
+      if (parse_long("--node", argv[++i], 0, CAN_NODE_MAX, &node) != 0) {
+        return 2;
+      }
+    } else if (strcmp(argv[i], "--can-timeout") == 0 && i + 1 < argc) {
+      if (parse_long("--can-timeout", argv[++i], 0, 60000, &can_timeout) != 0) {
+        return 2;
+      }
     } else if (strcmp(argv[i], "--print-config") == 0) {
       print_config = 1;
     } else if (argv[i][0] == '-' || scenario != NULL) {
@@ -76,6 +142,46 @@ int main(int argc, char **argv) {
   if (decimate > 0) {
     sc.log_decimation = decimate;
   }
+  sil_opts_t opts = {0};
+  can_proto_cfg_t pcfg;
+  can_proto_cfg_default(&pcfg);
+  if (node >= 0) {
+    pcfg.node = (uint8_t)node;
+  }
+  if (can_timeout >= 0) {
+    pcfg.timeout_ms = (uint16_t)can_timeout;
+  }
+  opts.realtime = realtime != 0;
+  opts.stop = &stop_flag;
+  if (can != NULL) {
+    opts.can = &pcfg;
+    if (strncmp(can, "socketcand:", 11) == 0) {
+      long port;
+      if (parse_long("--can socketcand:PORT", can + 11, 0, 65535, &port) != 0) {
+        return 2;
+      }
+      if (can_socketcand_open(&scd, (uint16_t)port, err, sizeof err) != 0) {
+        fprintf(stderr, "fluxdrive-sil: --can %s: %s\n", can, err);
+        return 2;
+      }
+      fprintf(stderr, "fluxdrive-sil: socketcand on 127.0.0.1:%u, node %u: waiting for a client\n",
+              (unsigned)can_socketcand_port(&scd), (unsigned)pcfg.node);
+      fflush(stderr);
+      opts.can_io = io_socketcand;
+      opts.can_ready = ready_socketcand;
+    } else if (strncmp(can, "socketcan:", 10) == 0 && can[10] != '\0') {
+      if (can_socketcan_open(&sck, can + 10, err, sizeof err) != 0) {
+        fprintf(stderr, "fluxdrive-sil: --can %s: %s\n", can, err);
+        return 2;
+      }
+      opts.can_io = io_socketcan;
+    } else {
+      fprintf(stderr, "fluxdrive-sil: --can: expected socketcand:PORT or socketcan:IFACE\n");
+      return 2;
+    }
+  }
+  signal(SIGINT, on_signal);
+  signal(SIGTERM, on_signal);
   log_npy_t lg;
   int logging = log_path != NULL && !bench;
   if (logging && log_npy_open(&lg, log_path, sc.log_decimation) != 0) {
@@ -96,7 +202,16 @@ int main(int argc, char **argv) {
     obs_user = &rec;
   }
   sil_result_t res;
-  int r = sil_run(&sc, obs, obs_user, &res, err, sizeof err);
+  int r = sil_run_ex(&sc, &opts, obs, obs_user, &res, err, sizeof err);
+  if (can != NULL) {
+    fprintf(stderr,
+            "fluxdrive-sil: CAN: %u frames read, %u ok, %u rejected, %u ignored, %u TX dropped, "
+            "%u timeouts\n",
+            (unsigned)res.can.rx_frames, (unsigned)res.can.rx_ok, (unsigned)res.can.rx_errors,
+            (unsigned)res.can.rx_ignored, (unsigned)res.can.tx_dropped, (unsigned)res.can.timeouts);
+    can_socketcand_close(&scd);
+    can_socketcan_close(&sck);
+  }
   if (record_path != NULL && isr_record_close(&rec) != 0) {
     fprintf(stderr, "fluxdrive-sil: %s: writing the ISR record failed\n", record_path);
     return 1;

@@ -42,11 +42,12 @@ static int fail(ctx_t *c, const char *path, const char *fmt, ...) {
   return -1;
 }
 
+/* "path.key" into out; a path longer than out is cut (it only names a
+ * field in a message). */
 static void join(char *out, size_t n, const char *path, const char *key) {
-  if (path[0] == '\0') {
-    snprintf(out, n, "%s", key);
-  } else {
-    snprintf(out, n, "%s.%s", path, key);
+  int r = path[0] == '\0' ? snprintf(out, n, "%s", key) : snprintf(out, n, "%s.%s", path, key);
+  if (r < 0 || (size_t)r >= n) {
+    out[n - 1] = '\0';
   }
 }
 
@@ -213,7 +214,7 @@ static int get_profile(ctx_t *c, const cJSON *obj, const char *path, const char 
     if (!cJSON_IsArray(terms)) {
       return fail(c, tp, "must be an array of profile terms");
     }
-    snprintf(p, sizeof p, "%s", tp);
+    memcpy(p, tp, sizeof p);
   }
   if (!cJSON_IsArray(terms)) {
     return fail(c, p, "must be a number, an array of terms or {\"unit\", \"terms\"}");
@@ -221,7 +222,9 @@ static int get_profile(ctx_t *c, const cJSON *obj, const char *path, const char 
   int i = 0;
   for (const cJSON *t = terms->child; t != NULL; t = t->next, ++i) {
     char tp[176];
-    snprintf(tp, sizeof tp, "%s[%d]", p, i);
+    if (snprintf(tp, sizeof tp, "%s[%d]", p, i) >= (int)sizeof tp) {
+      tp[sizeof tp - 1] = '\0';
+    }
     if (parse_term(c, t, tp, scale, pr) != 0) {
       return -1;
     }
@@ -481,7 +484,7 @@ static void scenario_defaults(scenario_t *sc) {
   drive_config_default(&sc->drive);
   preset_apply(preset_find("rubino2020_spm"), &sc->plant, &sc->drive);
   sc->plant.ts = 1.0 / 16000.0;
-  sc->plant.inverter = (plant_inverter_t){PLANT_INV_AVERAGE, 1e-6, 2};
+  sc->plant.inverter = (plant_inverter_t){PLANT_INV_AVERAGE, 1e-6, 1};
   sc->plant.dclink.kind = PLANT_DC_IDEAL;
   sc->plant.dclink.r = 0.1;
   sc->plant.dclink.c = 470e-6;

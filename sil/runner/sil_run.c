@@ -37,8 +37,25 @@ static void command_references(drive_t *drv, const scenario_t *sc, double t) {
   drive_cmd_flux(drv, (float)profile_eval(&sc->ref.flux, t));
 }
 
+static void sleep_s(double s) {
+  if (s <= 0.0) {
+    return;
+  }
+  struct timespec ts;
+  ts.tv_sec = (time_t)s;
+  ts.tv_nsec = (long)((s - (double)ts.tv_sec) * 1e9);
+  nanosleep(&ts, NULL);
+}
+
 int sil_run(const scenario_t *sc, sil_observer_fn obs, void *user, sil_result_t *res, char *err,
             size_t errlen) {
+  return sil_run_ex(sc, NULL, obs, user, res, err, errlen);
+}
+
+int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs, void *user,
+               sil_result_t *res, char *err, size_t errlen) {
+  static const sil_opts_t no_opts = {0};
+  static can_proto_t proto;
   static plant_t plant; /* large: keep off the stack; one run at a time */
   static drive_t drv;
   static hal_sil_t hal;
@@ -57,9 +74,25 @@ int sil_run(const scenario_t *sc, sil_observer_fn obs, void *user, sil_result_t 
   }
   drive_cmd_set_law(&drv, sc->drive.law);
   drive_cmd_set_mode(&drv, sc->drive.mode);
+  if (opts == NULL) {
+    opts = &no_opts;
+  }
+  const bool can = opts->can != NULL;
+  if (can && can_proto_init(&proto, opts->can) != 0) {
+    snprintf(err, errlen, "CAN: invalid node %u (0..%u)", (unsigned)opts->can->node, CAN_NODE_MAX);
+    return -1;
+  }
+  if (can && opts->can_ready != NULL) {
+    while (!opts->can_ready(opts->can_user) && !(opts->stop != NULL && *opts->stop)) {
+      if (opts->can_io != NULL) {
+        opts->can_io(opts->can_user, &hal, 0.0);
+      }
+      sleep_s(0.01);
+    }
+  }
 
   const double ts = sc->plant.ts;
-  const uint64_t n = (uint64_t)llround(sc->duration / ts);
+  uint64_t n = (uint64_t)llround(sc->duration / ts);
   const uint64_t tail = n - n / 20;
   float duty_active[3] = {0.5f, 0.5f, 0.5f};
   double torque_tail = 0.0;
@@ -73,17 +106,36 @@ int sil_run(const scenario_t *sc, sil_observer_fn obs, void *user, sil_result_t 
   plant_state_t st;
   hal_adc_sample_t sample;
   const double t_start = wall_now();
-  for (uint64_t k = 0; k < n; ++k) {
+  uint64_t k = 0;
+  for (; k < n; ++k) {
     const double t = (double)k * ts;
+    hal.time_us = (uint32_t)(uint64_t)(t * 1e6);
     if (k % sc->drive.slow_div == 0) {
-      command_references(&drv, sc, t);
-      drive_slow_loop(&drv);
+      if (opts->stop != NULL && *opts->stop) {
+        res->stopped = true;
+        break;
+      }
+      if (can) {
+        if (opts->can_io != NULL) {
+          opts->can_io(opts->can_user, &hal, t);
+        }
+        can_proto_poll(&proto, &drv, hal.time_us);
+        drive_slow_loop(&drv);
+        if (opts->can_io != NULL) {
+          opts->can_io(opts->can_user, &hal, t);
+        }
+      } else {
+        command_references(&drv, sc, t);
+        drive_slow_loop(&drv);
+      }
+      if (opts->realtime) {
+        sleep_s(t - (wall_now() - t_start));
+      }
     }
     /* 1. sample */
     plant_sample(&plant, &adc);
     to_hal_sample(&adc, profile_eval(&sc->encoder_error, t), &sample);
     hal.sample = sample;
-    hal.time_us = (uint32_t)(uint64_t)(t * 1e6);
     /* 2. ISR */
     drive_isr(&drv);
     /* 3. observe */
@@ -127,8 +179,14 @@ int sil_run(const scenario_t *sc, sil_observer_fn obs, void *user, sil_result_t 
   }
   res->wall_time = wall_now() - t_start;
   plant_get_state(&plant, &st);
+  if (k < n) { /* stopped early */
+    n = k;
+  }
   res->steps = n;
   res->sim_time = (double)n * ts;
+  if (can) {
+    res->can = proto.stats;
+  }
   res->real_time_factor = res->wall_time > 0.0 ? res->sim_time / res->wall_time : 0.0;
   res->final_speed = st.omega_m;
   res->final_speed_ref = profile_eval(&sc->ref.speed, res->sim_time);

@@ -64,6 +64,18 @@ ab_t frames_park_inv(dq_t x, sincos_t sc) {
 
 /* Non-finite input gives 0. Constant time (no loops). */
 float frames_wrap_pi(float theta) {
+  /* Fast paths: nearly every caller is within one turn of the range. */
+  if (theta >= -FRAMES_PI && theta < FRAMES_PI) {
+    return theta;
+  }
+  if (theta >= FRAMES_PI && theta < 3.0f * FRAMES_PI) {
+    float r = theta - FRAMES_2PI;
+    return r < FRAMES_PI ? r : -FRAMES_PI;
+  }
+  if (theta < -FRAMES_PI && theta >= -3.0f * FRAMES_PI) {
+    float r = theta + FRAMES_2PI;
+    return r >= -FRAMES_PI ? r : -FRAMES_PI;
+  }
   if (!isfinite(theta)) {
     return 0.0f;
   }

@@ -15,9 +15,13 @@
 #include "drive.h"
 #include "sil_test_util.h"
 
+/* Current noise on, DC-link voltage noise off: the trip is exact on the
+ * measured sample in any case; comparing it with the true crossing within
+ * one ISR needs the measurement to differ from the truth by less than one
+ * ISR of ramp (here only the ADC rounding: +-0.076 V, 0.9 ISR at 1400 V/s). */
 #define BASE                                                                                       \
-  "\"machine\": {\"preset\": \"rubino2020_spm\"}, \"sensors\": {\"i_noise\": 0.005, "              \
-  "\"v_noise\": 0.2}, \"log\": {\"decimation\": 1}, "
+  "\"machine\": {\"preset\": \"rubino2020_spm\"}, \"sensors\": {\"i_noise\": 0.005}, "             \
+  "\"log\": {\"decimation\": 1}, "
 
 /* Common checks: trip index, gates off from the trip on, cause latched. */
 static size_t check_trip(const trace_t *tr, const double *meas, double thr, uint32_t bit,
@@ -53,6 +57,7 @@ static void overvoltage(void **state) {
   size_t k =
       check_trip(&tr, tr.v_dc_meas, sc.drive.v_dc_max, DRIVE_FAULT_OVERVOLTAGE, "overvoltage");
   size_t k_true = first_above(tr.v_dc, tr.n, sc.drive.v_dc_max);
+  printf("overvoltage: true crossing at ISR %zu\n", k_true);
   assert_true(k + 1 >= k_true && k <= k_true + 1);
   trace_free(&tr);
 }

@@ -1,0 +1,218 @@
+"""A small Python API to one fluxdrive over CAN (python-can).
+
+Example (SIL: ``fluxdrive-sil sil/scenarios/can_demo.json --can socketcand:29536 --realtime``)::
+
+    from fluxdrive.can import Drive
+
+    with Drive("vcan0", "socketcand", node=1, port=29536) as drv:
+        drv.set_mode("speed")
+        drv.enable()
+        drv.set_speed(600.0)                      # rpm, acknowledged
+        drv.wait_for(lambda v: abs(v["speed_rpm"] - 600) < 6, timeout=5)
+        print(drv.read_telemetry())               # {"speed_rpm": ..., "torque_est": ...}
+        drv.set_param("speed_bw", 40.0)           # written, read back
+        drv.disable()
+
+Every command waits for the drive's REPLY and raises :class:`DriveError`
+(naming the rejected signal) unless it is ``ok``. The drive stops on its
+own (command timeout) when nothing arrives for ``can_timeout_ms`` while it
+runs: send commands or call :meth:`Drive.heartbeat` to keep it alive.
+"""
+
+from __future__ import annotations
+
+import queue
+import threading
+import time
+from typing import Any, Callable
+
+import can
+
+from fluxdrive.can.protocol import Protocol, Reply
+from fluxdrive.errors import FluxdriveError
+
+TELEMETRY = ("TM_SPEED", "TM_TORQUE", "TM_PHASE", "TM_DQ", "TM_FLUX")
+MODES = {"torque": 0, "speed": 1, "current": 2}
+LAWS = {"foc": 0, "pi_dfvc": 1, "db_dfvc": 2}
+KEEP_ENABLE, KEEP_MODE, KEEP_LAW = 2, 3, 3
+
+
+class DriveError(FluxdriveError):
+    """The drive rejected a request (``reply.result``, ``reply.signal``) or did not answer."""
+
+    def __init__(self, message: str, reply: Reply | None = None) -> None:
+        super().__init__(message, exit_code=1)
+        self.reply = reply
+
+
+def open_bus(channel: str = "vcan0", interface: str = "socketcand", host: str = "127.0.0.1",
+             port: int = 29536, **kwargs: Any) -> can.BusABC:
+    """A python-can bus; host and port are used by the socketcand interface only."""
+    if interface == "socketcand":
+        kwargs.setdefault("tcp_tune", True)
+        return can.Bus(channel=channel, interface=interface, host=host, port=port, **kwargs)
+    return can.Bus(channel=channel, interface=interface, **kwargs)
+
+
+class Drive:
+    """One drive (node) on a CAN bus."""
+
+    def __init__(self, channel: str = "vcan0", interface: str = "socketcand", node: int = 1, *,
+                 host: str = "127.0.0.1", port: int = 29536, bus: can.BusABC | None = None,
+                 reply_timeout: float = 1.0) -> None:
+        self.proto = Protocol(node)
+        self.bus = bus if bus is not None else open_bus(channel, interface, host, port)
+        self._own_bus = bus is None
+        self.reply_timeout = reply_timeout
+        self._replies: queue.Queue[Reply] = queue.Queue()
+        self._cond = threading.Condition()
+        self._values: dict[str, float] = {}
+        self._stamp: dict[str, float] = {}  # message name -> arrival (local clock)
+        self._frame_time: dict[str, float] = {}  # message name -> frame timestamp
+        self._req_lock = threading.Lock()
+        self._hb_task: can.broadcastmanager.CyclicSendTaskABC | None = None
+        self._hb_count = 0
+        self.notifier = can.Notifier(self.bus, [self._on_frame], timeout=0.02)
+
+    # --------------------------------------------------------- plumbing
+    def _on_frame(self, frame: can.Message) -> None:
+        d = self.proto.decode(frame)
+        if d is None:
+            return
+        name, sigs = d
+        if name == "REPLY":
+            r = self.proto.reply(frame)
+            if r is not None:
+                self._replies.put(r)
+            return
+        with self._cond:
+            self._values.update({k: float(v) for k, v in sigs.items()})
+            self._stamp[name] = time.monotonic()
+            self._frame_time[name] = float(frame.timestamp)
+            self._cond.notify_all()
+
+    def request(self, message: str, check: bool = True, **signals: Any) -> Reply:
+        """Sends a CMD_* or PARAM_REQ frame and returns the drive's REPLY."""
+        frame = self.proto.encode(message, **signals)
+        param = signals.get("param_id")
+        with self._req_lock:
+            while not self._replies.empty():  # stale answers
+                self._replies.get_nowait()
+            self.bus.send(frame)
+            deadline = time.monotonic() + self.reply_timeout
+            while True:
+                left = deadline - time.monotonic()
+                try:
+                    r = self._replies.get(timeout=max(left, 0.0))
+                except queue.Empty:
+                    raise DriveError(f"no reply to {message} from node {self.proto.node} "
+                                     f"within {self.reply_timeout} s") from None
+                if r.req == message and (param is None or r.param in (param, self.proto.param_names.get(param))):
+                    break
+        if check and not r.ok:
+            what = f" ({r.signal})" if r.signal != "none" else ""
+            raise DriveError(f"{message} rejected: {r.result}{what}", r)
+        return r
+
+    # --------------------------------------------------------- commands
+    def enable(self) -> Reply:
+        return self.request("CMD_STATE", enable=1, clear_fault=0, mode=KEEP_MODE, law=KEEP_LAW)
+
+    def disable(self) -> Reply:
+        return self.request("CMD_STATE", enable=0, clear_fault=0, mode=KEEP_MODE, law=KEEP_LAW)
+
+    def clear_fault(self) -> Reply:
+        return self.request("CMD_STATE", enable=KEEP_ENABLE, clear_fault=1, mode=KEEP_MODE, law=KEEP_LAW)
+
+    def set_mode(self, mode: str) -> Reply:
+        return self.request("CMD_STATE", enable=KEEP_ENABLE, clear_fault=0, mode=MODES[mode], law=KEEP_LAW)
+
+    def set_law(self, law: str) -> Reply:
+        return self.request("CMD_STATE", enable=KEEP_ENABLE, clear_fault=0, mode=KEEP_MODE, law=LAWS[law])
+
+    def set_torque(self, torque: float) -> Reply:
+        """Torque reference [N m]."""
+        return self.request("CMD_TORQUE", cmd_torque=torque)
+
+    def set_speed(self, rpm: float) -> Reply:
+        """Speed reference [rpm]."""
+        return self.request("CMD_SPEED", cmd_speed_rpm=rpm)
+
+    def set_current(self, i_d: float, i_q: float) -> Reply:
+        return self.request("CMD_CURRENT", cmd_id=i_d, cmd_iq=i_q)
+
+    def set_flux(self, flux: float) -> Reply:
+        """Stator flux reference [Vs], 0 = automatic."""
+        return self.request("CMD_FLUX", cmd_flux=flux)
+
+    def get_param(self, name: str | int) -> float:
+        pid = self.proto.param_id(name)
+        return self.request("PARAM_REQ", param_op=0, param_id=pid, param_value=0.0).value
+
+    def set_param(self, name: str | int, value: float) -> float:
+        """Writes a parameter; returns the value read back in the acknowledge."""
+        pid = self.proto.param_id(name)
+        return self.request("PARAM_REQ", param_op=1, param_id=pid, param_value=float(value)).value
+
+    def heartbeat(self, period: float | None = 0.1) -> None:
+        """Sends HOST_HB every `period` s (None or 0: stop), keeping the command timeout away."""
+        if self._hb_task is not None:
+            self._hb_task.stop()
+            self._hb_task = None
+        if period:
+            self._hb_task = self.bus.send_periodic(self.proto.encode("HOST_HB", host_hb_count=0), period)
+
+    # -------------------------------------------------------- telemetry
+    def values(self) -> dict[str, float]:
+        """The latest value of every signal received so far."""
+        with self._cond:
+            return dict(self._values)
+
+    def frame_time(self, message: str) -> float | None:
+        """Timestamp of the latest frame of `message` (the SIL: simulated time)."""
+        with self._cond:
+            return self._frame_time.get(message)
+
+    def read_telemetry(self, timeout: float = 1.0, messages: tuple[str, ...] = TELEMETRY) -> dict[str, float]:
+        """Waits for a fresh frame of each telemetry message; returns all latest values."""
+        t0 = time.monotonic()
+        with self._cond:
+            ok = self._cond.wait_for(lambda: all(self._stamp.get(m, -1.0) >= t0 for m in messages), timeout)
+            if not ok:
+                missing = [m for m in messages if self._stamp.get(m, -1.0) < t0]
+                raise DriveError(f"no telemetry ({', '.join(missing)}) within {timeout} s")
+            return dict(self._values)
+
+    def status(self, timeout: float = 1.0) -> dict[str, Any]:
+        """The latest STATUS, decoded (state and law by name)."""
+        v = self.read_telemetry(timeout, ("STATUS",))
+        st = {k: v[k] for k in ("state", "ctrl_mode", "ctrl_law", "faults", "v_dc", "timeout_ramp",
+                                "cmd_enabled", "err_count")}
+        names = {0: "idle", 1: "offset_cal", 2: "run", 3: "fault"}
+        st["state_name"] = names.get(int(st["state"]), str(st["state"]))
+        return st
+
+    def wait_for(self, predicate: Callable[[dict[str, float]], bool], timeout: float = 5.0) -> dict[str, float]:
+        """Waits until predicate(latest values) holds; returns the values."""
+        with self._cond:
+            def check() -> bool:
+                try:
+                    return bool(predicate(self._values))
+                except KeyError:
+                    return False
+            if not self._cond.wait_for(check, timeout):
+                raise DriveError(f"condition not met within {timeout} s (values: {self._values})")
+            return dict(self._values)
+
+    # ------------------------------------------------------------ close
+    def close(self) -> None:
+        self.heartbeat(None)
+        self.notifier.stop()
+        if self._own_bus:
+            self.bus.shutdown()
+
+    def __enter__(self) -> "Drive":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

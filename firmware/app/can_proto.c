@@ -164,6 +164,24 @@ static void handle_param(can_proto_t *p, drive_t *drv, const uint8_t *d, reply_t
   }
 }
 
+/* What REPLY.reply_value reports for a CMD_* message. */
+static float value_in_force(const drive_t *drv, can_msg_t m) {
+  switch (m) {
+  case CAN_MSG_CMD_STATE:
+    return drv->cmd.enable ? 1.0f : 0.0f;
+  case CAN_MSG_CMD_TORQUE:
+    return drv->cmd.torque;
+  case CAN_MSG_CMD_SPEED:
+    return drv->cmd.speed * RPM_PER_RADS;
+  case CAN_MSG_CMD_CURRENT:
+    return drv->cmd.id;
+  case CAN_MSG_CMD_FLUX:
+    return drv->cmd.flux;
+  default:
+    return 0.0f;
+  }
+}
+
 /* Applies a CMD_* frame (DLC and DBC ranges already checked). */
 static void handle_cmd(const can_proto_t *p, drive_t *drv, can_msg_t m, const uint8_t *d,
                        reply_t *r) {
@@ -187,7 +205,7 @@ static void handle_cmd(const can_proto_t *p, drive_t *drv, can_msg_t m, const ui
         drive_cmd_enable(drv, en == 1u);
       }
     }
-    r->value = drv->cmd.enable ? 1.0f : 0.0f;
+    r->value = value_in_force(drv, m);
     return;
   }
   case CAN_MSG_CMD_TORQUE: {
@@ -197,7 +215,7 @@ static void handle_cmd(const can_proto_t *p, drive_t *drv, can_msg_t m, const ui
     } else if (!p->ramp) {
       drive_cmd_torque(drv, t);
     }
-    r->value = drv->cmd.torque;
+    r->value = value_in_force(drv, m);
     return;
   }
   case CAN_MSG_CMD_SPEED: {
@@ -207,7 +225,7 @@ static void handle_cmd(const can_proto_t *p, drive_t *drv, can_msg_t m, const ui
     } else if (!p->ramp) {
       drive_cmd_speed(drv, rpm / RPM_PER_RADS);
     }
-    r->value = drv->cmd.speed * RPM_PER_RADS;
+    r->value = value_in_force(drv, m);
     return;
   }
   case CAN_MSG_CMD_CURRENT: {
@@ -220,7 +238,7 @@ static void handle_cmd(const can_proto_t *p, drive_t *drv, can_msg_t m, const ui
     } else if (!p->ramp) {
       drive_cmd_current(drv, id, iq);
     }
-    r->value = drv->cmd.id;
+    r->value = value_in_force(drv, m);
     return;
   }
   case CAN_MSG_CMD_FLUX:
@@ -228,7 +246,7 @@ static void handle_cmd(const can_proto_t *p, drive_t *drv, can_msg_t m, const ui
     if (!p->ramp) {
       drive_cmd_flux(drv, can_codec_get(CAN_SIG_CMD_FLUX, d));
     }
-    r->value = drv->cmd.flux;
+    r->value = value_in_force(drv, m);
     return;
   }
 }
@@ -266,6 +284,7 @@ static bool handle_frame(can_proto_t *p, drive_t *drv, const hal_can_frame_t *f,
     can_sig_t bad = first_out_of_range(m, f->data);
     if (bad != NO_SIGNAL) {
       reply_error(&r, CAN_RESULT_OUT_OF_RANGE, bad);
+      r.value = value_in_force(drv, m);
     } else if (m == CAN_MSG_PARAM_REQ) {
       handle_param(p, drv, f->data, &r);
     } else {

@@ -195,6 +195,29 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--figures", metavar="DIR", help="figures (default: docs/figures)")
     p.add_argument("--doc", metavar="MD", help="markdown file whose results table is replaced")
     p.set_defaults(func=_cmd_rubino)
+
+    p = sub.add_parser("pil", help="PIL: replay a scenario's ISRs on QEMU, compare, count")
+    p.add_argument("scenario", nargs="+", metavar="SCENARIO", help="scenario JSON file(s)")
+    p.add_argument("--law", metavar="LAWS", help="foc,pi_dfvc,db_dfvc (default: the scenario's)")
+    p.add_argument("--isrs", type=_positive_int, default=3000, metavar="N",
+                   help="ISRs traced for the instruction counts (default 3000)")
+    p.add_argument("--sil", metavar="PATH", help=sil_help)
+    p.add_argument("--elf", metavar="PATH", help="PIL image (default: $FLUXDRIVE_PIL_ELF, else "
+                   "build/cortex-m4f/pil/fluxdrive-pil.elf)")
+    p.add_argument("--out", metavar="DIR", help="work directory (default: out/pil)")
+    p.add_argument("--markdown", metavar="MD", help="write the report section into MD "
+                   "(e.g. docs/benchmarks.md)")
+    p.add_argument("--check-worst", type=_positive_int, metavar="N",
+                   help="fail when the DB-DFVC worst case reaches N instructions")
+    p.add_argument("--cpi", type=float, default=1.2, help="cycles per instruction for the "
+                   "budget column (default 1.2)")
+    p.add_argument("--free-running", action="store_true",
+                   help="do not force the applied voltage (docs/pil.md)")
+    p.add_argument("--timeout", type=float, default=600.0, help="per QEMU run [s]")
+    p.set_defaults(func=lambda a: __import__("fluxdrive.pil").pil.main(a))
+    from fluxdrive.can.cli import add_parser as add_can_parser  # fluxdrive can ...
+
+    add_can_parser(sub)
     return parser
 
 

@@ -1,0 +1,406 @@
+/*
+ * test_codec_proto.c - the CAN protocol on the SIL HAL: replies, bad DLC,
+ * out-of-range values naming the signal, unknown identifiers, parameters,
+ * the bounded receive (floods), lossless replies, and the command timeout
+ * (ramp, then fault) timed to one slow period.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "can_codec.h"
+#include "can_proto.h"
+#include "drive.h"
+#include "drive_params.h"
+#include "hal_sil.h"
+
+typedef struct {
+  hal_sil_t hal;
+  drive_t drv;
+  can_proto_t p;
+  can_proto_cfg_t pc;
+  uint64_t k; /* ISR count */
+} rig_t;
+
+static rig_t rig; /* large: off the stack */
+
+static void rig_init(void) {
+  memset(&rig, 0, sizeof rig);
+  hal_sil_init(&rig.hal);
+  hal_sil_bind(&rig.hal);
+  drive_config_t cfg;
+  drive_config_default(&cfg);
+  cfg.mode = DRIVE_MODE_SPEED;
+  assert_int_equal(drive_init(&rig.drv, &cfg, NULL), 0);
+  can_proto_cfg_default(&rig.pc);
+  rig.pc.node = 3;
+  assert_int_equal(can_proto_init(&rig.p, &rig.pc), 0);
+  rig.hal.sample.v_dc = 310.0f;
+  rig.hal.sample.enc_valid = true;
+}
+
+/* One slow period: protocol + slow loop, then slow_div ISRs. */
+static void slow_tick(void) {
+  rig.hal.time_us = (uint32_t)(rig.k * 1000000ull / 16000ull);
+  can_proto_poll(&rig.p, &rig.drv, rig.hal.time_us);
+  drive_slow_loop(&rig.drv);
+  for (unsigned i = 0; i < rig.drv.cfg.slow_div; ++i) {
+    drive_isr(&rig.drv);
+    rig.k++;
+  }
+}
+
+static void push(can_msg_t m, uint8_t dlc, const uint8_t data[8]) {
+  hal_can_frame_t f = {0};
+  f.id = can_codec_id(m, 3);
+  f.dlc = dlc;
+  memcpy(f.data, data, 8);
+  assert_true(hal_sil_can_push(&rig.hal.can_rx, &f));
+}
+
+static void push_speed(float rpm) {
+  uint8_t d[8] = {0};
+  can_codec_set(CAN_SIG_CMD_SPEED_RPM, d, rpm);
+  push(CAN_MSG_CMD_SPEED, 4, d);
+}
+
+static void push_state(unsigned en, unsigned clear, unsigned mode, unsigned law) {
+  uint8_t d[8] = {0};
+  can_codec_set_raw(CAN_SIG_ENABLE, d, en);
+  can_codec_set_raw(CAN_SIG_CLEAR_FAULT, d, clear);
+  can_codec_set_raw(CAN_SIG_MODE, d, mode);
+  can_codec_set_raw(CAN_SIG_LAW, d, law);
+  push(CAN_MSG_CMD_STATE, 4, d);
+}
+
+static void push_param(unsigned op, unsigned id, float v) {
+  uint8_t d[8] = {0};
+  can_codec_set_raw(CAN_SIG_PARAM_OP, d, op);
+  can_codec_set_raw(CAN_SIG_PARAM_ID, d, id);
+  can_codec_set(CAN_SIG_PARAM_VALUE, d, v);
+  push(CAN_MSG_PARAM_REQ, 8, d);
+}
+
+typedef struct {
+  unsigned req, result, signal, param;
+  float value;
+} reply_t;
+
+/* Pops TX frames; returns the replies (at most max) and counts others. */
+static unsigned pop_replies(reply_t *r, unsigned max, unsigned *status_n) {
+  hal_can_frame_t f;
+  unsigned n = 0;
+  while (hal_sil_can_pop(&rig.hal.can_tx, &f)) {
+    assert_false(f.extended);
+    if (f.id == can_codec_id(CAN_MSG_REPLY, 3)) {
+      assert_int_equal(f.dlc, 8);
+      assert_true(n < max);
+      r[n].req = can_codec_get_raw(CAN_SIG_REPLY_REQ, f.data);
+      r[n].result = can_codec_get_raw(CAN_SIG_REPLY_RESULT, f.data);
+      r[n].signal = can_codec_get_raw(CAN_SIG_REPLY_SIGNAL, f.data);
+      r[n].param = can_codec_get_raw(CAN_SIG_REPLY_PARAM, f.data);
+      r[n].value = can_codec_get(CAN_SIG_REPLY_VALUE, f.data);
+      n++;
+    } else if (f.id == can_codec_id(CAN_MSG_STATUS, 3) && status_n != NULL) {
+      (*status_n)++;
+    }
+  }
+  return n;
+}
+
+static void test_unknown_and_other_nodes_ignored(void **state) {
+  (void)state;
+  rig_init();
+  uint8_t d[8] = {0};
+  can_codec_set(CAN_SIG_CMD_SPEED_RPM, d, 100.0f);
+  hal_can_frame_t f = {0};
+  memcpy(f.data, d, 8);
+  f.dlc = 4;
+  f.id = can_codec_id(CAN_MSG_CMD_SPEED, 2); /* another node */
+  hal_sil_can_push(&rig.hal.can_rx, &f);
+  f.id = 0x7FF;
+  hal_sil_can_push(&rig.hal.can_rx, &f);
+  f.id = can_codec_id(CAN_MSG_CMD_SPEED, 3);
+  f.extended = true;
+  hal_sil_can_push(&rig.hal.can_rx, &f);
+  f.extended = false;
+  f.id = can_codec_id(CAN_MSG_TM_SPEED, 3); /* a drive->host message */
+  hal_sil_can_push(&rig.hal.can_rx, &f);
+  slow_tick();
+  reply_t r[4];
+  assert_int_equal(pop_replies(r, 4, NULL), 0);
+  assert_int_equal(rig.p.stats.rx_ignored, 4);
+  assert_true(rig.drv.cmd.speed == 0.0f);
+}
+
+static void test_bad_dlc_rejected(void **state) {
+  (void)state;
+  rig_init();
+  push_speed(100.0f);
+  slow_tick();
+  uint8_t d[8] = {0};
+  can_codec_set(CAN_SIG_CMD_SPEED_RPM, d, 200.0f);
+  push(CAN_MSG_CMD_SPEED, 8, d);
+  push(CAN_MSG_CMD_SPEED, 3, d);
+  push(CAN_MSG_PARAM_REQ, 0, d);
+  slow_tick();
+  reply_t r[8];
+  unsigned n = pop_replies(r, 8, NULL);
+  assert_int_equal(n, 4);
+  assert_int_equal(r[0].result, CAN_RESULT_OK);
+  for (unsigned i = 1; i < 4; ++i) {
+    assert_int_equal(r[i].result, CAN_RESULT_BAD_DLC);
+    assert_int_equal(r[i].signal, 0);
+  }
+  assert_int_equal(r[1].req, CAN_MSG_CMD_SPEED);
+  assert_int_equal(r[3].req, CAN_MSG_PARAM_REQ);
+  assert_float_equal(r[1].value, 0.0f, 1e-6f);
+  /* the reference in force stays */
+  assert_float_equal(rig.drv.cmd.speed * 9.54929659f, 100.0f, 1e-3f);
+}
+
+static void test_out_of_range_names_signal(void **state) {
+  (void)state;
+  rig_init();
+  push_speed(150.0f);
+  push_speed(1300.0f); /* above speed_max (1200 rpm) */
+  uint8_t d[8] = {0};
+  can_codec_set_raw(CAN_SIG_CMD_SPEED_RPM, d, (uint32_t)(int32_t)-20000001); /* beyond the DBC */
+  push(CAN_MSG_CMD_SPEED, 4, d);
+  push_state(1, 0, 7, 3); /* mode 7: outside the DBC range 0..3 */
+  memset(d, 0, sizeof d);
+  can_codec_set(CAN_SIG_CMD_TORQUE, d, 25.0f); /* above torque_max (20 N m) */
+  push(CAN_MSG_CMD_TORQUE, 4, d);
+  slow_tick();
+  reply_t r[8];
+  assert_int_equal(pop_replies(r, 8, NULL), 5);
+  assert_int_equal(r[0].result, CAN_RESULT_OK);
+  assert_float_equal(r[0].value, 150.0f, 1e-3f);
+  for (unsigned i = 1; i < 3; ++i) {
+    assert_int_equal(r[i].result, CAN_RESULT_OUT_OF_RANGE);
+    assert_int_equal(r[i].signal, CAN_SIG_CMD_SPEED_RPM + 1);
+    assert_float_equal(r[i].value, 150.0f, 1e-3f); /* the reference in force */
+  }
+  assert_int_equal(r[3].result, CAN_RESULT_OUT_OF_RANGE);
+  assert_int_equal(r[3].signal, CAN_SIG_MODE + 1);
+  assert_false(rig.drv.cmd.enable); /* nothing of the bad frame applied */
+  assert_int_equal(r[4].signal, CAN_SIG_CMD_TORQUE + 1);
+  assert_float_equal(rig.drv.cmd.speed * 9.54929659f, 150.0f, 1e-3f);
+  assert_true(rig.drv.cmd.torque == 0.0f);
+  assert_int_equal(rig.p.stats.rx_errors, 4);
+  assert_int_equal(rig.p.stats.rx_ok, 1);
+}
+
+static void test_params(void **state) {
+  (void)state;
+  rig_init();
+  push_param(0, 31, 0.0f);   /* get speed_bw */
+  push_param(1, 31, 40.0f);  /* set speed_bw */
+  push_param(1, 10, 50.0f);  /* i_max 50 A > i_trip: inconsistent */
+  push_param(1, 200, 1.0f);  /* unknown */
+  push_param(1, 40, 1e-4f);  /* ts: read only */
+  push_param(1, 2, -1.0f);   /* rs < 0: out of range */
+  push_param(1, 65, 250.0f); /* can_timeout_ms */
+  push_param(0, 64, 0.0f);   /* can_node */
+  slow_tick();
+  reply_t r[8];
+  assert_int_equal(pop_replies(r, 8, NULL), 8);
+  assert_int_equal(r[0].result, CAN_RESULT_OK);
+  assert_float_equal(r[0].value, 60.0f, 1e-6f);
+  assert_int_equal(r[1].result, CAN_RESULT_OK);
+  assert_float_equal(r[1].value, 40.0f, 1e-6f);
+  assert_float_equal(rig.drv.cfg.speed_bw, 40.0f, 1e-6f);
+  assert_float_equal(rig.drv.speed.cfg.kp, rig.drv.cfg.inertia * 40.0f, 1e-6f);
+  assert_int_equal(r[2].result, CAN_RESULT_INCONSISTENT);
+  assert_int_equal(r[2].param, 10);
+  assert_int_equal(r[2].signal, CAN_SIG_PARAM_VALUE + 1);
+  assert_float_equal(r[2].value, rig.drv.cfg.i_max, 1e-6f); /* unchanged */
+  assert_int_equal(r[3].result, CAN_RESULT_UNKNOWN_PARAM);
+  assert_int_equal(r[3].signal, CAN_SIG_PARAM_ID + 1);
+  assert_int_equal(r[4].result, CAN_RESULT_READ_ONLY);
+  assert_int_equal(r[5].result, CAN_RESULT_OUT_OF_RANGE);
+  assert_int_equal(r[6].result, CAN_RESULT_OK);
+  assert_int_equal(rig.p.cfg.timeout_ms, 250);
+  assert_float_equal(r[7].value, 3.0f, 1e-6f);
+}
+
+static void run_until_state(drive_state_t st, unsigned max_ticks) {
+  for (unsigned i = 0; i < max_ticks && rig.drv.state != st; ++i) {
+    push_param(0, 31, 0.0f); /* keeps the host alive */
+    slow_tick();
+  }
+  assert_int_equal(rig.drv.state, st);
+}
+
+static void test_idle_only_params_refused_while_running(void **state) {
+  (void)state;
+  rig_init();
+  push_state(1, 0, 3, 3);
+  run_until_state(DRIVE_STATE_RUN, 100);
+  reply_t r[64];
+  pop_replies(r, 64, NULL);
+  push_param(1, 2, 8.0f);   /* rs: idle only */
+  push_param(1, 11, 10.0f); /* torque_max: live */
+  slow_tick();
+  assert_int_equal(pop_replies(r, 64, NULL), 2);
+  assert_int_equal(r[0].result, CAN_RESULT_NOT_WHILE_RUNNING);
+  assert_float_equal(rig.drv.cfg.rs, 7.1f, 1e-6f);
+  assert_int_equal(r[1].result, CAN_RESULT_OK);
+  assert_float_equal(rig.drv.speed.cfg.torque_max, 10.0f, 1e-6f);
+  assert_int_equal(rig.drv.state, DRIVE_STATE_RUN);
+}
+
+static void test_flood_bounded_per_poll(void **state) {
+  (void)state;
+  rig_init();
+  for (unsigned i = 0; i < 200; ++i) {
+    push_speed(10.0f);
+  }
+  rig.hal.time_us = 0;
+  can_proto_poll(&rig.p, &rig.drv, 0);
+  assert_int_equal(rig.p.stats.rx_frames, CAN_PROTO_RX_MAX);
+  assert_int_equal(rig.hal.can_rx.head - rig.hal.can_rx.tail, 200 - CAN_PROTO_RX_MAX);
+}
+
+static void test_replies_never_lost_on_full_tx(void **state) {
+  (void)state;
+  rig_init();
+  hal_can_frame_t junk = {0};
+  while (hal_sil_can_push(&rig.hal.can_tx, &junk)) {
+  }
+  for (unsigned i = 0; i < 40; ++i) {
+    push_speed((float)i);
+  }
+  unsigned replies = 0;
+  reply_t r[64];
+  for (unsigned t = 0; t < 400 && replies < 40; ++t) {
+    slow_tick();
+    hal_can_frame_t f;
+    /* the host reads a few frames per period */
+    for (unsigned j = 0; j < 16 && hal_sil_can_pop(&rig.hal.can_tx, &f); ++j) {
+      if (f.id == can_codec_id(CAN_MSG_REPLY, 3)) {
+        replies++;
+      }
+    }
+    if (rig.hal.can_tx.head - rig.hal.can_tx.tail < HAL_SIL_CAN_QUEUE / 2) {
+      replies += pop_replies(r, 64, NULL);
+    }
+  }
+  assert_int_equal(replies, 40);
+  assert_int_equal(rig.p.stats.rx_ok, 40);
+  assert_float_equal(rig.drv.cmd.speed * 9.54929659f, 39.0f, 1e-3f);
+}
+
+/* Silence while running: ramp at timeout_ms, fault at timeout_ms + ramp_ms,
+ * both to one slow period. */
+static void test_command_timeout(void **state) {
+  (void)state;
+  rig_init();
+  rig.p.cfg.timeout_ms = 300;
+  rig.p.cfg.ramp_ms = 100;
+  push_state(1, 0, 0, 3); /* enable, torque mode */
+  uint8_t d[8] = {0};
+  can_codec_set(CAN_SIG_CMD_TORQUE, d, 4.0f);
+  push(CAN_MSG_CMD_TORQUE, 4, d);
+  run_until_state(DRIVE_STATE_RUN, 100);
+  for (unsigned i = 0; i < 20; ++i) {
+    push_param(0, 31, 0.0f);
+    slow_tick();
+  }
+  assert_float_equal(rig.drv.tm.torque_ref, 4.0f, 1e-6f);
+  reply_t r[256];
+  pop_replies(r, 256, NULL);
+  const uint32_t last = rig.p.last_rx_us;
+  uint32_t t_ramp = 0, t_fault = 0;
+  float prev_torque = 4.0f;
+  for (unsigned i = 0; i < 1000 && t_fault == 0u; ++i) {
+    slow_tick();
+    if (rig.p.ramp && t_ramp == 0u) {
+      t_ramp = rig.hal.time_us;
+    }
+    if (t_ramp != 0u && rig.drv.state == DRIVE_STATE_RUN) {
+      assert_true(rig.drv.tm.torque_ref <= prev_torque + 1e-6f);
+      prev_torque = rig.drv.tm.torque_ref;
+    }
+    if (rig.drv.state == DRIVE_STATE_FAULT) {
+      t_fault = rig.hal.time_us;
+    }
+  }
+  assert_true(t_ramp > 0u && t_fault > 0u);
+  assert_true(abs((int)(t_ramp - last) - 300000) <= 1000);
+  assert_true(abs((int)(t_fault - last) - 400000) <= 1000);
+  assert_true(prev_torque < 0.1f); /* ramped down before the gates went off */
+  assert_int_equal(rig.drv.faults, DRIVE_FAULT_CMD_TIMEOUT);
+  assert_false(rig.hal.gates_on);
+  assert_int_equal(rig.p.stats.timeouts, 1);
+  /* STATUS was sent at once on the ramp and on the fault */
+  unsigned status_n = 0;
+  pop_replies(r, 256, &status_n);
+  assert_true(status_n >= 2);
+  /* clear + enable restarts from rest in the previous mode */
+  push_state(2, 1, 3, 3);
+  slow_tick();
+  assert_int_equal(rig.drv.state, DRIVE_STATE_IDLE);
+  assert_true(rig.drv.cmd.torque == 0.0f);
+  assert_int_equal(rig.drv.cmd.mode, DRIVE_MODE_TORQUE);
+}
+
+static void test_no_timeout_when_idle_or_off(void **state) {
+  (void)state;
+  rig_init();
+  for (unsigned i = 0; i < 2000; ++i) {
+    slow_tick();
+  }
+  assert_int_equal(rig.drv.state, DRIVE_STATE_IDLE);
+  assert_int_equal(rig.p.stats.timeouts, 0);
+  rig_init();
+  rig.p.cfg.timeout_ms = 0;
+  push_state(1, 0, 3, 3);
+  for (unsigned i = 0; i < 2000; ++i) {
+    slow_tick();
+  }
+  assert_int_equal(rig.drv.state, DRIVE_STATE_RUN);
+}
+
+static void test_telemetry_rates(void **state) {
+  (void)state;
+  rig_init();
+  rig.p.cfg.period_ms[CAN_PERIOD_TM_SPEED] = 5;
+  rig.p.cfg.period_ms[CAN_PERIOD_TM_FLUX] = 0;
+  unsigned n_speed = 0, n_flux = 0, n_hb = 0;
+  for (unsigned i = 0; i < 1000; ++i) {
+    slow_tick();
+    hal_can_frame_t f;
+    while (hal_sil_can_pop(&rig.hal.can_tx, &f)) {
+      n_speed += f.id == can_codec_id(CAN_MSG_TM_SPEED, 3);
+      n_flux += f.id == can_codec_id(CAN_MSG_TM_FLUX, 3);
+      n_hb += f.id == can_codec_id(CAN_MSG_HEARTBEAT, 3);
+      assert_int_equal(f.dlc, can_codec_msg(can_codec_lookup(f.id, false, 3))->dlc);
+    }
+  }
+  assert_int_equal(n_speed, 200); /* 1 s at 5 ms */
+  assert_int_equal(n_flux, 0);
+  assert_int_equal(n_hb, 2); /* 500 ms */
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_unknown_and_other_nodes_ignored),
+      cmocka_unit_test(test_bad_dlc_rejected),
+      cmocka_unit_test(test_out_of_range_names_signal),
+      cmocka_unit_test(test_params),
+      cmocka_unit_test(test_idle_only_params_refused_while_running),
+      cmocka_unit_test(test_flood_bounded_per_poll),
+      cmocka_unit_test(test_replies_never_lost_on_full_tx),
+      cmocka_unit_test(test_command_timeout),
+      cmocka_unit_test(test_no_timeout_when_idle_or_off),
+      cmocka_unit_test(test_telemetry_rates),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

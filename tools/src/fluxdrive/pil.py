@@ -1,0 +1,498 @@
+"""Processor-in-the-loop replay on QEMU ``mps2-an386`` (docs/pil.md).
+
+Per scenario and control law:
+
+1. ``fluxdrive-sil SCENARIO --record-isr rec.bin`` records every ISR's inputs
+   and the host build's outputs (sil/runner/isr_stream.h).
+2. The PIL image (pil/, Cortex-M4F, the board's fd_core/fd_app objects)
+   replays the whole stream in QEMU; its outputs are compared with the
+   host's: duties within ``DUTY_TOL``, gate state, fault bits and drive
+   state identical.
+3. The first ``isrs`` ISRs are replayed again with ``-singlestep -d
+   exec,nochain``: every executed instruction is one trace line, streamed
+   through a FIFO and counted per ISR (from drive_isr's entry to the first
+   line back in its caller pil_step, callees included) and per function.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import threading
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from fluxdrive import sil
+from fluxdrive.errors import FluxdriveError
+
+ENV_ELF = "FLUXDRIVE_PIL_ELF"
+ELF_RELPATH = Path("build/cortex-m4f/pil/fluxdrive-pil.elf")
+ELF_HINT = (
+    "build it with: cmake --preset cortex-m4f && "
+    "cmake --build build/cortex-m4f --target fluxdrive-pil.elf"
+)
+QEMU = "qemu-system-arm"
+
+#: Absolute tolerance on the duties (0..1). Both builds are IEEE-754 binary32
+#: without contraction (-std=c11 implies -ffp-contract=off on both) and
+#: agree bit for bit except where libm differs: glibc's sinf/cosf/atan2f/asinf
+#: (x86-64) and newlib's fdlibm float versions (Cortex-M4F) differ by 1-2 ulp.
+#: Those differences pass through the laws' gains (deadbeat: ~L/Ts, the
+#: inverse of the discrete model) and the modulator into the duties; with
+#: the applied voltage forced (docs/pil.md) they stay within a few tens of ulp
+#: of 1.0 (measured worst 2.4e-6). 2e-5 = ~170 ulp of 1.0 = 6 mV on 310 V.
+DUTY_TOL = 2e-5
+
+BUDGET_CYCLES = 10625  # 170 MHz / 16 kHz
+RUN = 2  # DRIVE_STATE_RUN
+
+HEADER = np.dtype(
+    [
+        ("magic", "<u4"),
+        ("version", "<u4"),
+        ("header_size", "<u4"),
+        ("config_size", "<u4"),
+        ("in_size", "<u4"),
+        ("out_size", "<u4"),
+        ("count", "<u4"),
+        ("flags", "<u4"),
+    ]
+)
+MAGIC, VERSION, FORCE_APPLIED = 0x52534946, 1, 1
+OUT = np.dtype(
+    [("duty", "<f4", 3), ("flags", "<u4"), ("faults", "<u4"), ("state", "<u4")]
+)
+IN_SIZE = 72
+
+#: Blocks of the per-function share: the first pattern that a function name
+#: starts with (or equals) names its block.
+BLOCKS = [
+    ("drive (ISR body, protections, PLL, offsets)", ("drive_", "angle_pll_")),
+    ("control-law dispatch", ("ctrl_",)),
+    ("DFVC step", ("dfvc_step", "dfvc_reset")),
+    ("flux observer", ("flux_observer_", "flux_obs_")),
+    ("current predictor", ("current_predictor_",)),
+    ("SPM discrete model", ("spm_discrete_",)),
+    ("DFVC references (MTPA/FW/MTPV)", ("dfvc_refs_",)),
+    ("DB-DFVC law", ("dfvc_deadbeat_",)),
+    ("PI-DFVC law", ("dfvc_pi_", "pi_ctrl_")),
+    ("FOC current control", ("current_ctrl_", "pmsm_")),
+    ("modulation", ("modulation_",)),
+    ("dead-time compensation", ("deadtime_comp_",)),
+    ("frames (Clarke/Park, wrap)", ("frames_",)),
+    (
+        "libm sinf/cosf (newlib)",
+        ("sinf", "cosf", "__kernel_sinf", "__kernel_cosf", "__ieee754_rem_pio2f",
+         "__kernel_rem_pio2f"),
+    ),
+    ("libm atan2f/asinf (newlib)", ("atan2f", "atanf", "__ieee754_atan2f", "asinf",
+                                    "__ieee754_asinf")),
+    ("libm sqrtf/powf (newlib)", ("sqrtf", "__ieee754_sqrtf", "powf", "__ieee754_powf")),
+    ("libm classify/min/max/floor (newlib)", ("__fpclassifyf", "fmaxf", "fminf", "floorf",
+                                              "fabsf", "scalbnf", "copysignf")),
+    ("libc memset/memcpy", ("memset", "memcpy")),
+    ("PIL replay HAL (stands in for the register HAL)", ("hal_",)),
+]
+
+
+def block_of(func: str) -> str:
+    for name, pats in BLOCKS:
+        for p in pats:
+            if func == p or (p.endswith("_") and func.startswith(p)):
+                return name
+    return "other: " + (func or "?")
+
+
+# ------------------------------------------------------------------ files
+def read_record(path: Path) -> tuple[bytes, np.ndarray, np.ndarray]:
+    """(header+config bytes, input records as raw bytes rows, host outputs)."""
+    data = path.read_bytes()
+    if len(data) < HEADER.itemsize:
+        raise FluxdriveError(f"{path}: too short for an ISR record", exit_code=1)
+    h = np.frombuffer(data, HEADER, count=1)[0]
+    if int(h["magic"]) != MAGIC or int(h["version"]) != VERSION:
+        raise FluxdriveError(f"{path}: not an isr_stream v{VERSION} file", exit_code=1)
+    if int(h["in_size"]) != IN_SIZE or int(h["out_size"]) != OUT.itemsize:
+        raise FluxdriveError(f"{path}: record layout differs from this tool's", exit_code=1)
+    start = int(h["header_size"]) + int(h["config_size"])
+    n = int(h["count"])
+    rec = np.dtype([("in", f"V{IN_SIZE}"), ("out", OUT)])
+    body = np.frombuffer(data, rec, count=n, offset=start)
+    return data[:start], body, body["out"]
+
+
+def write_pil_input(path: Path, head: bytes, body: np.ndarray, n: int, force: bool) -> None:
+    h = np.frombuffer(head, HEADER, count=1).copy()
+    h["count"] = n
+    h["flags"] = FORCE_APPLIED if force else 0
+    with open(path, "wb") as f:
+        f.write(h.tobytes())
+        f.write(head[HEADER.itemsize:])
+        f.write(body[:n].tobytes())
+
+
+# ------------------------------------------------------------------- qemu
+def qemu_argv(elf: Path, trace: Path | None) -> list[str]:
+    argv = [
+        QEMU, "-M", "mps2-an386", "-nographic", "-monitor", "none", "-serial", "none",
+        "-semihosting-config", "enable=on,target=native", "-kernel", str(elf),
+    ]
+    if trace is not None:
+        # -singlestep: one instruction per translation block; -d exec logs
+        # every TB execution, nochain keeps chained TBs from skipping the log.
+        argv += ["-singlestep", "-d", "exec,nochain", "-D", str(trace)]
+    return argv
+
+
+def run_qemu(elf: Path, workdir: Path, timeout: float) -> np.ndarray:
+    out = workdir / "pil_out.bin"
+    out.unlink(missing_ok=True)
+    try:
+        r = subprocess.run(qemu_argv(elf, None), cwd=workdir, capture_output=True,
+                           text=True, timeout=timeout, check=False)
+    except FileNotFoundError:
+        raise FluxdriveError(f"{QEMU} not found", hint="apt-get install qemu-system-arm") from None
+    except subprocess.TimeoutExpired:
+        raise FluxdriveError(f"PIL replay timed out after {timeout:.0f} s", exit_code=1) from None
+    if r.returncode != 0:
+        raise FluxdriveError(
+            f"PIL image failed (exit {r.returncode}): {(r.stdout + r.stderr).strip()}", exit_code=1
+        )
+    return np.fromfile(out, OUT)
+
+
+@dataclass
+class TraceResult:
+    counts: list[int] = field(default_factory=list)  # per ISR, in order
+    funcs: list[dict[str, int]] = field(default_factory=list)  # per ISR
+
+
+def _parse_trace(stream, res: TraceResult) -> None:
+    """Stream parser: line = 'Trace 0: HOSTPTR [cs_base/pc/flags/cflags] SYMBOL'."""
+    in_isr = False
+    prev = b""
+    cur: dict[bytes, int] = {}
+    n = 0
+    for line in stream:
+        j = line.rfind(b"] ")
+        if j < 0:
+            continue
+        s = line[j + 2:-1]
+        if s == b"drive_isr" and prev == b"pil_step":
+            in_isr, cur, n = True, {}, 0
+        elif s == b"pil_step" and in_isr:
+            in_isr = False
+            res.counts.append(n)
+            res.funcs.append({k.decode(): v for k, v in cur.items()})
+        if in_isr:
+            n += 1
+            cur[s] = cur.get(s, 0) + 1
+        prev = s
+
+
+def run_qemu_trace(elf: Path, workdir: Path, timeout: float) -> tuple[TraceResult, np.ndarray]:
+    fifo = workdir / "trace.fifo"
+    fifo.unlink(missing_ok=True)
+    os.mkfifo(fifo)
+    out = workdir / "pil_out.bin"
+    out.unlink(missing_ok=True)
+    res = TraceResult()
+    proc = subprocess.Popen(qemu_argv(elf, fifo), cwd=workdir, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT)
+    err: list[BaseException] = []
+
+    def reader() -> None:
+        try:
+            with open(fifo, "rb", buffering=1 << 22) as f:
+                _parse_trace(f, res)
+        except BaseException as exc:  # pragma: no cover - reported below
+            err.append(exc)
+
+    t = threading.Thread(target=reader, daemon=True)
+    t.start()
+    try:
+        msg, _ = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.communicate()
+        raise FluxdriveError(f"traced PIL replay timed out after {timeout:.0f} s",
+                             exit_code=1) from None
+    finally:
+        t.join(timeout=60)
+        fifo.unlink(missing_ok=True)
+    if proc.returncode != 0:
+        raise FluxdriveError(f"traced PIL image failed (exit {proc.returncode}): "
+                             f"{msg.decode(errors='replace').strip()}", exit_code=1)
+    if err:
+        raise FluxdriveError(f"trace parser failed: {err[0]}", exit_code=1)
+    return res, np.fromfile(out, OUT)
+
+
+# ------------------------------------------------------------- comparison
+@dataclass
+class Agreement:
+    isrs: int
+    max_duty_dev: float
+    max_dev_isr: int
+    duty_bad: int
+    gates_bad: int
+    faults_bad: int
+    state_bad: int
+
+    @property
+    def ok(self) -> bool:
+        return self.duty_bad == 0 and self.gates_bad == 0 and self.faults_bad == 0 and \
+            self.state_bad == 0
+
+
+def compare(host: np.ndarray, pil: np.ndarray) -> Agreement:
+    if len(pil) != len(host):
+        raise FluxdriveError(f"PIL wrote {len(pil)} ISR outputs, expected {len(host)}",
+                             exit_code=1)
+    dev = np.abs(host["duty"].astype(np.float64) - pil["duty"].astype(np.float64)).max(axis=1)
+    dev = np.where(np.isnan(dev), np.inf, dev) if len(dev) else dev
+    k = int(np.argmax(dev)) if len(dev) else 0
+    return Agreement(
+        isrs=len(host),
+        max_duty_dev=float(dev[k]) if len(dev) else 0.0,
+        max_dev_isr=k,
+        duty_bad=int((dev > DUTY_TOL).sum()),
+        gates_bad=int(((host["flags"] ^ pil["flags"]) & 1).sum()),
+        faults_bad=int((host["faults"] != pil["faults"]).sum()),
+        state_bad=int((host["state"] != pil["state"]).sum()),
+    )
+
+
+# ---------------------------------------------------------------- counting
+@dataclass
+class Counts:
+    isrs: int  # ISRs running the law (state RUN before and after)
+    mean: float
+    worst: int
+    worst_isr: int
+    blocks: dict[str, float]  # mean instructions per ISR per block
+    funcs: dict[str, float]
+
+
+def law_counts(tr: TraceResult, host: np.ndarray) -> Counts:
+    n = min(len(tr.counts), len(host))
+    st = host["state"][:n]
+    run = [j for j in range(1, n) if st[j] == RUN and st[j - 1] == RUN]
+    if not run:
+        raise FluxdriveError("no ISR ran the control law in the traced window "
+                             "(raise --isrs beyond the offset calibration)", exit_code=1)
+    c = np.array([tr.counts[j] for j in run])
+    funcs: dict[str, int] = {}
+    for j in run:
+        for f, v in tr.funcs[j].items():
+            funcs[f] = funcs.get(f, 0) + v
+    blocks: dict[str, float] = {}
+    for f, v in funcs.items():
+        b = block_of(f)
+        blocks[b] = blocks.get(b, 0.0) + v / len(run)
+    w = int(np.argmax(c))
+    return Counts(len(run), float(c.mean()), int(c[w]), run[w], blocks,
+                  {f: v / len(run) for f, v in funcs.items()})
+
+
+# ------------------------------------------------------------------- run
+@dataclass
+class PilRun:
+    scenario: str
+    law: str
+    agreement: Agreement
+    counts: Counts
+    trace_exact: bool  # traced replay's outputs == untraced replay's
+
+
+def locate_elf(explicit: str | None) -> Path:
+    if explicit:
+        p = Path(explicit)
+    elif os.environ.get(ENV_ELF):
+        p = Path(os.environ[ENV_ELF])
+    else:
+        root = sil.find_repo_root()
+        if root is None:
+            raise FluxdriveError("cannot find the repo root; pass --elf", hint=ELF_HINT)
+        p = root / ELF_RELPATH
+    if not p.is_file():
+        raise FluxdriveError(f"PIL image not found: {p}", hint=ELF_HINT)
+    return p.resolve()
+
+
+def scenario_with_law(src: Path, law: str | None, dst: Path) -> str:
+    try:
+        sc = json.loads(src.read_text(encoding="utf-8"))
+    except (OSError, json.JSONDecodeError) as exc:
+        raise FluxdriveError(f"{src}: {exc}") from None
+    ctrl = sc.setdefault("controller", {})
+    if law is not None:
+        ctrl["law"] = law
+    dst.write_text(json.dumps(sc, indent=2) + "\n", encoding="utf-8")
+    return str(ctrl.get("law", "foc"))
+
+
+def run_one(runner: Path, elf: Path, scenario: Path, law: str | None, isrs: int,
+            workdir: Path, force: bool, timeout: float) -> PilRun:
+    workdir.mkdir(parents=True, exist_ok=True)
+    scen = workdir / "scenario.json"
+    law_name = scenario_with_law(scenario, law, scen)
+    rec = workdir / "rec.bin"
+    rec.unlink(missing_ok=True)
+    r = sil.run_sil([str(runner), str(scen), "--record-isr", str(rec)])
+    if not r.ok:
+        sil.relay_stderr(r)
+        raise FluxdriveError(f"SIL runner failed (exit {r.returncode})", exit_code=1)
+    head, body, host = read_record(rec)
+
+    write_pil_input(workdir / "pil_in.bin", head, body, len(body), force)
+    pil_out = run_qemu(elf, workdir, timeout)
+    agreement = compare(host, pil_out)
+
+    n = min(isrs, len(body))
+    write_pil_input(workdir / "pil_in.bin", head, body, n, force)
+    tr, traced_out = run_qemu_trace(elf, workdir, timeout)
+    if len(tr.counts) != n:
+        raise FluxdriveError(f"trace shows {len(tr.counts)} ISRs, replayed {n}", exit_code=1)
+    exact = traced_out.tobytes() == pil_out[:n].tobytes()
+    return PilRun(scenario.stem, law_name, agreement, law_counts(tr, host), exact)
+
+
+# ---------------------------------------------------------------- report
+def format_report(runs: list[PilRun], isrs: int, cpi: float) -> str:
+    lines = []
+    for r in runs:
+        a, c = r.agreement, r.counts
+        lines.append(f"== {r.scenario} / {r.law}")
+        lines.append(
+            f"agreement over {a.isrs} ISRs: max |duty dev| {a.max_duty_dev:.3g} at ISR "
+            f"{a.max_dev_isr} (tolerance {DUTY_TOL:g}), {a.duty_bad} duty / {a.gates_bad} gate / "
+            f"{a.faults_bad} fault / {a.state_bad} state mismatches -> "
+            f"{'OK' if a.ok else 'FAIL'}"
+        )
+        lines.append(
+            f"instructions per ISR over {c.isrs} law ISRs (first {isrs} ISRs traced): mean "
+            f"{c.mean:.0f}, worst {c.worst} (ISR {c.worst_isr}); budget {BUDGET_CYCLES} cycles: "
+            f"{100 * c.worst * cpi / BUDGET_CYCLES:.0f} % at {cpi:g} cycles/instruction "
+            f"(worst case); traced outputs identical to untraced: {r.trace_exact}"
+        )
+        for b, v in sorted(c.blocks.items(), key=lambda kv: -kv[1]):
+            lines.append(f"  {v:8.1f}  {100 * v / c.mean:5.1f} %  {b}")
+    return "\n".join(lines)
+
+
+SECTION = "## ISR instruction counts (PIL, QEMU mps2-an386)"
+
+
+def format_markdown(runs: list[PilRun], isrs: int, cpi: float, build: str) -> str:
+    out = [SECTION, ""]
+    out.append(
+        f"Measured by `fluxdrive pil` (docs/pil.md): the ISR inputs of a SIL run replayed on "
+        f"the Cortex-M4F image in QEMU 7.2 `mps2-an386` (`{build}`), executed instructions "
+        f"counted exactly from the `-singlestep -d exec,nochain` trace, from `drive_isr` "
+        f"entry to its return, callees included, over the ISRs that ran the control law "
+        f"within the first {isrs} ISRs of each scenario. These are instructions, not cycles: "
+        f"the budget column assumes {cpi:g} cycles per instruction against "
+        f"{BUDGET_CYCLES} cycles per ISR (170 MHz / 16 kHz)."
+    )
+    out.append("")
+    out.append("| scenario | law | law ISRs | mean | worst | worst x "
+               f"{cpi:g} / {BUDGET_CYCLES} | duties max dev (full run) | ISRs compared |")
+    out.append("|---|---|---:|---:|---:|---:|---:|---:|")
+    for r in runs:
+        c, a = r.counts, r.agreement
+        out.append(
+            f"| {r.scenario} | {r.law} | {c.isrs} | {c.mean:.0f} | {c.worst} | "
+            f"{100 * c.worst * cpi / BUDGET_CYCLES:.0f} % | {a.max_duty_dev:.2g}"
+            f"{'' if a.ok else ' (FAIL)'} | {a.isrs} |"
+        )
+    out.append("")
+    out.append("Share of the mean per block (instructions per ISR, % of the mean):")
+    out.append("")
+    for r in runs:
+        c = r.counts
+        out.append(f"* {r.scenario} / {r.law}: " + "; ".join(
+            f"{b} {v:.0f} ({100 * v / c.mean:.0f} %)"
+            for b, v in sorted(c.blocks.items(), key=lambda kv: -kv[1]) if v >= 0.5))
+    out.append("")
+    return "\n".join(out)
+
+
+def update_markdown(path: Path, section: str) -> None:
+    """Replace our section (from its heading to the next '## ' heading) or
+    append it; other sections are left as they are."""
+    text = path.read_text(encoding="utf-8") if path.exists() else "# Benchmarks\n\n"
+    lines = text.splitlines(keepends=True)
+    start = next((i for i, ln in enumerate(lines) if ln.rstrip() == SECTION), None)
+    if start is None:
+        if not text.endswith("\n"):
+            text += "\n"
+        new = text + ("\n" if not text.endswith("\n\n") else "") + section
+    else:
+        end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith("## ")),
+                   len(lines))
+        tail = "".join(lines[end:])
+        new = "".join(lines[:start]) + section + ("\n" + tail if tail else "")
+    path.write_text(new, encoding="utf-8")
+
+
+def tools_available() -> None:
+    if shutil.which(QEMU) is None:
+        raise FluxdriveError(f"{QEMU} not found", hint="apt-get install qemu-system-arm")
+
+
+LAWS = ("foc", "pi_dfvc", "db_dfvc")
+
+
+def main(args) -> int:
+    """``fluxdrive pil``: see the module docstring."""
+    import time
+
+    tools_available()
+    runner = sil.locate_sil(args.sil)
+    elf = locate_elf(args.elf)
+    scenarios = []
+    for s in args.scenario:
+        p = Path(s)
+        if not p.is_file():
+            raise FluxdriveError(f"scenario not found: {p}")
+        scenarios.append(p)
+    laws: list[str | None] = [None]
+    if args.law:
+        laws = [x.strip() for x in args.law.split(",") if x.strip()]
+        bad = [x for x in laws if x not in LAWS]
+        if bad:
+            raise FluxdriveError(f"unknown law {bad[0]!r}; use {', '.join(LAWS)}")
+    out_dir = Path(args.out) if args.out else Path("out") / "pil"
+    runs: list[PilRun] = []
+    for sc in scenarios:
+        for law in laws:
+            t0 = time.monotonic()
+            wd = out_dir / f"{sc.stem}-{law or 'scenario'}"
+            r = run_one(runner, elf, sc, law, args.isrs, wd, not args.free_running,
+                        args.timeout)
+            runs.append(r)
+            print(format_report([r], args.isrs, args.cpi), flush=True)
+            print(f"  ({time.monotonic() - t0:.1f} s, files in {wd})", flush=True)
+    build = "MinSizeRel -Os, -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard"
+    md = format_markdown(runs, args.isrs, args.cpi, build)
+    if args.markdown:
+        update_markdown(Path(args.markdown), md)
+        print(f"markdown: {args.markdown} (section '{SECTION[3:]}')")
+    rc = 0
+    for r in runs:
+        if not r.agreement.ok:
+            print(f"FAIL: {r.scenario}/{r.law}: PIL outputs disagree with the host build")
+            rc = 1
+        if not r.trace_exact:
+            print(f"FAIL: {r.scenario}/{r.law}: traced replay differs from the untraced one")
+            rc = 1
+        if args.check_worst and r.law == "db_dfvc" and r.counts.worst >= args.check_worst:
+            print(f"FAIL: {r.scenario}/{r.law}: worst case {r.counts.worst} instructions, "
+                  f"limit {args.check_worst}")
+            rc = 1
+    return rc

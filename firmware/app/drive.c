@@ -99,13 +99,14 @@ static uint32_t drive_protect(const drive_t *drv, const hal_adc_sample_t *s, con
 
 static void drive_update_position(drive_t *drv, const hal_adc_sample_t *s) {
   if (s->enc_valid && isfinite(s->enc_angle)) {
-    float th = drv->cfg.pole_pairs * s->enc_angle - drv->cfg.enc_offset;
-    angle_pll_update(&drv->pll, frames_wrap_pi(th));
+    /* The encoder angle is sampled at the ADC instant: Park uses it as is;
+     * the PLL gives the speed. */
+    const float th = frames_wrap_pi(drv->cfg.pole_pairs * s->enc_angle - drv->cfg.enc_offset);
+    angle_pll_update(&drv->pll, th);
+    drv->pos.theta_e = th;
+  } else {
+    drv->pos.theta_e = drv->pll.theta;
   }
-  /* The encoder angle is sampled at the ADC instant: use it as is for
-   * Park; the PLL gives the speed. */
-  float th_meas = drv->cfg.pole_pairs * s->enc_angle - drv->cfg.enc_offset;
-  drv->pos.theta_e = s->enc_valid ? frames_wrap_pi(th_meas) : drv->pll.theta;
   drv->pos.omega_e = drv->pll.omega;
   drv->pos.omega_m = drv->pll.omega / drv->cfg.pole_pairs;
   drv->pos.rate_acc += drv->pll.omega_rate;

@@ -16,8 +16,8 @@
 #include <time.h>
 #include <unistd.h>
 
-/* Frames are held back this long after the raw-mode "< ok >": python-can
- * reads that reply with one recv() and needs it alone. */
+/* Frames are held back (buffered) this long after the raw-mode "< ok >":
+ * python-can reads that reply with one recv() and needs it alone. */
 #define RAW_SETTLE_S 0.1
 
 static double wall_now(void) {
@@ -93,6 +93,9 @@ static int out_put(can_scd_client_t *c, const char *txt, size_t n) {
 }
 
 static void flush_client(can_scd_client_t *c) {
+  if (c->phase == 2 && wall_now() - c->raw_at < RAW_SETTLE_S) {
+    return; /* frames wait until the client has read the raw-mode "< ok >" */
+  }
   while (c->fd >= 0 && c->out_len > 0) {
     ssize_t w = send(c->fd, c->out, c->out_len, MSG_NOSIGNAL);
     if (w < 0) {
@@ -128,6 +131,7 @@ static void accept_clients(can_socketcand_t *s) {
     c->phase = 0;
     c->in_len = c->out_len = 0;
     out_put(c, "< hi >", 6);
+    flush_client(c);
   }
 }
 
@@ -213,16 +217,9 @@ static void broadcast(can_socketcand_t *s, const hal_can_frame_t *f, double t,
   char line[96];
   format_frame(f, t, line, sizeof line);
   size_t n = strlen(line);
-  double now = -1.0;
   for (int i = 0; i < CAN_SCD_CLIENTS; ++i) {
     can_scd_client_t *c = &s->cl[i];
     if (c->fd < 0 || c->phase != 2 || c == except) {
-      continue;
-    }
-    if (now < 0.0) {
-      now = wall_now();
-    }
-    if (now - c->raw_at < RAW_SETTLE_S) {
       continue;
     }
     if (!out_put(c, line, n)) {
@@ -247,10 +244,12 @@ static int do_command(can_socketcand_t *s, can_scd_client_t *c, char *cmd, hal_s
   if (c->phase == 0 && strcmp(tok[0], "open") == 0 && ntok == 2) {
     c->phase = 1;
     out_put(c, "< ok >", 6);
+    flush_client(c);
   } else if (c->phase == 1 && strcmp(tok[0], "rawmode") == 0 && ntok == 1) {
+    out_put(c, "< ok >", 6);
+    flush_client(c); /* alone: python-can reads it with one recv() */
     c->phase = 2;
     c->raw_at = wall_now();
-    out_put(c, "< ok >", 6);
   } else if (c->phase == 2 && strcmp(tok[0], "send") == 0) {
     hal_can_frame_t f;
     if (parse_send(tok + 1, ntok - 1, &f) != 0) {

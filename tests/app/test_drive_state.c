@@ -37,6 +37,16 @@ static void run_isrs(int n) {
   }
 }
 
+/* A fresh drive, enabled with zero currents, through calibration to run. */
+static void start_running(void) {
+  setup_drive();
+  sample(0.0f, 0.0f, 0.0f, 310.0f);
+  drive_cmd_enable(&drv, true);
+  drive_slow_loop(&drv);
+  run_isrs(drv.cfg.offset_samples + 2);
+  assert_int_equal(drv.state, DRIVE_STATE_RUN);
+}
+
 static void calibrates_offsets_then_runs(void **state) {
   (void)state;
   setup_drive();
@@ -82,12 +92,7 @@ static void offset_out_of_range_faults(void **state) {
 
 static void fault_latches_until_cleared(void **state) {
   (void)state;
-  setup_drive();
-  sample(0.0f, 0.0f, 0.0f, 310.0f);
-  drive_cmd_enable(&drv, true);
-  drive_slow_loop(&drv);
-  run_isrs(drv.cfg.offset_samples + 2);
-  assert_int_equal(drv.state, DRIVE_STATE_RUN);
+  start_running();
   /* one sample above the trip level */
   sample(drv.cfg.i_trip + 0.01f, 0.0f, -(drv.cfg.i_trip + 0.01f), 310.0f);
   drive_isr(&drv);
@@ -158,12 +163,7 @@ static void commands_are_clamped_and_staged(void **state) {
 
 static void law_change_waits_for_gates_off(void **state) {
   (void)state;
-  setup_drive();
-  sample(0.0f, 0.0f, 0.0f, 310.0f);
-  drive_cmd_enable(&drv, true);
-  drive_slow_loop(&drv);
-  run_isrs(drv.cfg.offset_samples + 2);
-  assert_int_equal(drv.state, DRIVE_STATE_RUN);
+  start_running();
   assert_true(drive_cmd_set_law(&drv, DRIVE_LAW_PI_DFVC));
   drive_slow_loop(&drv);
   assert_int_equal(drv.ref.law, DRIVE_LAW_FOC);

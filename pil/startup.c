@@ -19,9 +19,12 @@ __attribute__((noreturn)) void Reset_Handler(void) {
   SCB_CPACR |= (0xFu << 20); /* CP10, CP11: full access */
   __asm__ volatile("dsb\n\tisb" ::: "memory");
   const uint32_t *src = &_sidata;
+  /* linker symbols bound one region each: comparing them is the point */
+  // cppcheck-suppress comparePointers
   for (uint32_t *dst = &_sdata; dst < &_edata;) {
     *dst++ = *src++;
   }
+  // cppcheck-suppress comparePointers
   for (uint32_t *dst = &_sbss; dst < &_ebss;) {
     *dst++ = 0u;
   }

@@ -13,7 +13,10 @@
 #define ID DRIVE_PARAM_IDLE
 #define LV DRIVE_PARAM_LIVE
 #define P(id, field, type, access, lo, hi)                                                         \
-  { id, #field, (uint16_t)offsetof(drive_config_t, field), type, access, lo, hi }
+  {                                                                                                \
+#field, lo, hi, (uint16_t)offsetof(drive_config_t, field), id, (uint8_t)(type),                \
+        (uint8_t)(access)                                                                          \
+  }
 
 /* Ranges: what drive_config_check accepts for the field alone; the checks
  * between fields (i_trip >= i_max ...) are drive_config_check's. */

@@ -27,12 +27,12 @@ typedef enum {
 typedef enum { DRIVE_PARAM_F32 = 0, DRIVE_PARAM_U16 = 1 } drive_param_type_t;
 
 typedef struct {
-  uint8_t id;
   const char *name;
-  uint16_t offset; /* offsetof(drive_config_t, field) */
-  drive_param_type_t type;
-  drive_param_access_t access;
   float min, max;
+  uint16_t offset; /* offsetof(drive_config_t, field) */
+  uint8_t id;
+  uint8_t type;   /* drive_param_type_t */
+  uint8_t access; /* drive_param_access_t */
 } drive_param_t;
 
 typedef enum {

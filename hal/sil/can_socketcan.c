@@ -9,6 +9,7 @@
 #include <string.h>
 
 #if defined(__linux__) && defined(__has_include)
+// cppcheck-suppress preprocessorErrorDirective
 #if __has_include(<linux/can.h>) && __has_include(<linux/can/raw.h>)
 #define FD_HAVE_SOCKETCAN 1
 #endif
@@ -38,13 +39,14 @@ int can_socketcan_open(can_socketcan_t *s, const char *ifname, char *err, size_t
   }
   struct ifreq ifr;
   memset(&ifr, 0, sizeof ifr);
-  if (strlen(ifname) >= sizeof ifr.ifr_name) {
+  size_t len = strlen(ifname);
+  if (len >= sizeof ifr.ifr_name) {
     snprintf(err, errlen, "%s: interface name too long", ifname);
     close(s->fd);
     s->fd = -1;
     return -1;
   }
-  strcpy(ifr.ifr_name, ifname);
+  memcpy(ifr.ifr_name, ifname, len + 1);
   struct sockaddr_can addr;
   memset(&addr, 0, sizeof addr);
   addr.can_family = AF_CAN;

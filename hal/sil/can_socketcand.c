@@ -195,16 +195,19 @@ static int parse_send(char **tok, int ntok, hal_can_frame_t *f) {
 
 static void format_frame(const hal_can_frame_t *f, double t, char *buf, size_t n) {
   unsigned long long us = t > 0.0 ? (unsigned long long)(t * 1e6 + 0.5) : 0ull;
-  int k = f->extended ? snprintf(buf, n, "< frame %08X %llu.%06llu ",
-                                 (unsigned)(f->id & 0x1FFFFFFFu), us / 1000000ull, us % 1000000ull)
-                      : snprintf(buf, n, "< frame %03X %llu.%06llu ", (unsigned)(f->id & 0x7FFu),
-                                 us / 1000000ull, us % 1000000ull);
-  unsigned dlc = f->dlc > 8u ? 8u : f->dlc;
-  for (unsigned i = 0; i < dlc && k > 0 && (size_t)k + 3 < n; ++i) {
-    k += snprintf(buf + k, n - (size_t)k, "%02X", f->data[i]);
+  char hex[17];
+  size_t dlc = f->dlc > 8u ? 8u : f->dlc;
+  // cppcheck-suppress knownConditionTrueFalse ; dlc comes from the frame
+  for (size_t i = 0; i < dlc; ++i) {
+    snprintf(hex + 2u * i, 3, "%02X", f->data[i]);
   }
-  if (k > 0 && (size_t)k + 3 < n) {
-    snprintf(buf + k, n - (size_t)k, " >");
+  hex[2u * (size_t)dlc] = '\0';
+  if (f->extended) {
+    snprintf(buf, n, "< frame %08X %llu.%06llu %s >", (unsigned)(f->id & 0x1FFFFFFFu),
+             us / 1000000ull, us % 1000000ull, hex);
+  } else {
+    snprintf(buf, n, "< frame %03X %llu.%06llu %s >", (unsigned)(f->id & 0x7FFu), us / 1000000ull,
+             us % 1000000ull, hex);
   }
 }
 
@@ -212,14 +215,14 @@ static int queue_room(const hal_sil_can_queue_t *q) {
   return q->head - q->tail < HAL_SIL_CAN_QUEUE;
 }
 
-static void broadcast(can_socketcand_t *s, const hal_can_frame_t *f, double t,
-                      const can_scd_client_t *except) {
+/* To every raw-mode client but number `except` (-1: none). */
+static void broadcast(can_socketcand_t *s, const hal_can_frame_t *f, double t, int except) {
   char line[96];
   format_frame(f, t, line, sizeof line);
   size_t n = strlen(line);
   for (int i = 0; i < CAN_SCD_CLIENTS; ++i) {
     can_scd_client_t *c = &s->cl[i];
-    if (c->fd < 0 || c->phase != 2 || c == except) {
+    if (i == except || c->fd < 0 || c->phase != 2) {
       continue;
     }
     if (!out_put(c, line, n)) {
@@ -261,7 +264,7 @@ static int do_command(can_socketcand_t *s, can_scd_client_t *c, char *cmd, hal_s
     }
     hal_sil_can_push(&hal->can_rx, &f);
     s->rx_frames++;
-    broadcast(s, &f, t, c);
+    broadcast(s, &f, t, (int)(c - s->cl));
   } else if (strcmp(tok[0], "echo") == 0 && ntok == 1) {
     out_put(c, "< echo >", 8);
   } else {
@@ -344,7 +347,7 @@ void can_socketcand_poll(can_socketcand_t *s, hal_sil_t *hal, double t) {
   hal_can_frame_t f;
   while (hal_sil_can_pop(&hal->can_tx, &f)) {
     s->tx_frames++;
-    broadcast(s, &f, t, NULL);
+    broadcast(s, &f, t, -1);
   }
   for (int i = 0; i < CAN_SCD_CLIENTS; ++i) {
     flush_client(&s->cl[i]);

@@ -6,6 +6,7 @@
 #include <stdint.h>
 
 #include "board.h"
+#include "can_proto.h"
 #include "drive.h"
 #include "hal.h"
 #include "hal_stm32g4.h"
@@ -13,6 +14,7 @@
 /* The drive instance (globals are allowed outside firmware/core). Placed in
  * CCM SRAM: the ISR's data on the zero-wait-state D-bus. */
 static drive_t s_drv __attribute__((section(".ccmbss.drive")));
+static can_proto_t s_can;
 static volatile uint32_t s_ticks;
 
 /* Readable with a debugger: HAL_INIT_ERR_* bits, and the drive_init field. */
@@ -66,6 +68,12 @@ int main(void) {
     g_board_config_field = field;
     err |= 0x80000000u;
   }
+  can_proto_cfg_t can_cfg;
+  can_proto_cfg_default(&can_cfg);
+  can_cfg.node = (uint8_t)BOARD_CAN_NODE_ID;
+  if (can_proto_init(&s_can, &can_cfg) != 0) {
+    err |= 0x40000000u;
+  }
   if (err == 0u) {
     err |= hal_stm32g4_start(); /* PWM carrier + ADC trigger + ISR */
   }
@@ -84,6 +92,8 @@ int main(void) {
     if (now != done) {
       /* one slow loop per tick; after a long stall, skip the missed ones */
       done = (now - done > 4u) ? now : done + 1u;
+      /* CAN commands are staged here and take effect in the slow loop */
+      can_proto_poll(&s_can, &s_drv, hal_time_us());
       drive_slow_loop(&s_drv);
       /* Refresh only while both contexts run: the slow loop is here and
        * the PWM-period interrupt advanced since the last refresh. */

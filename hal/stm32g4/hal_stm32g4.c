@@ -30,7 +30,10 @@ uint32_t hal_stm32g4_init(void) {
   if (!hal_adc_init()) {
     err |= HAL_INIT_ERR_ADC;
   }
-  if (!hal_fdcan_init(BOARD_CAN_BITRATE, BOARD_CAN_NODE_ID, 0x7Fu)) {
+  /* The protocol's identifiers are base + node with the node in the low
+   * nibble (firmware/app/can/fluxdrive.dbc): accept every base for this
+   * node; can_proto ignores the bases it does not handle. */
+  if (!hal_fdcan_init(BOARD_CAN_BITRATE, BOARD_CAN_NODE_ID, 0x00Fu)) {
     err |= HAL_INIT_ERR_CAN;
   }
   return err;

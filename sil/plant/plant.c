@@ -51,6 +51,7 @@ int plant_init(plant_t *pl, const plant_params_t *p, const char **field) {
   a->inv_r = p->dclink.kind == PLANT_DC_RC ? 1.0 / p->dclink.r : 0.0;
   a->inv_c = p->dclink.kind == PLANT_DC_RC ? 1.0 / p->dclink.c : 0.0;
   a->kdt = p->inverter.dead_time / p->ts;
+  a->inv_ts = 1.0 / p->ts;
   plant_inverter_init(pl);
   for (int j = 0; j < 3; j++) {
     a->edge_t[j] = -1e30; /* no command edge yet */
@@ -67,6 +68,7 @@ int plant_init(plant_t *pl, const plant_params_t *p, const char **field) {
   pl->omega_m =
       p->mech.mode == PLANT_MECH_IMPOSED ? profile_eval(&p->mech.speed, 0.0) : p->mech.omega0;
   pl->v_dc = p->dclink.v_source;
+  a->cur.key[0] = NAN; /* no cached currents */
   plant_sensors_init(pl);
   return 0;
 }
@@ -81,6 +83,7 @@ static double clamp_duty(double d) {
 void plant_step(plant_t *pl, const double duty[3], bool gates_on) {
   const double d[3] = {clamp_duty(duty[0]), clamp_duty(duty[1]), clamp_duty(duty[2])};
   const double ts = pl->p.ts;
+  plant_mech_input_refresh(pl);
   double x[X_N] = {pl->lambda_d, pl->lambda_q, pl->theta_m, pl->omega_m, pl->v_dc, 0, 0, 0, 0};
   const int avg = pl->p.inverter.model == PLANT_INV_AVERAGE;
   if (gates_on && avg) {
@@ -93,7 +96,7 @@ void plant_step(plant_t *pl, const double duty[3], bool gates_on) {
   } else {
     plant_inverter_sw_period(pl, d, gates_on, x);
   }
-  const double inv_ts = 1.0 / ts;
+  const double inv_ts = pl->aux.inv_ts;
   pl->v_abc_avg[0] = x[X_VA] * inv_ts;
   pl->v_abc_avg[1] = x[X_VB] * inv_ts;
   pl->v_abc_avg[2] = -(pl->v_abc_avg[0] + pl->v_abc_avg[1]);
@@ -109,25 +112,47 @@ void plant_step(plant_t *pl, const double duty[3], bool gates_on) {
   pl->aux.n_steps++;
   pl->t = (double)pl->aux.n_steps * ts;
   if (pl->p.mech.mode == PLANT_MECH_IMPOSED) {
-    pl->omega_m = profile_eval(&pl->p.mech.speed, pl->t); /* exactly the profile */
+    pl->omega_m = plant_mech_input(pl, pl->t); /* exactly the profile */
   }
 }
 
+static inline double torque_of(const plant_t *pl, const plant_cur_cache_t *c) {
+  return 1.5 * pl->p.machine.pole_pairs * (pl->lambda_d * c->i_dq[1] - pl->lambda_q * c->i_dq[0]);
+}
+
+void plant_get_brief(plant_t *pl, plant_brief_t *out) {
+  const plant_cur_cache_t *c = plant_machine_cur(pl);
+  out->i_abc[0] = c->i_abc[0];
+  out->i_abc[1] = c->i_abc[1];
+  out->i_abc[2] = c->i_abc[2];
+  out->omega_m = pl->omega_m;
+  out->torque = torque_of(pl, c);
+  out->v_dc = pl->v_dc;
+}
+
 void plant_get_state(const plant_t *pl, plant_state_t *out) {
-  const double th_e = wrap_2pi(pl->p.machine.pole_pairs * pl->theta_m);
+  plant_cur_cache_t fresh;
+  const plant_cur_cache_t *c = &pl->aux.cur;
+  if (!plant_machine_cur_fresh(pl)) {
+    plant_machine_cur_compute(pl, &fresh);
+    c = &fresh;
+  }
   out->t = pl->t;
-  plant_machine_currents(pl, pl->lambda_d, pl->lambda_q, th_e, out->i_dq, out->i_abc);
+  out->i_dq[0] = c->i_dq[0];
+  out->i_dq[1] = c->i_dq[1];
+  for (int k = 0; k < 3; k++) {
+    out->i_abc[k] = c->i_abc[k];
+  }
   out->lambda_dq[0] = pl->lambda_d;
   out->lambda_dq[1] = pl->lambda_q;
   for (int k = 0; k < 3; k++) {
     out->v_abc[k] = pl->v_abc_avg[k];
   }
   out->theta_m = pl->theta_m;
-  out->theta_e = th_e;
+  out->theta_e = wrap_2pi(c->th_e);
   out->omega_m = pl->omega_m;
-  out->torque = plant_machine_torque(pl, pl->lambda_d, pl->lambda_q);
-  out->load_torque =
-      pl->p.mech.mode == PLANT_MECH_FREE ? profile_eval(&pl->p.mech.load_torque, pl->t) : 0.0;
+  out->torque = torque_of(pl, c);
+  out->load_torque = pl->p.mech.mode == PLANT_MECH_FREE ? plant_mech_input(pl, pl->t) : 0.0;
   out->v_dc = pl->v_dc;
   out->i_dc = pl->i_dc_avg;
 }

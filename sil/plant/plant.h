@@ -100,13 +100,30 @@ typedef struct {
   double i_dc;         /* period-average DC-link current drawn [A] */
 } plant_state_t;
 
-/* Internal working data of plant_t (constants precomputed by plant_init and
- * the memory of the switching-level inverter). Not part of the API: read the
- * state through plant_get_state(). */
+/* True currents of one state, cached (plant_machine.c): valid while the
+ * state equals the key (lambda_d, lambda_q, theta_m) bit for bit. */
+typedef struct {
+  double key[3];
+  double th_e, c, s; /* pole_pairs * theta_m (not wrapped), its cos and sin */
+  double i_dq[2], i_abc[3];
+} plant_cur_cache_t;
+
+/* The part of the true state that run metrics need (plant_get_brief). */
+typedef struct {
+  double i_abc[3]; /* [A] */
+  double omega_m;  /* [rad/s] */
+  double torque;   /* [N m] */
+  double v_dc;     /* [V] */
+} plant_brief_t;
+
+/* Internal working data of plant_t (constants precomputed by plant_init,
+ * caches and the memory of the switching-level inverter). Not part of the
+ * API: read the state through plant_get_state(). */
 typedef struct {
   /* constants */
   double inv_ld, inv_lq, inv_j, inv_c, inv_r; /* 1/Ld, 1/Lq, 1/J, 1/C, 1/R */
   double kdt;                                 /* dead_time / ts */
+  double inv_ts;                              /* 1 / ts */
   double inv_band;  /* 1 / width of the smooth sign of the average-model dead time [1/A] */
   uint64_t n_steps; /* periods done: t = n_steps * ts exactly */
   /* switching-level inverter memory, per leg: time of the last commanded
@@ -118,6 +135,13 @@ typedef struct {
   int all_zero;   /* all phase currents blocked by the diodes */
   int gates_prev; /* gates were on during the last period */
   double v_star;  /* star-point voltage at the last valley (see plant_sample) */
+  /* mechanical input profile (plant_internal.h): equal to m_val for
+   * t in [m_t0, m_t1) */
+  double m_val, m_t0, m_t1;
+  plant_cur_cache_t cur;
+  /* sensor constants (plant_sensors.c) */
+  double adc_levels, adc_ilsb, adc_vlsb, enc_step;
+  double noise[4]; /* standard normals for the next sample (plant_sensors.c) */
 } plant_aux_t;
 
 typedef struct {
@@ -133,6 +157,10 @@ typedef struct {
   plant_aux_t aux; /* internal */
 } plant_t;
 
+/* After plant_init, only pl->p.dclink.v_source may be changed (between
+ * steps); the other parameters are fixed (constants and caches derive from
+ * them). The state members may be set between steps (tests do). */
+
 /* Validates the parameters; on error returns a negative number and sets
  * *field to the name of the offending parameter (static string). */
 int plant_check(const plant_params_t *p, const char **field);
@@ -144,5 +172,9 @@ void plant_step(plant_t *pl, const double duty[3], bool gates_on);
 /* Sensor readings at the present plant time (the carrier valley). */
 void plant_sample(plant_t *pl, plant_adc_t *out);
 void plant_get_state(const plant_t *pl, plant_state_t *out);
+/* The same values as plant_get_state() for the members of plant_brief_t,
+ * cheaply: the currents are computed once per state and shared with
+ * plant_sample() (hence not const). */
+void plant_get_brief(plant_t *pl, plant_brief_t *out);
 
 #endif

@@ -31,10 +31,31 @@ enum {
 };
 
 /* Mechanical input at time t: the imposed speed [rad/s] (IMPOSED) or the
- * load torque [N m] (FREE). */
+ * load torque [N m] (FREE). Bit-identical to evaluating the profile; taken
+ * from the span cache (plant_mech_input_refresh) while the profile is
+ * constant. */
 static inline double plant_mech_input(const plant_t *pl, double t) {
+  const plant_aux_t *a = &pl->aux;
+  if (t >= a->m_t0 && t < a->m_t1) {
+    return a->m_val;
+  }
   const plant_mech_t *m = &pl->p.mech;
   return profile_eval(m->mode == PLANT_MECH_IMPOSED ? &m->speed : &m->load_torque, t);
+}
+
+/* Refreshes the span cache of plant_mech_input when the period starting at
+ * the present time is not inside it (once per profile change, or every
+ * period while the profile is not constant). */
+static inline void plant_mech_input_refresh(plant_t *pl) {
+  plant_aux_t *a = &pl->aux;
+  const double t = pl->t;
+  if (t >= a->m_t0 && t + pl->p.ts < a->m_t1) {
+    return;
+  }
+  const plant_mech_t *m = &pl->p.mech;
+  a->m_val = profile_eval_span(m->mode == PLANT_MECH_IMPOSED ? &m->speed : &m->load_torque, t,
+                               &a->m_t1);
+  a->m_t0 = t;
 }
 
 /* Mechanics (plant_mech.c documents the convention):
@@ -76,9 +97,20 @@ static inline double plant_dclink_deriv(const plant_t *pl, const double *x, doub
 
 /* plant_machine.c */
 int plant_machine_check(const plant_machine_t *m, const char **field);
-void plant_machine_currents(const plant_t *pl, double lambda_d, double lambda_q, double theta_e,
-                            double i_dq[2], double i_abc[3]);
-double plant_machine_torque(const plant_t *pl, double lambda_d, double lambda_q);
+/* True currents of the present state, computed into c (keyed on it). */
+void plant_machine_cur_compute(const plant_t *pl, plant_cur_cache_t *c);
+static inline int plant_machine_cur_fresh(const plant_t *pl) {
+  const plant_cur_cache_t *c = &pl->aux.cur;
+  return c->key[0] == pl->lambda_d && c->key[1] == pl->lambda_q && c->key[2] == pl->theta_m;
+}
+/* The cached true currents of the present state (computed once per state:
+ * the sensors, the metrics and the next period's rotor angle share them). */
+static inline const plant_cur_cache_t *plant_machine_cur(plant_t *pl) {
+  if (!plant_machine_cur_fresh(pl)) {
+    plant_machine_cur_compute(pl, &pl->aux.cur);
+  }
+  return &pl->aux.cur;
+}
 void plant_machine_zero_phase_current(const plant_t *pl, double *x, int leg);
 
 /* plant_inverter.c, plant_inverter_avg.c, plant_inverter_sw.c */

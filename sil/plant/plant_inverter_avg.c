@@ -21,12 +21,15 @@
 
 #include <math.h>
 
-static inline double eff_duty(double d, double kdt, double i_norm) {
-  if (d <= 0.0 || d >= 1.0) {
-    return d;
-  }
+/* d_eff for a leg with duty d and kd = td/Ts when 0 < d < 1, else kd = 0
+ * (no switching, no dead time: d_eff = d - 0 = d; only a NaN current, i.e.
+ * an already diverged state, gives NaN there). The clamps are branches:
+ * well predicted (a current crosses its band a few times per electrical
+ * period), they keep the comparisons off the stage-to-stage dependency
+ * chain, which bounds the speed of the integrator. */
+static inline double eff_duty(double d, double kd, double i_norm) {
   const double sg = i_norm > 1.0 ? 1.0 : (i_norm < -1.0 ? -1.0 : i_norm);
-  const double e = d - kdt * sg;
+  const double e = d - kd * sg;
   return e < 0.0 ? 0.0 : (e > 1.0 ? 1.0 : e);
 }
 
@@ -57,83 +60,151 @@ static inline void stage_cos_sin(const angle_ref_t *r, double th, double *c, dou
   *s = r->s * cd + r->c * sd;
 }
 
-static inline void avg_deriv(const plant_t *pl, const angle_ref_t *ar, const double *d,
-                             const double *x, double m, double *dx) {
-  const plant_machine_t *mp = &pl->p.machine;
-  const double pp = (double)mp->pole_pairs;
-  double c, s;
-  stage_cos_sin(ar, pp * x[X_TH], &c, &s);
-  const double id = (x[X_LD] - mp->lambda_m) * pl->aux.inv_ld;
-  const double iq = x[X_LQ] * pl->aux.inv_lq;
+/* Constants of one period, in locals (no reloads through pl in the stages). */
+typedef struct {
+  double pp, lm, inv_ld, inv_lq, rs, nb, b, inv_j, vsrc, inv_r, inv_c;
+  double d[3], kd[3]; /* duties; td/Ts for a switching leg (0 < d < 1), else 0 */
+  int imposed, ideal;
+} avg_k_t;
+
+/* Derivative at one stage, c and s being cos and sin of the stage's rotor
+ * angle. The same expressions as plant_internal.h's inline mechanics and
+ * DC link, with the parameters hoisted. */
+static inline void avg_deriv(const avg_k_t *restrict k, double c, double s,
+                             const double *restrict x, double m, double *restrict dx) {
+  const double id = (x[X_LD] - k->lm) * k->inv_ld;
+  const double iq = x[X_LQ] * k->inv_lq;
   const double ial = id * c - iq * s, ibe = id * s + iq * c;
   const double ia = ial, ib = -0.5 * ial + PLANT_SQRT3_2 * ibe, ic = -ia - ib;
-  const double vdc = plant_dclink_voltage(pl, x);
-  const double kdt = pl->aux.kdt, nb = pl->aux.inv_band;
-  const double da = eff_duty(d[0], kdt, ia * nb);
-  const double db = eff_duty(d[1], kdt, ib * nb);
-  const double dc = eff_duty(d[2], kdt, ic * nb);
+  const double vdc = k->ideal ? k->vsrc : (x[X_VC] > 0.0 ? x[X_VC] : 0.0);
+  const double nb = k->nb;
+  const double da = eff_duty(k->d[0], k->kd[0], ia * nb);
+  const double db = eff_duty(k->d[1], k->kd[1], ib * nb);
+  const double dc = eff_duty(k->d[2], k->kd[2], ic * nb);
   const double va0 = da * vdc, vb0 = db * vdc, vc0 = dc * vdc;
   const double vn = (va0 + vb0 + vc0) * (1.0 / 3.0);
   const double van = va0 - vn, vbn = vb0 - vn;
   const double vbe = (vb0 - vc0) * PLANT_INV_SQRT3;
   const double vd = van * c + vbe * s, vq = -van * s + vbe * c;
-  const double w = plant_mech_speed(pl, x, m);
-  const double we = pp * w;
-  dx[X_LD] = vd - mp->rs * id + we * x[X_LQ];
-  dx[X_LQ] = vq - mp->rs * iq - we * x[X_LD];
-  const double te = 1.5 * pp * (x[X_LD] * iq - x[X_LQ] * id);
-  plant_mech_deriv(pl, x, m, te, dx);
+  const double w = k->imposed ? m : x[X_W];
+  const double we = k->pp * w;
+  dx[X_LD] = vd - k->rs * id + we * x[X_LQ];
+  dx[X_LQ] = vq - k->rs * iq - we * x[X_LD];
+  if (k->imposed) {
+    dx[X_TH] = m;
+    dx[X_W] = 0.0;
+  } else {
+    const double te = 1.5 * k->pp * (x[X_LD] * iq - x[X_LQ] * id);
+    dx[X_TH] = x[X_W];
+    dx[X_W] = (te - k->b * x[X_W] - m) * k->inv_j;
+  }
   const double idc = da * ia + db * ib + dc * ic;
-  dx[X_VC] = plant_dclink_deriv(pl, x, idc);
+  dx[X_VC] = k->ideal ? 0.0 : ((k->vsrc - x[X_VC]) * k->inv_r - idc) * k->inv_c;
   dx[X_VA] = van;
   dx[X_VB] = vbn;
   dx[X_VN] = vn - 0.5 * vdc;
   dx[X_IDC] = idc;
 }
 
-/* One period with gates on: `substeps` classical RK4 steps. x holds the
- * state at the period start (integrals zeroed) and returns it at the end. */
-void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x) {
+#if defined(__GNUC__)
+#define AVG_ALWAYS_INLINE __attribute__((always_inline)) inline
+#else
+#define AVG_ALWAYS_INLINE inline
+#endif
+
+/* The RK4 steps of one period; `ideal` and `imposed` are constants at each
+ * call site (specialised copies). State entries whose derivative is
+ * identically zero (v_C on an ideal link, w under imposed speed) are left
+ * as they are: x + h * 0 = x, the same result without the work. */
+static AVG_ALWAYS_INLINE void avg_rk4(const plant_t *pl, const avg_k_t *restrict kc, int ideal,
+                                      int imposed, angle_ref_t *restrict ar, double *restrict x) {
   const int n = pl->p.inverter.substeps;
   const double h = pl->p.ts / n, h2 = 0.5 * h, h6 = h / 6.0;
+  avg_k_t k = *kc;
+  k.ideal = ideal;
+  k.imposed = imposed;
   double t = pl->t;
   double m0 = plant_mech_input(pl, t);
-  angle_ref_t ar;
-  ar.th = pl->p.machine.pole_pairs * x[X_TH];
-  ar.c = cos(ar.th);
-  ar.s = sin(ar.th);
-  for (int k = 0; k < n; k++) {
+  for (int j = 0; j < n; j++) {
     const double m1 = plant_mech_input(pl, t + h2);
     const double m2 = plant_mech_input(pl, t + h);
     double k1[X_N], k2[X_N], k3[X_N], k4[X_N], xs[X_N];
-    if (k > 0) { /* carry the reference angle: libm once per period at speed */
-      double c, s;
-      const double th = pl->p.machine.pole_pairs * x[X_TH];
-      stage_cos_sin(&ar, th, &c, &s);
-      ar.th = th;
-      ar.c = c;
-      ar.s = s;
+    double c, s;
+    if (j > 0) { /* carry the reference angle: libm once per period at speed */
+      const double th = k.pp * x[X_TH];
+      stage_cos_sin(ar, th, &c, &s);
+      ar->th = th;
+      ar->c = c;
+      ar->s = s;
     }
-    avg_deriv(pl, &ar, duty, x, m0, k1);
-    for (int i = 0; i < X_N; i++) {
+    avg_deriv(&k, ar->c, ar->s, x, m0, k1);
+    for (int i = 0; i < X_VA; i++) { /* the integrals X_VA.. are not read */
       xs[i] = x[i] + h2 * k1[i];
     }
-    avg_deriv(pl, &ar, duty, xs, m1, k2);
-    for (int i = 0; i < X_N; i++) {
+    stage_cos_sin(ar, k.pp * xs[X_TH], &c, &s);
+    avg_deriv(&k, c, s, xs, m1, k2);
+    for (int i = 0; i < X_VA; i++) {
       xs[i] = x[i] + h2 * k2[i];
     }
-    avg_deriv(pl, &ar, duty, xs, m1, k3);
-    for (int i = 0; i < X_N; i++) {
+    stage_cos_sin(ar, k.pp * xs[X_TH], &c, &s);
+    avg_deriv(&k, c, s, xs, m1, k3);
+    for (int i = 0; i < X_VA; i++) {
       xs[i] = x[i] + h * k3[i];
     }
-    avg_deriv(pl, &ar, duty, xs, m2, k4);
+    stage_cos_sin(ar, k.pp * xs[X_TH], &c, &s);
+    avg_deriv(&k, c, s, xs, m2, k4);
     for (int i = 0; i < X_N; i++) {
+      if ((ideal && i == X_VC) || (imposed && i == X_W)) {
+        continue;
+      }
       x[i] += h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
     }
     t += h;
-    if (pl->p.mech.mode == PLANT_MECH_IMPOSED) {
+    if (imposed) {
       x[X_W] = m2; /* the imposed speed, exactly */
     }
     m0 = m2;
+  }
+}
+
+/* One period with gates on: `substeps` classical RK4 steps. x holds the
+ * state at the period start (integrals zeroed) and returns it at the end.
+ * The first stage of each step is at the reference angle itself (cos and
+ * sin known: from the plant's current cache for the first step). */
+void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x) {
+  const plant_params_t *p = &pl->p;
+  avg_k_t k;
+  k.pp = (double)p->machine.pole_pairs;
+  k.lm = p->machine.lambda_m;
+  k.inv_ld = pl->aux.inv_ld;
+  k.inv_lq = pl->aux.inv_lq;
+  k.rs = p->machine.rs;
+  k.nb = pl->aux.inv_band;
+  k.b = p->mech.b;
+  k.inv_j = pl->aux.inv_j;
+  k.vsrc = p->dclink.v_source;
+  k.inv_r = pl->aux.inv_r;
+  k.inv_c = pl->aux.inv_c;
+  for (int j = 0; j < 3; j++) {
+    k.d[j] = duty[j];
+    k.kd[j] = duty[j] > 0.0 && duty[j] < 1.0 ? pl->aux.kdt : 0.0;
+  }
+  k.imposed = p->mech.mode == PLANT_MECH_IMPOSED;
+  k.ideal = p->dclink.kind == PLANT_DC_IDEAL;
+  angle_ref_t ar;
+  if (x[X_TH] == pl->theta_m) { /* always, from plant_step */
+    const plant_cur_cache_t *cc = plant_machine_cur(pl);
+    ar.th = cc->th_e;
+    ar.c = cc->c;
+    ar.s = cc->s;
+  } else {
+    ar.th = k.pp * x[X_TH];
+    ar.c = cos(ar.th);
+    ar.s = sin(ar.th);
+  }
+  if (k.ideal && !k.imposed) {
+    avg_rk4(pl, &k, 1, 0, &ar, x); /* the usual case */
+  } else {
+    avg_rk4(pl, &k, k.ideal, k.imposed, &ar, x);
   }
 }

@@ -35,23 +35,22 @@ int plant_machine_check(const plant_machine_t *m, const char **field) {
   return 0;
 }
 
-void plant_machine_currents(const plant_t *pl, double lambda_d, double lambda_q, double theta_e,
-                            double i_dq[2], double i_abc[3]) {
-  const double id = (lambda_d - pl->p.machine.lambda_m) * pl->aux.inv_ld;
-  const double iq = lambda_q * pl->aux.inv_lq;
-  const double c = cos(theta_e), s = sin(theta_e);
-  const double ia = id * c - iq * s, ib = id * s + iq * c;
-  i_dq[0] = id;
-  i_dq[1] = iq;
-  i_abc[0] = ia;
-  i_abc[1] = -0.5 * ia + PLANT_SQRT3_2 * ib;
-  i_abc[2] = -0.5 * ia - PLANT_SQRT3_2 * ib;
-}
-
-double plant_machine_torque(const plant_t *pl, double lambda_d, double lambda_q) {
-  const double id = (lambda_d - pl->p.machine.lambda_m) * pl->aux.inv_ld;
-  const double iq = lambda_q * pl->aux.inv_lq;
-  return 1.5 * pl->p.machine.pole_pairs * (lambda_d * iq - lambda_q * id);
+void plant_machine_cur_compute(const plant_t *pl, plant_cur_cache_t *c) {
+  c->key[0] = pl->lambda_d;
+  c->key[1] = pl->lambda_q;
+  c->key[2] = pl->theta_m;
+  c->th_e = pl->p.machine.pole_pairs * pl->theta_m;
+  const double id = (pl->lambda_d - pl->p.machine.lambda_m) * pl->aux.inv_ld;
+  const double iq = pl->lambda_q * pl->aux.inv_lq;
+  const double co = cos(c->th_e), si = sin(c->th_e);
+  const double ia = id * co - iq * si, ib = id * si + iq * co;
+  c->c = co;
+  c->s = si;
+  c->i_dq[0] = id;
+  c->i_dq[1] = iq;
+  c->i_abc[0] = ia;
+  c->i_abc[1] = -0.5 * ia + PLANT_SQRT3_2 * ib;
+  c->i_abc[2] = -0.5 * ia - PLANT_SQRT3_2 * ib;
 }
 
 /* Projects the flux state so that phase `leg`'s current is exactly zero,

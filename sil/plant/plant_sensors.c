@@ -7,9 +7,10 @@
  *   back with the nominal gain, as the firmware would.
  * DC-link voltage: unipolar ADC 0..v_full_scale, LSB = v_full_scale/2^bits,
  *   same rounding and saturation, white noise v_noise.
- * Noise: xorshift64* seeded through splitmix64 from `seed`, Box-Muller
- *   normals; deterministic for a given seed and call sequence; no random
- *   number is drawn for a zero noise setting.
+ * Noise: xorshift64* seeded through splitmix64 from `seed`, Marsaglia
+ *   polar normals, drawn one sample ahead (draw_noise); deterministic for a
+ *   given seed and call sequence; no random number is drawn for a zero
+ *   noise setting.
  * Encoder: mechanical angle floored to 2 pi / encoder_cpr (0 = ideal).
  * Star point: returned exactly (no ADC model), see plant.c.
  */
@@ -53,12 +54,6 @@ static uint64_t splitmix64(uint64_t z) {
   return z ^ (z >> 31);
 }
 
-void plant_sensors_init(plant_t *pl) {
-  pl->rng = splitmix64(pl->p.sensors.seed);
-  if (pl->rng == 0) {
-    pl->rng = 0x9E3779B97F4A7C15ull;
-  }
-}
 
 /* uniform in (0, 1] */
 static double rng_uniform(uint64_t *s) {
@@ -89,6 +84,37 @@ static void rng_normal2(uint64_t *s, double *z0, double *z1) {
   *z1 = 0.0;
 }
 
+/* The standard normals of the next sample (n[0..2] currents, n[3] DC-link
+ * voltage), drawn one sample ahead: the sequence is the same as drawing
+ * them in plant_sample, but the draw (log, sqrt, division) is off the path
+ * from the plant state to the ISR and overlaps with it. */
+static void draw_noise(plant_t *pl) {
+  const plant_sensors_t *s = &pl->p.sensors;
+  double *n = pl->aux.noise;
+  n[0] = n[1] = n[2] = n[3] = 0.0;
+  if (s->i_noise > 0.0) {
+    rng_normal2(&pl->rng, &n[0], &n[1]);
+    rng_normal2(&pl->rng, &n[2], &n[3]);
+  } else if (s->v_noise > 0.0) {
+    double unused;
+    rng_normal2(&pl->rng, &n[3], &unused);
+  }
+}
+
+void plant_sensors_init(plant_t *pl) {
+  const plant_sensors_t *s = &pl->p.sensors;
+  plant_aux_t *a = &pl->aux;
+  a->adc_levels = ldexp(1.0, s->adc_bits);
+  a->adc_ilsb = 2.0 * s->i_full_scale / a->adc_levels;
+  a->adc_vlsb = s->v_full_scale / a->adc_levels;
+  a->enc_step = s->encoder_cpr > 0 ? PLANT_TWO_PI / s->encoder_cpr : 0.0;
+  pl->rng = splitmix64(pl->p.sensors.seed);
+  if (pl->rng == 0) {
+    pl->rng = 0x9E3779B97F4A7C15ull;
+  }
+  draw_noise(pl);
+}
+
 static double adc_round(double x, double lsb, double code_min, double code_max, double code_off) {
   double code = floor(x / lsb + 0.5) + code_off;
   code = code < code_min ? code_min : (code > code_max ? code_max : code);
@@ -97,31 +123,25 @@ static double adc_round(double x, double lsb, double code_min, double code_max, 
 
 void plant_sample(plant_t *pl, plant_adc_t *out) {
   const plant_sensors_t *s = &pl->p.sensors;
-  const double levels = ldexp(1.0, s->adc_bits);
-  double i_dq[2], i_abc[3], n[4] = {0.0, 0.0, 0.0, 0.0};
-  plant_machine_currents(pl, pl->lambda_d, pl->lambda_q, pl->p.machine.pole_pairs * pl->theta_m,
-                         i_dq, i_abc);
-  if (s->i_noise > 0.0) {
-    rng_normal2(&pl->rng, &n[0], &n[1]);
-    rng_normal2(&pl->rng, &n[2], &n[3]);
-  } else if (s->v_noise > 0.0) {
-    double unused;
-    rng_normal2(&pl->rng, &n[3], &unused);
-  }
-  const double ilsb = 2.0 * s->i_full_scale / levels;
+  const plant_aux_t *a = &pl->aux;
+  const double levels = a->adc_levels;
+  const double *n = a->noise;
+  const double *i_abc = plant_machine_cur(pl)->i_abc;
+  const double ilsb = a->adc_ilsb;
   for (int k = 0; k < 3; k++) {
     const double raw = (1.0 + s->gain_error[k]) * i_abc[k] + s->offset_error[k] + s->i_noise * n[k];
     out->i_abc[k] = adc_round(raw, ilsb, 0.0, levels - 1.0, 0.5 * levels);
   }
-  const double vlsb = s->v_full_scale / levels;
+  const double vlsb = a->adc_vlsb;
   out->v_dc = adc_round(pl->v_dc + s->v_noise * n[3], vlsb, 0.0, levels - 1.0, 0.0);
   out->v_star = pl->aux.v_star;
   if (s->encoder_cpr > 0) {
-    const double step = PLANT_TWO_PI / s->encoder_cpr;
+    const double step = a->enc_step;
     double cnt = floor(pl->theta_m / step);
     cnt = cnt >= s->encoder_cpr ? 0.0 : (cnt < 0.0 ? 0.0 : cnt);
     out->enc_angle = cnt * step;
   } else {
     out->enc_angle = pl->theta_m;
   }
+  draw_noise(pl); /* for the next sample */
 }

@@ -39,6 +39,37 @@ double profile_eval(const profile_t *p, double t) {
   return y;
 }
 
+/* End of the interval from t over which term k keeps its value at t. */
+static double term_span(const profile_term_t *k, double t) {
+  switch (k->kind) {
+  case PROFILE_CONST:
+    return INFINITY;
+  case PROFILE_STEP:
+    return t >= k->t0 ? INFINITY : k->t0;
+  case PROFILE_RAMP:
+    if (t >= k->t1) {
+      return INFINITY;
+    }
+    return t < k->t0 ? k->t0 : t; /* 0 up to t0 (inclusive), then rising */
+  case PROFILE_SINE:
+    if (k->t1 > k->t0 && t > k->t1) {
+      return INFINITY;
+    }
+    return t < k->t0 ? k->t0 : t;
+  }
+  return t;
+}
+
+double profile_eval_span(const profile_t *p, double t, double *t_end) {
+  double end = INFINITY;
+  for (int i = 0; i < p->n; i++) {
+    const double e = term_span(&p->term[i], t);
+    end = e < end ? e : end;
+  }
+  *t_end = end;
+  return profile_eval(p, t);
+}
+
 int profile_add(profile_t *p, profile_term_t term) {
   if (p->n < 0 || p->n >= PROFILE_MAX_TERMS) {
     return -1;

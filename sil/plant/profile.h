@@ -29,6 +29,12 @@ typedef struct {
 } profile_t;
 
 double profile_eval(const profile_t *p, double t);
+/* profile_eval(p, t), and in *t_end the end of the interval [t, *t_end)
+ * (possibly empty: *t_end <= t) over which profile_eval() returns this same
+ * value bit for bit (const terms, a step or sine before its start, a ramp
+ * before its start or after its end, a sine after its end). Lets callers
+ * that evaluate a profile many times per period skip the evaluation. */
+double profile_eval_span(const profile_t *p, double t, double *t_end);
 /* Appends a term; returns 0, or -1 when full. */
 int profile_add(profile_t *p, profile_term_t term);
 /* Validates term count, kinds and values (finite; ramp t1 > t0; sine

@@ -118,8 +118,10 @@ _Static_assert(sizeof(isr_stream_out_t) == 24, "isr_stream_out_t layout");
   FLT(dfvc_iqs_bw)
 /* clang-format on */
 
-#define ISR_STREAM_COUNT_FLT(n)    +1
-#define ISR_STREAM_COUNT_INT(n, t) +1
+/* Each field adds one to a sum written as "0 +1 +1 ...": the bare "+1" is
+ * the point of these X-macro arms. */
+#define ISR_STREAM_COUNT_FLT(n)    +1 // NOLINT(bugprone-macro-parentheses)
+#define ISR_STREAM_COUNT_INT(n, t) +1 // NOLINT(bugprone-macro-parentheses)
 enum {
   ISR_STREAM_CONFIG_WORDS = 0 ISR_STREAM_CONFIG_FIELDS(ISR_STREAM_COUNT_FLT, ISR_STREAM_COUNT_INT)
 };

@@ -23,7 +23,10 @@ static void to_hal_sample(const plant_adc_t *a, double enc_error, hal_adc_sample
   }
   s->v_dc = (float)a->v_dc;
   s->v_star = (float)a->v_star;
-  double th = fmod(a->enc_angle + enc_error, 2.0 * SIL_PI);
+  double th = a->enc_angle + enc_error;
+  if (!(th >= 0.0 && th < 2.0 * SIL_PI)) { /* fmod is the identity on [0, 2 pi) */
+    th = fmod(th, 2.0 * SIL_PI);
+  }
   s->enc_angle = (float)(th < 0.0 ? th + 2.0 * SIL_PI : th);
   s->enc_valid = true;
 }
@@ -104,7 +107,10 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
 
   plant_adc_t adc;
   plant_state_t st;
+  plant_brief_t br; /* what the metrics need: cheaper than plant_state_t */
   hal_adc_sample_t sample;
+  /* encoder error and source voltage profiles, each constant until *_end */
+  double enc_err = 0.0, enc_err_end = -INFINITY, v_src = 0.0, v_src_end = -INFINITY;
   const double t_start = wall_now();
   uint64_t k = 0;
   for (; k < n; ++k) {
@@ -134,44 +140,52 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
     }
     /* 1. sample */
     plant_sample(&plant, &adc);
-    to_hal_sample(&adc, profile_eval(&sc->encoder_error, t), &sample);
+    if (!(t < enc_err_end)) {
+      enc_err = profile_eval_span(&sc->encoder_error, t, &enc_err_end);
+    }
+    to_hal_sample(&adc, enc_err, &sample);
     hal.sample = sample;
     /* 2. ISR */
     drive_isr(&drv);
     /* 3. observe */
-    plant_get_state(&plant, &st);
+    plant_get_brief(&plant, &br);
     for (int x = 0; x < 3; ++x) {
-      double a = fabs(st.i_abc[x]);
+      double a = fabs(br.i_abc[x]);
       if (a > res->max_phase_current) {
         res->max_phase_current = a;
         res->max_phase_current_t = t;
       }
     }
-    res->v_dc_min = fmin(res->v_dc_min, st.v_dc);
-    res->v_dc_max = fmax(res->v_dc_max, st.v_dc);
-    res->max_speed = fmax(res->max_speed, st.omega_m);
-    res->min_speed = fmin(res->min_speed, st.omega_m);
+    /* fmin/fmax semantics (a NaN sample is ignored), without the calls */
+    res->v_dc_min = br.v_dc < res->v_dc_min ? br.v_dc : res->v_dc_min;
+    res->v_dc_max = br.v_dc > res->v_dc_max ? br.v_dc : res->v_dc_max;
+    res->max_speed = br.omega_m > res->max_speed ? br.omega_m : res->max_speed;
+    res->min_speed = br.omega_m < res->min_speed ? br.omega_m : res->min_speed;
     if (k >= tail) {
-      torque_tail += st.torque;
+      torque_tail += br.torque;
     }
     res->faults_seen |= drv.faults;
     if (drv.faults != 0u && res->first_fault_t < 0.0) {
       res->first_fault_t = t;
     }
     if (obs != NULL) {
+      plant_get_state(&plant, &st);
       sil_step_t s = {k, t, &st, &sample, &drv, sc, duty_active, hal.gates_on};
       obs(user, &s);
     }
     /* 4. plant over [t_k, t_k+1) */
-    plant.p.dclink.v_source = profile_eval(&sc->v_source, t);
+    if (!(t < v_src_end)) {
+      v_src = profile_eval_span(&sc->v_source, t, &v_src_end);
+    }
+    plant.p.dclink.v_source = v_src;
     const double d[3] = {duty_active[0], duty_active[1], duty_active[2]};
     plant_step(&plant, d, hal.gates_on);
     memcpy(duty_active, hal.duty, sizeof duty_active);
     /* hardware comparator: gates off in hardware, latched */
     if (sc->hw_trip > 0.0 && hal.gates_on) {
-      plant_get_state(&plant, &st);
-      if (fabs(st.i_abc[0]) > sc->hw_trip || fabs(st.i_abc[1]) > sc->hw_trip ||
-          fabs(st.i_abc[2]) > sc->hw_trip) {
+      plant_get_brief(&plant, &br);
+      if (fabs(br.i_abc[0]) > sc->hw_trip || fabs(br.i_abc[1]) > sc->hw_trip ||
+          fabs(br.i_abc[2]) > sc->hw_trip) {
         hal.hw_tripped = true;
         hal.gates_on = false;
       }

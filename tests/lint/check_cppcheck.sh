@@ -7,6 +7,6 @@ cd "$1"
 cppcheck --quiet --error-exitcode=1 --enable=warning,style,performance,portability \
   --std=c11 --inline-suppr --suppress=missingIncludeSystem --suppress=unusedFunction \
   --suppress='badBitmaskCheck:hal/stm32g4/*' --suppress='redundantAssignment:hal/stm32g4/*' \
-  -I firmware/core -I firmware/app -I hal -I hal/sil -I sil/plant -I sil/runner \
-  firmware hal sil
+  -I firmware/core -I firmware/app -I hal -I hal/sil -I sil/plant -I sil/runner -I pil \
+  firmware hal sil pil
 echo "cppcheck: clean"

@@ -21,6 +21,7 @@ runs: send commands or call :meth:`Drive.heartbeat` to keep it alive.
 
 from __future__ import annotations
 
+import logging
 import queue
 import threading
 import time
@@ -49,6 +50,8 @@ def open_bus(channel: str = "vcan0", interface: str = "socketcand", host: str = 
              port: int = 29536, **kwargs: Any) -> can.BusABC:
     """A python-can bus; host and port are used by the socketcand interface only."""
     if interface == "socketcand":
+        # python-can warns on every frame split across TCP reads: not a problem
+        logging.getLogger("can.interfaces.socketcand.socketcand").setLevel(logging.ERROR)
         kwargs.setdefault("tcp_tune", True)
         return can.Bus(channel=channel, interface=interface, host=host, port=port, **kwargs)
     return can.Bus(channel=channel, interface=interface, **kwargs)

@@ -11,6 +11,7 @@
 
 #include "control/modulation.h"
 #include "hal.h"
+#include "math/fd_math.h"
 #include "math/frames.h"
 
 #define TWO_PI_F 6.28318531f
@@ -76,7 +77,7 @@ int drive_init(drive_t *drv, const drive_config_t *cfg, const char **field) {
 static uint32_t drive_protect(const drive_t *drv, const hal_adc_sample_t *s, const float i[3]) {
   const drive_config_t *c = &drv->cfg;
   uint32_t f = 0;
-  if (!(isfinite(i[0]) && isfinite(i[1]) && isfinite(i[2]) && isfinite(s->v_dc))) {
+  if (!(fd_isfinite(i[0]) && fd_isfinite(i[1]) && fd_isfinite(i[2]) && fd_isfinite(s->v_dc))) {
     return DRIVE_FAULT_SAMPLE;
   }
   if (fabsf(i[0]) > c->i_trip || fabsf(i[1]) > c->i_trip || fabsf(i[2]) > c->i_trip) {
@@ -98,7 +99,7 @@ static uint32_t drive_protect(const drive_t *drv, const hal_adc_sample_t *s, con
 }
 
 static void drive_update_position(drive_t *drv, const hal_adc_sample_t *s) {
-  if (s->enc_valid && isfinite(s->enc_angle)) {
+  if (s->enc_valid && fd_isfinite(s->enc_angle)) {
     /* The encoder angle is sampled at the ADC instant: Park uses it as is;
      * the PLL gives the speed. */
     const float th = frames_wrap_pi(drv->cfg.pole_pairs * s->enc_angle - drv->cfg.enc_offset);
@@ -313,7 +314,7 @@ bool drive_cmd_set_mode(drive_t *drv, drive_mode_t mode) {
 }
 
 static float clampf(float x, float lo, float hi) {
-  if (!isfinite(x)) {
+  if (!fd_isfinite(x)) {
     return 0.0f;
   }
   return x < lo ? lo : (x > hi ? hi : x);

@@ -18,6 +18,7 @@
 #include <math.h>
 
 #include "control/modulation.h"
+#include "math/fd_math.h"
 
 /* Current band over which the dead-time correction fades through zero. */
 #define DEADTIME_BAND_FRACTION 0.02f
@@ -72,7 +73,7 @@ static void ctrl_step_foc(ctrl_t *c, const ctrl_in_t *in, ctrl_out_t *out) {
   sincos_t sc = frames_sincos(in->theta_e);
   dq_t i = frames_park(in->i_ab, sc);
   dq_t i_ref;
-  float t_lim = fminf(c->torque_max, pmsm_torque(&c->machine, (dq_t){0.0f, c->i_max}));
+  float t_lim = fd_minf(c->torque_max, pmsm_torque(&c->machine, (dq_t){0.0f, c->i_max}));
   if (in->mode == DRIVE_MODE_CURRENT) {
     i_ref = (dq_t){in->id_ref, in->iq_ref};
   } else {
@@ -95,8 +96,9 @@ static void ctrl_step_foc(ctrl_t *c, const ctrl_in_t *in, ctrl_out_t *out) {
   out->torque_min = -t_lim;
   out->torque_max = t_lim;
   out->tm.torque = pmsm_torque(&c->machine, i);
-  out->tm.flux = sqrtf(powf(c->machine.ld * i.d + c->machine.lambda_m, 2.0f) +
-                       powf(c->machine.lq * i.q, 2.0f));
+  const float flux_d = c->machine.ld * i.d + c->machine.lambda_m;
+  const float flux_q = c->machine.lq * i.q;
+  out->tm.flux = sqrtf(flux_d * flux_d + flux_q * flux_q);
 }
 
 static void ctrl_step_dfvc(ctrl_t *c, const ctrl_in_t *in, ctrl_out_t *out) {
@@ -115,8 +117,8 @@ static void ctrl_step_dfvc(ctrl_t *c, const ctrl_in_t *in, ctrl_out_t *out) {
   out->v_ref = d.v_ab_ref;
   out->i_pred = d.i_ab_mid;
   out->i_dq = frames_park(in->i_ab, frames_sincos(in->theta_e));
-  out->torque_min = fmaxf(d.torque_min, -c->torque_max);
-  out->torque_max = fminf(d.torque_max, c->torque_max);
+  out->torque_min = fd_maxf(d.torque_min, -c->torque_max);
+  out->torque_max = fd_minf(d.torque_max, c->torque_max);
   out->fault = d.fault;
   out->tm = (ctrl_telemetry_t){.flux = d.lambda_s,
                                .flux_ref = d.lambda_ref,
@@ -141,7 +143,7 @@ void ctrl_step(ctrl_t *c, const ctrl_in_t *in, ctrl_out_t *out) {
     out->fault = 1u;
     break;
   }
-  if (!(isfinite(out->v_ref.alpha) && isfinite(out->v_ref.beta))) {
+  if (!(fd_isfinite(out->v_ref.alpha) && fd_isfinite(out->v_ref.beta))) {
     out->fault = 1u;
   }
 }

@@ -12,6 +12,8 @@
 
 #include <math.h>
 
+#include "math/fd_math.h"
+
 void current_ctrl_init(current_ctrl_t *cc, const current_ctrl_cfg_t *cfg) {
   cc->cfg = *cfg;
   const float wc = cfg->bandwidth;
@@ -28,11 +30,11 @@ void current_ctrl_reset(current_ctrl_t *cc) {
 
 dq_t current_ctrl_update(current_ctrl_t *cc, dq_t i_ref, dq_t i, float we, float v_max) {
   dq_t v = {0.0f, 0.0f};
-  if (!(v_max > 0.0f) || !isfinite(v_max)) {
+  if (!(v_max > 0.0f) || !fd_isfinite(v_max)) {
     cc->limited = 1; /* no voltage available: output zero, keep integrators */
     return v;
   }
-  if (!isfinite(we)) {
+  if (!fd_isfinite(we)) {
     we = 0.0f;
   }
   const current_ctrl_cfg_t *c = &cc->cfg;

@@ -6,10 +6,12 @@
 #include <math.h>
 #include <string.h>
 
+#include "math/fd_math.h"
+
 int deadtime_comp_init(deadtime_comp_t *d, const deadtime_comp_cfg_t *cfg) {
   memset(d, 0, sizeof(*d));
-  if (!(isfinite(cfg->td) && cfg->td >= 0.0f && isfinite(cfg->ts) && cfg->ts > 0.0f &&
-        cfg->td < cfg->ts && isfinite(cfg->i_band) && cfg->i_band >= 0.0f)) {
+  if (!(fd_isfinite(cfg->td) && cfg->td >= 0.0f && fd_isfinite(cfg->ts) && cfg->ts > 0.0f &&
+        cfg->td < cfg->ts && fd_isfinite(cfg->i_band) && cfg->i_band >= 0.0f)) {
     return -1;
   }
   d->cfg = *cfg;
@@ -22,7 +24,7 @@ void deadtime_comp_reset(deadtime_comp_t *d) {
 }
 
 float deadtime_comp_sign(const deadtime_comp_t *d, float i) {
-  if (!isfinite(i)) {
+  if (!fd_isfinite(i)) {
     return 0.0f;
   }
   if (i >= d->cfg.i_band) {

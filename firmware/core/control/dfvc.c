@@ -6,6 +6,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "math/fd_math.h"
+
 #define DFVC_INV_SQRT3 0.577350269189626f
 #define DFVC_2PI       6.28318530717959f
 #define DFVC_DEG       0.0174532925199433f
@@ -39,8 +41,8 @@ int dfvc_init(dfvc_t *c, const dfvc_cfg_t *cfg) {
   memset(c, 0, sizeof(*c));
   c->cfg = *cfg;
   const dfvc_cfg_t *k = cfg;
-  if (!(isfinite(k->rot_advance) && k->rot_advance >= 0.0f && k->rot_advance <= 1.0f &&
-        isfinite(k->lambda_collapse) && k->lambda_collapse >= 0.0f &&
+  if (!(fd_isfinite(k->rot_advance) && k->rot_advance >= 0.0f && k->rot_advance <= 1.0f &&
+        fd_isfinite(k->lambda_collapse) && k->lambda_collapse >= 0.0f &&
         (k->omega_delta_mode == DFVC_OMEGA_DELTA_TARGET ||
          k->omega_delta_mode == DFVC_OMEGA_DELTA_OBSERVED))) {
     return -1;
@@ -71,13 +73,13 @@ void dfvc_reset(dfvc_t *c) {
 }
 
 static int dfvc_finite_ab(ab_t x) {
-  return isfinite(x.alpha) && isfinite(x.beta);
+  return fd_isfinite(x.alpha) && fd_isfinite(x.beta);
 }
 
 static int dfvc_inputs_ok(const dfvc_in_t *in) {
   return (in->law == DFVC_LAW_DEADBEAT || in->law == DFVC_LAW_PI) && dfvc_finite_ab(in->i_ab) &&
-         dfvc_finite_ab(in->v_ab_applied) && isfinite(in->theta_r) && isfinite(in->omega_r) &&
-         isfinite(in->v_dc) && isfinite(in->torque_ref) && isfinite(in->lambda_ref);
+         dfvc_finite_ab(in->v_ab_applied) && fd_isfinite(in->theta_r) && fd_isfinite(in->omega_r) &&
+         fd_isfinite(in->v_dc) && fd_isfinite(in->torque_ref) && fd_isfinite(in->lambda_ref);
 }
 
 void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
@@ -106,7 +108,7 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
   dfvc_refs_update(&c->refs, &ri, &r);
 
   /* the linear range of the min-max modulator */
-  const float v_max = fmaxf(in->v_dc, 0.0f) * DFVC_INV_SQRT3;
+  const float v_max = fd_maxf(in->v_dc, 0.0f) * DFVC_INV_SQRT3;
   dq_t v_dqs;
   uint32_t lim = r.limits;
   if (in->law == DFVC_LAW_DEADBEAT) {
@@ -159,7 +161,7 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
   const ab_t i2 = current_predictor_step(&c->mpe, i1, v_ab, theta_r1, in->omega_r);
 
   if (!(dfvc_finite_ab(v_ab) && dfvc_finite_ab(i2) && dfvc_finite_ab(o.lambda_next) &&
-        isfinite(r.lambda_ref) && isfinite(r.iqs_ref))) {
+        fd_isfinite(r.lambda_ref) && fd_isfinite(r.iqs_ref))) {
     dfvc_reset(c);
     memset(out, 0, sizeof(*out));
     out->fault = DFVC_FAULT_STATE;

@@ -6,14 +6,17 @@
 #include <math.h>
 #include <string.h>
 
+#include "math/fast_trig.h"
+#include "math/fd_math.h"
+
 static int dfvc_deadbeat_pos(float x) {
-  return isfinite(x) && x > 0.0f;
+  return fd_isfinite(x) && x > 0.0f;
 }
 
 int dfvc_deadbeat_init(dfvc_deadbeat_t *db, const dfvc_deadbeat_cfg_t *cfg) {
   memset(db, 0, sizeof(*db));
   const dfvc_deadbeat_cfg_t *c = cfg;
-  if (!(isfinite(c->rs) && c->rs >= 0.0f && dfvc_deadbeat_pos(c->ls) &&
+  if (!(fd_isfinite(c->rs) && c->rs >= 0.0f && dfvc_deadbeat_pos(c->ls) &&
         dfvc_deadbeat_pos(c->lambda_m) && dfvc_deadbeat_pos(c->ts) &&
         dfvc_deadbeat_pos(c->v_sd_max))) {
     return -1;
@@ -35,9 +38,12 @@ float dfvc_deadbeat_omega_delta_target(const dfvc_deadbeat_t *db, float iqs_ref,
    * + Ls (i_qs* - i_qs(t+1)) / lambda_m. With exact parameters this is
    * asin(Ls i_qs* / lambda_m); with detuned ones the error scales the step
    * only and vanishes in steady state (no bias on v_qs). */
-  float s = sinf(delta_next) + db->cfg.ls * (iqs_ref - iqs_next) / db->cfg.lambda_m;
-  s = fminf(fmaxf(s, -1.0f), 1.0f);
-  return frames_wrap_pi(asinf(s) - delta_next) * db->inv_ts;
+  float sd;
+  float cd;
+  fd_sincosf(delta_next, &sd, &cd);
+  const float s = sd + db->cfg.ls * (iqs_ref - iqs_next) / db->cfg.lambda_m;
+  /* fd_asinf clamps s to [-1, 1] */
+  return frames_wrap_pi(fd_asinf(s) - delta_next) * db->inv_ts;
 }
 
 void dfvc_deadbeat_step(const dfvc_deadbeat_t *db, const dfvc_deadbeat_in_t *in,
@@ -53,14 +59,14 @@ void dfvc_deadbeat_step(const dfvc_deadbeat_t *db, const dfvc_deadbeat_in_t *in,
   out->v_dqs_raw.d = vd;
   out->v_dqs_raw.q = vq;
 
-  const float vmax = fmaxf(in->v_max, 0.0f);
-  const float vd_max = fminf(c->v_sd_max, vmax);
+  const float vmax = fd_maxf(in->v_max, 0.0f);
+  const float vd_max = fd_minf(c->v_sd_max, vmax);
   float vdl = vd;
   if (fabsf(vdl) > vd_max) {
     vdl = copysignf(vd_max, vdl);
     sat |= DFVC_DEADBEAT_SAT_D;
   }
-  const float vq_max = sqrtf(fmaxf(vmax * vmax - vdl * vdl, 0.0f));
+  const float vq_max = sqrtf(fd_maxf(vmax * vmax - vdl * vdl, 0.0f));
   float vql = vq;
   if (fabsf(vql) > vq_max) {
     vql = copysignf(vq_max, vql);

@@ -6,8 +6,10 @@
 #include <math.h>
 #include <string.h>
 
+#include "math/fd_math.h"
+
 static int dfvc_pi_pos(float x) {
-  return isfinite(x) && x > 0.0f;
+  return fd_isfinite(x) && x > 0.0f;
 }
 
 /* One PI step with limits [-lim, lim]; while pushed into a limit the
@@ -22,7 +24,7 @@ static float dfvc_pi_axis(float *integ, float kp, float ki, float ts, float err,
   } else {
     *integ += ki * ts * err;
   }
-  *integ = fminf(fmaxf(*integ, -lim - ff), lim - ff);
+  *integ = fd_minf(fd_maxf(*integ, -lim - ff), lim - ff);
   float y = kp * err + *integ + ff;
   *sat = 0;
   if (y > lim) {
@@ -38,7 +40,7 @@ static float dfvc_pi_axis(float *integ, float kp, float ki, float ts, float err,
 int dfvc_pi_init(dfvc_pi_t *c, const dfvc_pi_cfg_t *cfg) {
   memset(c, 0, sizeof(*c));
   const dfvc_pi_cfg_t *k = cfg;
-  if (!(isfinite(k->rs) && k->rs >= 0.0f && dfvc_pi_pos(k->ls) && dfvc_pi_pos(k->ts) &&
+  if (!(fd_isfinite(k->rs) && k->rs >= 0.0f && dfvc_pi_pos(k->ls) && dfvc_pi_pos(k->ts) &&
         dfvc_pi_pos(k->bw_flux) && dfvc_pi_pos(k->bw_iqs) && dfvc_pi_pos(k->v_sd_max))) {
     return -1;
   }
@@ -60,18 +62,18 @@ void dfvc_pi_reset(dfvc_pi_t *c) {
 
 void dfvc_pi_step(dfvc_pi_t *c, const dfvc_pi_in_t *in, dfvc_pi_out_t *out) {
   const dfvc_pi_cfg_t *k = &c->cfg;
-  const float vmax = fmaxf(in->v_max, 0.0f);
+  const float vmax = fd_maxf(in->v_max, 0.0f);
   int sd = 0;
   int sq = 0;
 
   /* flux loop on the d_s equation of Rubino 2020, eq. (16) */
-  const float vd_max = fminf(k->v_sd_max, vmax);
+  const float vd_max = fd_minf(k->v_sd_max, vmax);
   const float ff_d = k->rs * in->i_dqs.d;
   const float vd = dfvc_pi_axis(&c->integ_d, c->kp_flux, c->ki_flux, k->ts,
                                 in->lambda_ref - in->lambda_s, ff_d, vd_max, 0.0f, &sd);
 
   /* i_qs loop on Rubino 2020, eq. (32) */
-  const float vq_max = sqrtf(fmaxf(vmax * vmax - vd * vd, 0.0f));
+  const float vq_max = sqrtf(fd_maxf(vmax * vmax - vd * vd, 0.0f));
   const float ff_q = in->omega_r * in->lambda_s + in->omega_delta * k->ls * in->i_dqs.d;
   const float vq = dfvc_pi_axis(&c->integ_q, c->kp_iqs, c->ki_iqs, k->ts, in->iqs_ref - in->i_dqs.q,
                                 ff_q, vq_max, k->rs * in->i_dqs.q, &sq);

@@ -7,18 +7,21 @@
 #include <math.h>
 #include <string.h>
 
+#include "math/fast_trig.h"
+#include "math/fd_math.h"
+
 #define DFVC_REFS_INV_SQRT3 0.577350269189626f
 #define DFVC_REFS_HALF_PI   1.57079632679490f
 #define DFVC_REFS_W_MIN     1.0f /* floor of |omega_r| in (23) [rad/s] */
 
 static int dfvc_refs_pos(float x) {
-  return isfinite(x) && x > 0.0f;
+  return fd_isfinite(x) && x > 0.0f;
 }
 
 int dfvc_refs_init(dfvc_refs_t *r, const dfvc_refs_cfg_t *cfg) {
   memset(r, 0, sizeof(*r));
   const dfvc_refs_cfg_t *c = cfg;
-  if (!(isfinite(c->rs) && c->rs >= 0.0f && dfvc_refs_pos(c->ls) && dfvc_refs_pos(c->lambda_m) &&
+  if (!(fd_isfinite(c->rs) && c->rs >= 0.0f && dfvc_refs_pos(c->ls) && dfvc_refs_pos(c->lambda_m) &&
         dfvc_refs_pos(c->pole_pairs) && dfvc_refs_pos(c->i_max) && dfvc_refs_pos(c->delta_max) &&
         c->delta_max <= DFVC_REFS_HALF_PI && dfvc_refs_pos(c->lambda_min) &&
         dfvc_refs_pos(c->v_margin) && c->v_margin <= 1.0f)) {
@@ -31,13 +34,16 @@ int dfvc_refs_init(dfvc_refs_t *r, const dfvc_refs_cfg_t *cfg) {
 
 void dfvc_refs_reset(dfvc_refs_t *r) {
   /* Rubino 2020, eq. (26) */
-  r->iqs_max_delta = r->cfg.lambda_m / r->cfg.ls * sinf(r->cfg.delta_max);
+  float sd;
+  float cd;
+  fd_sincosf(r->cfg.delta_max, &sd, &cd);
+  r->iqs_max_delta = r->cfg.lambda_m / r->cfg.ls * sd;
   r->torque_mtpa_max = 1.5f * r->cfg.pole_pairs * r->cfg.lambda_m * r->cfg.i_max;
 }
 
 float dfvc_refs_lambda_mtpa(const dfvc_refs_t *r, float torque_ref) {
   const dfvc_refs_cfg_t *c = &r->cfg;
-  const float t = fminf(fabsf(torque_ref), r->torque_mtpa_max);
+  const float t = fd_minf(fabsf(torque_ref), r->torque_mtpa_max);
   /* Rubino 2020, eq. (22) */
   const float x = c->ls * t / (c->pole_pairs * c->lambda_m * c->lambda_m);
   return c->lambda_m * sqrtf(1.0f + (4.0f / 9.0f) * x * x);
@@ -46,7 +52,7 @@ float dfvc_refs_lambda_mtpa(const dfvc_refs_t *r, float torque_ref) {
 float dfvc_refs_lambda_vlim(const dfvc_refs_t *r, float v_dc, float omega_r, float i_ds,
                             float i_qs) {
   const dfvc_refs_cfg_t *c = &r->cfg;
-  const float vmax = fmaxf(v_dc, 0.0f) * DFVC_REFS_INV_SQRT3 * c->v_margin;
+  const float vmax = fd_maxf(v_dc, 0.0f) * DFVC_REFS_INV_SQRT3 * c->v_margin;
   const float rd = c->rs * i_ds;
   const float rad = vmax * vmax - rd * rd;
   if (rad <= 0.0f) {
@@ -55,7 +61,7 @@ float dfvc_refs_lambda_vlim(const dfvc_refs_t *r, float v_dc, float omega_r, flo
   const float sgn = (omega_r < 0.0f) ? -1.0f : 1.0f;
   /* Rubino 2020, eq. (23), with omega_s replaced by omega_r */
   const float num = sqrtf(rad) - c->rs * i_qs * sgn;
-  return fmaxf(num, 0.0f) / fmaxf(fabsf(omega_r), DFVC_REFS_W_MIN);
+  return fd_maxf(num, 0.0f) / fd_maxf(fabsf(omega_r), DFVC_REFS_W_MIN);
 }
 
 void dfvc_refs_update(const dfvc_refs_t *r, const dfvc_refs_in_t *in, dfvc_refs_out_t *out) {
@@ -96,7 +102,7 @@ void dfvc_refs_update(const dfvc_refs_t *r, const dfvc_refs_in_t *in, dfvc_refs_
     lim |= DFVC_REFS_IQS_DELTA;
   }
   out->iqs_ref = iq;
-  out->torque_max = 1.5f * c->pole_pairs * lref * fminf(out->iqs_max_i, out->iqs_max_delta);
+  out->torque_max = 1.5f * c->pole_pairs * lref * fd_minf(out->iqs_max_i, out->iqs_max_delta);
   out->torque_min = -out->torque_max;
   out->limits = lim;
 }

@@ -12,10 +12,12 @@
 
 #include <math.h>
 
+#include "math/fd_math.h"
+
 #define MOD_INV_SQRT3 0.577350269189626f
 
 float modulation_v_max(float v_dc) {
-  return (v_dc > 0.0f && isfinite(v_dc)) ? v_dc * MOD_INV_SQRT3 : 0.0f;
+  return (v_dc > 0.0f && fd_isfinite(v_dc)) ? v_dc * MOD_INV_SQRT3 : 0.0f;
 }
 
 static float mod_clamp01(float x) {
@@ -35,12 +37,12 @@ static float mod_min3(float a, float b, float c) {
 modulation_out_t modulation_minmax(ab_t v_ref, float v_dc) {
   modulation_out_t out = {{0.5f, 0.5f, 0.5f}, {0.0f, 0.0f}, 1};
   const float v_max = modulation_v_max(v_dc);
-  if (!(v_max > 0.0f) || !isfinite(v_ref.alpha) || !isfinite(v_ref.beta)) {
+  if (!(v_max > 0.0f) || !fd_isfinite(v_ref.alpha) || !fd_isfinite(v_ref.beta)) {
     return out; /* safe output: zero average voltage, flagged */
   }
   out.saturated = 0;
   const float mag = sqrtf(v_ref.alpha * v_ref.alpha + v_ref.beta * v_ref.beta);
-  if (!isfinite(mag)) {
+  if (!fd_isfinite(mag)) {
     out.saturated = 1; /* finite but huge components overflowed */
     return out;
   }

@@ -6,6 +6,8 @@
 
 #include <math.h>
 
+#include "math/fd_math.h"
+
 void speed_ctrl_init(speed_ctrl_t *sc, const speed_ctrl_cfg_t *cfg) {
   sc->cfg = *cfg;
   const float tm = fabsf(cfg->torque_max);
@@ -18,7 +20,7 @@ void speed_ctrl_reset(speed_ctrl_t *sc, float w_meas, float torque_now) {
   const float tm = sc->cfg.torque_max;
   pi_ctrl_set_limits(&sc->pi, -tm, tm);
   pi_ctrl_reset(&sc->pi, torque_now); /* zero error -> output = torque_now */
-  sc->w_ref_ramped = isfinite(w_meas) ? w_meas : 0.0f;
+  sc->w_ref_ramped = fd_isfinite(w_meas) ? w_meas : 0.0f;
 }
 
 /* Open loop (kp s + ki)/(J s^2): kp = J wb puts the crossover near wb, the
@@ -34,7 +36,7 @@ float speed_ctrl_update(speed_ctrl_t *sc, float w_ref, float w, float t_min, flo
   const float tm = sc->cfg.torque_max;
   const float step = sc->cfg.accel_max * sc->cfg.ts;
   const float w_prev = sc->w_ref_ramped;
-  if (isfinite(w_ref)) {
+  if (fd_isfinite(w_ref)) {
     const float dw = w_ref - sc->w_ref_ramped;
     if (dw > step) {
       sc->w_ref_ramped += step;

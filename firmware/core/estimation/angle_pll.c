@@ -9,6 +9,8 @@
 
 #include <math.h>
 
+#include "math/fd_math.h"
+
 void angle_pll_init(angle_pll_t *p, float bandwidth, float ts) {
   p->kp = 2.0f * bandwidth; /* zeta = 1 */
   p->ki = bandwidth * bandwidth;
@@ -18,13 +20,13 @@ void angle_pll_init(angle_pll_t *p, float bandwidth, float ts) {
 
 void angle_pll_reset(angle_pll_t *p, float theta, float omega) {
   p->theta = frames_wrap_pi(theta);
-  p->omega = isfinite(omega) ? omega : 0.0f;
+  p->omega = fd_isfinite(omega) ? omega : 0.0f;
   p->omega_rate = p->omega;
 }
 
 /* A non-finite measurement is skipped: the PLL coasts at its speed. */
 void angle_pll_update(angle_pll_t *p, float theta_meas) {
-  const float e = isfinite(theta_meas) ? frames_wrap_pi(theta_meas - p->theta) : 0.0f;
+  const float e = fd_isfinite(theta_meas) ? frames_wrap_pi(theta_meas - p->theta) : 0.0f;
   p->omega += p->ki * p->ts * e;
   p->omega_rate = p->omega + p->kp * e;
   p->theta = frames_wrap_pi(p->theta + p->ts * p->omega_rate);

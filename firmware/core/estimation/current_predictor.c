@@ -7,9 +7,11 @@
 #include <math.h>
 #include <string.h>
 
+#include "math/fd_math.h"
+
 int current_predictor_init(current_predictor_t *p, const current_predictor_cfg_t *cfg) {
   memset(p, 0, sizeof(*p));
-  if (!isfinite(cfg->lambda_m) || cfg->lambda_m < 0.0f ||
+  if (!fd_isfinite(cfg->lambda_m) || cfg->lambda_m < 0.0f ||
       (cfg->mode != CURRENT_PREDICTOR_EXACT && cfg->mode != CURRENT_PREDICTOR_EQ21)) {
     return -1;
   }

@@ -7,6 +7,9 @@
 #include <math.h>
 #include <string.h>
 
+#include "math/fast_trig.h"
+#include "math/fd_math.h"
+
 /* Amplitude and unit vector of a flux vector; a vanishing vector gets the
  * identity direction (theta = 0). */
 static float flux_observer_polar(ab_t x, sincos_t *sc) {
@@ -24,10 +27,10 @@ static float flux_observer_polar(ab_t x, sincos_t *sc) {
 int flux_observer_init(flux_observer_t *o, const flux_observer_cfg_t *cfg) {
   memset(o, 0, sizeof(*o));
   const flux_observer_cfg_t *c = cfg;
-  if (!(isfinite(c->rs) && c->rs >= 0.0f && isfinite(c->ls) && c->ls > 0.0f &&
-        isfinite(c->lambda_m) && c->lambda_m >= 0.0f && isfinite(c->pole_pairs) &&
-        c->pole_pairs > 0.0f && isfinite(c->ts) && c->ts > 0.0f && isfinite(c->omega_c) &&
-        c->omega_c >= 0.0f && isfinite(c->omega_s_bw) && c->omega_s_bw > 0.0f)) {
+  if (!(fd_isfinite(c->rs) && c->rs >= 0.0f && fd_isfinite(c->ls) && c->ls > 0.0f &&
+        fd_isfinite(c->lambda_m) && c->lambda_m >= 0.0f && fd_isfinite(c->pole_pairs) &&
+        c->pole_pairs > 0.0f && fd_isfinite(c->ts) && c->ts > 0.0f && fd_isfinite(c->omega_c) &&
+        c->omega_c >= 0.0f && fd_isfinite(c->omega_s_bw) && c->omega_s_bw > 0.0f)) {
     return -1;
   }
   o->cfg = *cfg;
@@ -61,7 +64,7 @@ void flux_observer_update(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, float
   out->lambda = lh;
   out->lambda_cm = lcm;
   out->lambda_s = flux_observer_polar(lh, &out->sc_s);
-  out->theta_s = atan2f(out->sc_s.s, out->sc_s.c);
+  out->theta_s = fd_atan2f(out->sc_s.s, out->sc_s.c);
 
   /* Fig. 3: back-EMF (resistive drop averaged over the period) plus the
    * current-model correction omega_c (lambda_cm - lambda_hat), then the one-step
@@ -75,11 +78,11 @@ void flux_observer_update(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, float
   ln.beta = lh.beta + c->ts * e.beta;
   out->lambda_next = ln;
   out->lambda_s_next = flux_observer_polar(ln, &out->sc_s_next);
-  out->theta_s_next = atan2f(out->sc_s_next.s, out->sc_s_next.c);
+  out->theta_s_next = fd_atan2f(out->sc_s_next.s, out->sc_s_next.c);
 
   /* flux-frame speed: filtered derivative of theta_s */
   if (!o->started) {
-    o->omega_s = isfinite(omega_r) ? omega_r : 0.0f;
+    o->omega_s = fd_isfinite(omega_r) ? omega_r : 0.0f;
   } else {
     const float raw = frames_wrap_pi(out->theta_s - o->theta_s_prev) / c->ts;
     o->omega_s += o->alpha_s * (raw - o->omega_s);

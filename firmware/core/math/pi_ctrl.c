@@ -17,6 +17,8 @@
 
 #include <math.h>
 
+#include "math/fd_math.h"
+
 static float pi_clamp(float x, float lo, float hi) {
   return (x > hi) ? hi : ((x < lo) ? lo : x);
 }
@@ -33,7 +35,7 @@ void pi_ctrl_init(pi_ctrl_t *pi, float kp, float ki, float ts, float out_min, fl
 
 /* Preset the integral (bumpless transfer: output = integ at zero error). */
 void pi_ctrl_reset(pi_ctrl_t *pi, float integ) {
-  pi->integ = isfinite(integ) ? pi_clamp(integ, pi->out_min, pi->out_max) : 0.0f;
+  pi->integ = fd_isfinite(integ) ? pi_clamp(integ, pi->out_min, pi->out_max) : 0.0f;
 }
 
 /* NaN limits are ignored (previous kept); crossed limits collapse to their
@@ -52,10 +54,10 @@ void pi_ctrl_set_limits(pi_ctrl_t *pi, float out_min, float out_max) {
 }
 
 float pi_ctrl_update(pi_ctrl_t *pi, float err, float ff) {
-  if (!isfinite(err)) {
+  if (!fd_isfinite(err)) {
     err = 0.0f; /* hold the integral, no proportional kick */
   }
-  if (!isfinite(ff)) {
+  if (!fd_isfinite(ff)) {
     ff = 0.0f;
   }
   const float p = pi->kp * err;
@@ -75,7 +77,7 @@ float pi_ctrl_update(pi_ctrl_t *pi, float err, float ff) {
   const float hi = pi->out_max - ff - ((p < 0.0f) ? p : 0.0f);
   const float lo = pi->out_min - ff - ((p > 0.0f) ? p : 0.0f);
   integ = pi_clamp(integ, lo, hi);
-  if (isfinite(integ)) {
+  if (fd_isfinite(integ)) {
     pi->integ = integ;
   }
   return pi_clamp(p + pi->integ + ff, pi->out_min, pi->out_max);

@@ -5,6 +5,8 @@
 
 #include <math.h>
 
+#include "math/fd_math.h"
+
 dq_t pmsm_flux(const pmsm_params_t *m, dq_t i) {
   dq_t l;
   l.d = m->ld * i.d + m->lambda_m;
@@ -21,7 +23,7 @@ float pmsm_torque(const pmsm_params_t *m, dq_t i) {
 /* id = 0: T = 3/2 p lambda_m iq. Zero when the machine has no magnet. */
 float pmsm_iq_for_torque(const pmsm_params_t *m, float t) {
   const float k = 1.5f * m->pole_pairs * m->lambda_m;
-  return (fabsf(k) > 1e-12f && isfinite(t)) ? t / k : 0.0f;
+  return (fabsf(k) > 1e-12f && fd_isfinite(t)) ? t / k : 0.0f;
 }
 
 /* Steady state (di/dt = 0): v = Rs i + we J lambda,

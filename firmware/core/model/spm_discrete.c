@@ -7,8 +7,11 @@
 #include <math.h>
 #include <string.h>
 
+#include "math/fast_trig.h"
+#include "math/fd_math.h"
+
 static int spm_discrete_valid(float x) {
-  return isfinite(x) && (x > 0.0f);
+  return fd_isfinite(x) && (x > 0.0f);
 }
 
 void spm_discrete_reset(spm_discrete_t *m) {
@@ -35,13 +38,16 @@ int spm_discrete_init(spm_discrete_t *m, float rs, float ls, float ts) {
 spm_discrete_coef_t spm_discrete_coef(const spm_discrete_t *m, float omega_xy) {
   spm_discrete_coef_t c;
   const float phi = omega_xy * m->ts; /* eq. (12) */
-  const float s = sinf(phi);
-  const float sh = sinf(0.5f * phi);
+  /* one sin/cos evaluation at phi/2: sin phi = 2 sh ch, 1 - cos phi = 2 sh^2 */
+  float sh;
+  float ch;
+  fd_sincosf(0.5f * phi, &sh, &ch);
+  const float vers = 2.0f * sh * sh;
   /* Rubino 2020, eq. (14) */
-  c.a_xx = m->ks * cosf(phi);
-  c.a_xy = m->ks * s;
+  c.a_xx = m->ks * (1.0f - vers);
+  c.a_xy = m->ks * (2.0f * sh * ch);
   /* 1 - a_xx without cancellation: (1 - k) + k (1 - cos phi) */
-  const float one_minus_axx = m->one_minus_k + 2.0f * m->ks * sh * sh;
+  const float one_minus_axx = m->one_minus_k + m->ks * vers;
   /* Rubino 2020, eq. (15); 1/Rs * f/(f^2 + w^2) written as 1/(Ls (f^2 + w^2)) */
   const float g = 1.0f / (m->ls * (m->fs * m->fs + omega_xy * omega_xy));
   c.b_xx = g * (m->fs * one_minus_axx + omega_xy * c.a_xy);

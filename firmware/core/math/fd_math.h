@@ -1,0 +1,33 @@
+/*
+ * fd_math.h - small float helpers for the ISR path, inlined: no libm call
+ * for a classification, a minimum or a clamp.
+ *
+ * newlib's isfinite() expands to a call of __fpclassifyf and fminf/fmaxf
+ * are library functions; these compile to a few instructions (VCMP, VSEL
+ * or a branch). NaN handling is explicit and documented per helper.
+ */
+#ifndef FD_MATH_FD_MATH_H
+#define FD_MATH_FD_MATH_H
+
+/* 1 if x is neither infinite nor NaN. */
+static inline int fd_isfinite(float x) {
+  return __builtin_isfinite(x);
+}
+
+/* The smaller of a and b; b when a is NaN (as fminf). b must not be NaN. */
+static inline float fd_minf(float a, float b) {
+  return (a < b) ? a : b;
+}
+
+/* The larger of a and b; b when a is NaN (as fmaxf). b must not be NaN. */
+static inline float fd_maxf(float a, float b) {
+  return (a > b) ? a : b;
+}
+
+/* fd_minf(fd_maxf(x, lo), hi), i.e. fminf(fmaxf(x, lo), hi): lo for a NaN x,
+ * hi when lo > hi. lo and hi must not be NaN. */
+static inline float fd_clampf(float x, float lo, float hi) {
+  return fd_minf(fd_maxf(x, lo), hi);
+}
+
+#endif

@@ -86,8 +86,9 @@ void plant_step(plant_t *pl, const double duty[3], bool gates_on) {
   plant_mech_input_refresh(pl);
   double x[X_N] = {pl->lambda_d, pl->lambda_q, pl->theta_m, pl->omega_m, pl->v_dc, 0, 0, 0, 0};
   const int avg = pl->p.inverter.model == PLANT_INV_AVERAGE;
+  double cs_end[2] = {NAN, NAN}; /* cos, sin of the end angle (average model) */
   if (gates_on && avg) {
-    plant_inverter_avg_period(pl, d, x);
+    plant_inverter_avg_period(pl, d, x, cs_end);
     for (int j = 0; j < 3; j++) {
       pl->aux.cond[j] = -1; /* all legs driven: no diode state */
     }
@@ -113,6 +114,17 @@ void plant_step(plant_t *pl, const double duty[3], bool gates_on) {
   pl->t = (double)pl->aux.n_steps * ts;
   if (pl->p.mech.mode == PLANT_MECH_IMPOSED) {
     pl->omega_m = plant_mech_input(pl, pl->t); /* exactly the profile */
+  }
+  /* The true currents of the new state, for plant_sample, the metrics and
+   * the next period. cos/sin of the new rotor angle: carried from the
+   * period's reference by the integrator when the angle did not wrap (then
+   * pole_pairs * theta_m is exactly the angle they belong to), from libm
+   * otherwise and every PLANT_CARRY_MAX periods. */
+  if (!isnan(cs_end[0]) && pl->theta_m == x[X_TH] && ++pl->aux.carry_n < PLANT_CARRY_MAX) {
+    plant_machine_cur_fill(pl, &pl->aux.cur, cs_end[0], cs_end[1]);
+  } else {
+    pl->aux.carry_n = 0;
+    plant_machine_cur_compute(pl, &pl->aux.cur);
   }
 }
 

@@ -100,6 +100,8 @@ typedef struct {
   double i_dc;         /* period-average DC-link current drawn [A] */
 } plant_state_t;
 
+#define PLANT_ZIG_N 128 /* layers of the ziggurat normal generator */
+
 /* True currents of one state, cached (plant_machine.c): valid while the
  * state equals the key (lambda_d, lambda_q, theta_m) bit for bit. */
 typedef struct {
@@ -139,9 +141,12 @@ typedef struct {
    * t in [m_t0, m_t1) */
   double m_val, m_t0, m_t1;
   plant_cur_cache_t cur;
+  int carry_n; /* periods since cur's cos/sin last came from libm */
   /* sensor constants (plant_sensors.c) */
   double adc_levels, adc_ilsb, adc_vlsb, enc_step;
-  double noise[4]; /* standard normals for the next sample (plant_sensors.c) */
+  /* ziggurat tables of the noise generator (plant_sensors.c) */
+  uint32_t zig_k[PLANT_ZIG_N];
+  double zig_w[PLANT_ZIG_N], zig_f[PLANT_ZIG_N];
 } plant_aux_t;
 
 typedef struct {

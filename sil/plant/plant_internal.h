@@ -14,6 +14,11 @@
 #define PLANT_TWO_PI    6.28318530717958647692
 #define PLANT_SQRT3_2   0.86602540378443864676 /* sqrt(3)/2 */
 #define PLANT_INV_SQRT3 0.57735026918962576451 /* 1/sqrt(3) */
+/* Periods over which cos/sin of the rotor angle are carried by angle
+ * addition from one period to the next (plant_step) before libm
+ * recomputes them: each carry adds ~2 ulp, so they stay within ~1e-14 of
+ * libm's values. */
+#define PLANT_CARRY_MAX 16
 
 /* Integration state vector. The last four entries are integrals over the
  * period (reset to 0 at its start) from which the period averages are taken. */
@@ -53,8 +58,8 @@ static inline void plant_mech_input_refresh(plant_t *pl) {
     return;
   }
   const plant_mech_t *m = &pl->p.mech;
-  a->m_val = profile_eval_span(m->mode == PLANT_MECH_IMPOSED ? &m->speed : &m->load_torque, t,
-                               &a->m_t1);
+  a->m_val =
+      profile_eval_span(m->mode == PLANT_MECH_IMPOSED ? &m->speed : &m->load_torque, t, &a->m_t1);
   a->m_t0 = t;
 }
 
@@ -97,8 +102,10 @@ static inline double plant_dclink_deriv(const plant_t *pl, const double *x, doub
 
 /* plant_machine.c */
 int plant_machine_check(const plant_machine_t *m, const char **field);
-/* True currents of the present state, computed into c (keyed on it). */
+/* True currents of the present state, computed into c (keyed on it);
+ * _fill with co, si = cos, sin(pole_pairs * theta_m) already known. */
 void plant_machine_cur_compute(const plant_t *pl, plant_cur_cache_t *c);
+void plant_machine_cur_fill(const plant_t *pl, plant_cur_cache_t *c, double co, double si);
 static inline int plant_machine_cur_fresh(const plant_t *pl) {
   const plant_cur_cache_t *c = &pl->aux.cur;
   return c->key[0] == pl->lambda_d && c->key[1] == pl->lambda_q && c->key[2] == pl->theta_m;
@@ -116,7 +123,7 @@ void plant_machine_zero_phase_current(const plant_t *pl, double *x, int leg);
 /* plant_inverter.c, plant_inverter_avg.c, plant_inverter_sw.c */
 int plant_inverter_check(const plant_inverter_t *inv, double ts, const char **field);
 void plant_inverter_init(plant_t *pl);
-void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x);
+void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, double cs_end[2]);
 void plant_inverter_sw_period(plant_t *pl, const double duty[3], bool gates_on, double *x);
 
 /* plant_dclink.c */

@@ -64,19 +64,19 @@ static inline void stage_cos_sin(const angle_ref_t *r, double th, double *c, dou
 typedef struct {
   double pp, lm, inv_ld, inv_lq, rs, nb, b, inv_j, vsrc, inv_r, inv_c;
   double d[3], kd[3]; /* duties; td/Ts for a switching leg (0 < d < 1), else 0 */
-  int imposed, ideal;
+  int imposed, ideal; /* mech.mode == IMPOSED, dclink.kind == IDEAL */
 } avg_k_t;
 
 /* Derivative at one stage, c and s being cos and sin of the stage's rotor
  * angle. The same expressions as plant_internal.h's inline mechanics and
  * DC link, with the parameters hoisted. */
-static inline void avg_deriv(const avg_k_t *restrict k, double c, double s,
+static inline void avg_deriv(const avg_k_t *restrict k, int ideal, int imposed, double c, double s,
                              const double *restrict x, double m, double *restrict dx) {
   const double id = (x[X_LD] - k->lm) * k->inv_ld;
   const double iq = x[X_LQ] * k->inv_lq;
   const double ial = id * c - iq * s, ibe = id * s + iq * c;
   const double ia = ial, ib = -0.5 * ial + PLANT_SQRT3_2 * ibe, ic = -ia - ib;
-  const double vdc = k->ideal ? k->vsrc : (x[X_VC] > 0.0 ? x[X_VC] : 0.0);
+  const double vdc = ideal ? k->vsrc : (x[X_VC] > 0.0 ? x[X_VC] : 0.0);
   const double nb = k->nb;
   const double da = eff_duty(k->d[0], k->kd[0], ia * nb);
   const double db = eff_duty(k->d[1], k->kd[1], ib * nb);
@@ -86,11 +86,11 @@ static inline void avg_deriv(const avg_k_t *restrict k, double c, double s,
   const double van = va0 - vn, vbn = vb0 - vn;
   const double vbe = (vb0 - vc0) * PLANT_INV_SQRT3;
   const double vd = van * c + vbe * s, vq = -van * s + vbe * c;
-  const double w = k->imposed ? m : x[X_W];
+  const double w = imposed ? m : x[X_W];
   const double we = k->pp * w;
   dx[X_LD] = vd - k->rs * id + we * x[X_LQ];
   dx[X_LQ] = vq - k->rs * iq - we * x[X_LD];
-  if (k->imposed) {
+  if (imposed) {
     dx[X_TH] = m;
     dx[X_W] = 0.0;
   } else {
@@ -99,7 +99,7 @@ static inline void avg_deriv(const avg_k_t *restrict k, double c, double s,
     dx[X_W] = (te - k->b * x[X_W] - m) * k->inv_j;
   }
   const double idc = da * ia + db * ib + dc * ic;
-  dx[X_VC] = k->ideal ? 0.0 : ((k->vsrc - x[X_VC]) * k->inv_r - idc) * k->inv_c;
+  dx[X_VC] = ideal ? 0.0 : ((k->vsrc - x[X_VC]) * k->inv_r - idc) * k->inv_c;
   dx[X_VA] = van;
   dx[X_VB] = vbn;
   dx[X_VN] = vn - 0.5 * vdc;
@@ -117,12 +117,11 @@ static inline void avg_deriv(const avg_k_t *restrict k, double c, double s,
  * identically zero (v_C on an ideal link, w under imposed speed) are left
  * as they are: x + h * 0 = x, the same result without the work. */
 static AVG_ALWAYS_INLINE void avg_rk4(const plant_t *pl, const avg_k_t *restrict kc, int ideal,
-                                      int imposed, angle_ref_t *restrict ar, double *restrict x) {
+                                      int imposed, angle_ref_t *restrict ar, double *restrict x,
+                                      double *restrict cs_end) {
   const int n = pl->p.inverter.substeps;
   const double h = pl->p.ts / n, h2 = 0.5 * h, h6 = h / 6.0;
-  avg_k_t k = *kc;
-  k.ideal = ideal;
-  k.imposed = imposed;
+  const avg_k_t *restrict k = kc; /* not copied: a copy of the just-written struct would stall */
   double t = pl->t;
   double m0 = plant_mech_input(pl, t);
   for (int j = 0; j < n; j++) {
@@ -131,28 +130,28 @@ static AVG_ALWAYS_INLINE void avg_rk4(const plant_t *pl, const avg_k_t *restrict
     double k1[X_N], k2[X_N], k3[X_N], k4[X_N], xs[X_N];
     double c, s;
     if (j > 0) { /* carry the reference angle: libm once per period at speed */
-      const double th = k.pp * x[X_TH];
+      const double th = k->pp * x[X_TH];
       stage_cos_sin(ar, th, &c, &s);
       ar->th = th;
       ar->c = c;
       ar->s = s;
     }
-    avg_deriv(&k, ar->c, ar->s, x, m0, k1);
+    avg_deriv(k, ideal, imposed, ar->c, ar->s, x, m0, k1);
     for (int i = 0; i < X_VA; i++) { /* the integrals X_VA.. are not read */
       xs[i] = x[i] + h2 * k1[i];
     }
-    stage_cos_sin(ar, k.pp * xs[X_TH], &c, &s);
-    avg_deriv(&k, c, s, xs, m1, k2);
+    stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
+    avg_deriv(k, ideal, imposed, c, s, xs, m1, k2);
     for (int i = 0; i < X_VA; i++) {
       xs[i] = x[i] + h2 * k2[i];
     }
-    stage_cos_sin(ar, k.pp * xs[X_TH], &c, &s);
-    avg_deriv(&k, c, s, xs, m1, k3);
+    stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
+    avg_deriv(k, ideal, imposed, c, s, xs, m1, k3);
     for (int i = 0; i < X_VA; i++) {
       xs[i] = x[i] + h * k3[i];
     }
-    stage_cos_sin(ar, k.pp * xs[X_TH], &c, &s);
-    avg_deriv(&k, c, s, xs, m2, k4);
+    stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
+    avg_deriv(k, ideal, imposed, c, s, xs, m2, k4);
     for (int i = 0; i < X_N; i++) {
       if ((ideal && i == X_VC) || (imposed && i == X_W)) {
         continue;
@@ -165,13 +164,16 @@ static AVG_ALWAYS_INLINE void avg_rk4(const plant_t *pl, const avg_k_t *restrict
     }
     m0 = m2;
   }
+  stage_cos_sin(ar, k->pp * x[X_TH], &cs_end[0], &cs_end[1]);
 }
 
 /* One period with gates on: `substeps` classical RK4 steps. x holds the
  * state at the period start (integrals zeroed) and returns it at the end.
  * The first stage of each step is at the reference angle itself (cos and
- * sin known: from the plant's current cache for the first step). */
-void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x) {
+ * sin known: from the plant's current cache for the first step). cs_end
+ * returns cos and sin of pole_pairs * x[X_TH] at the end, carried from the
+ * last reference like the stage angles (plant_step decides their use). */
+void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, double cs_end[2]) {
   const plant_params_t *p = &pl->p;
   avg_k_t k;
   k.pp = (double)p->machine.pole_pairs;
@@ -203,8 +205,8 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x) {
     ar.s = sin(ar.th);
   }
   if (k.ideal && !k.imposed) {
-    avg_rk4(pl, &k, 1, 0, &ar, x); /* the usual case */
+    avg_rk4(pl, &k, 1, 0, &ar, x, cs_end); /* the usual case */
   } else {
-    avg_rk4(pl, &k, k.ideal, k.imposed, &ar, x);
+    avg_rk4(pl, &k, k.ideal, k.imposed, &ar, x, cs_end);
   }
 }

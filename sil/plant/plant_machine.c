@@ -35,14 +35,13 @@ int plant_machine_check(const plant_machine_t *m, const char **field) {
   return 0;
 }
 
-void plant_machine_cur_compute(const plant_t *pl, plant_cur_cache_t *c) {
+void plant_machine_cur_fill(const plant_t *pl, plant_cur_cache_t *c, double co, double si) {
   c->key[0] = pl->lambda_d;
   c->key[1] = pl->lambda_q;
   c->key[2] = pl->theta_m;
   c->th_e = pl->p.machine.pole_pairs * pl->theta_m;
   const double id = (pl->lambda_d - pl->p.machine.lambda_m) * pl->aux.inv_ld;
   const double iq = pl->lambda_q * pl->aux.inv_lq;
-  const double co = cos(c->th_e), si = sin(c->th_e);
   const double ia = id * co - iq * si, ib = id * si + iq * co;
   c->c = co;
   c->s = si;
@@ -51,6 +50,11 @@ void plant_machine_cur_compute(const plant_t *pl, plant_cur_cache_t *c) {
   c->i_abc[0] = ia;
   c->i_abc[1] = -0.5 * ia + PLANT_SQRT3_2 * ib;
   c->i_abc[2] = -0.5 * ia - PLANT_SQRT3_2 * ib;
+}
+
+void plant_machine_cur_compute(const plant_t *pl, plant_cur_cache_t *c) {
+  const double th_e = pl->p.machine.pole_pairs * pl->theta_m;
+  plant_machine_cur_fill(pl, c, cos(th_e), sin(th_e));
 }
 
 /* Projects the flux state so that phase `leg`'s current is exactly zero,

@@ -108,7 +108,6 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
   plant_adc_t adc;
   plant_state_t st;
   plant_brief_t br; /* what the metrics need: cheaper than plant_state_t */
-  hal_adc_sample_t sample;
   /* encoder error and source voltage profiles, each constant until *_end */
   double enc_err = 0.0, enc_err_end = -INFINITY, v_src = 0.0, v_src_end = -INFINITY;
   const double t_start = wall_now();
@@ -143,8 +142,7 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
     if (!(t < enc_err_end)) {
       enc_err = profile_eval_span(&sc->encoder_error, t, &enc_err_end);
     }
-    to_hal_sample(&adc, enc_err, &sample);
-    hal.sample = sample;
+    to_hal_sample(&adc, enc_err, &hal.sample); /* in place: no copy of a just-written struct */
     /* 2. ISR */
     drive_isr(&drv);
     /* 3. observe */
@@ -170,7 +168,7 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
     }
     if (obs != NULL) {
       plant_get_state(&plant, &st);
-      sil_step_t s = {k, t, &st, &sample, &drv, sc, duty_active, hal.gates_on};
+      sil_step_t s = {k, t, &st, &hal.sample, &drv, sc, duty_active, hal.gates_on};
       obs(user, &s);
     }
     /* 4. plant over [t_k, t_k+1) */

@@ -3,8 +3,11 @@ set(FD_WARNINGS -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes
     -Wmissing-prototypes -Wconversion -Wno-sign-conversion)
 
 # The MCU core and app: single precision only (ARCHITECTURE.md, "Conventions").
+# -fno-math-errno: the core never reads errno, so sqrtf is the VSQRT.F32
+# instruction (x86: SQRTSS) instead of a libm call that sets errno for a
+# negative argument; results are IEEE-754 identical.
 set(FD_CORE_FLAGS ${FD_WARNINGS} -Wdouble-promotion -fsingle-precision-constant
-    -Wfloat-equal -Wvla)
+    -Wfloat-equal -Wvla -fno-math-errno)
 
 option(FD_SANITIZE "Build with address and undefined-behaviour sanitizers" OFF)
 if(FD_SANITIZE AND NOT CMAKE_CROSSCOMPILING)

@@ -95,6 +95,8 @@ static void ctrl_step_foc(ctrl_t *c, const ctrl_in_t *in, ctrl_out_t *out) {
   out->i_pred = frames_park_inv(i_ref, sc_next);
   out->torque_min = -t_lim;
   out->torque_max = t_lim;
+  out->fault = 0u;
+  out->tm = (ctrl_telemetry_t){0};
   out->tm.torque = pmsm_torque(&c->machine, i);
   const float flux_d = c->machine.ld * i.d + c->machine.lambda_m;
   const float flux_q = c->machine.lq * i.q;
@@ -116,7 +118,11 @@ static void ctrl_step_dfvc(ctrl_t *c, const ctrl_in_t *in, ctrl_out_t *out) {
   dfvc_step(&c->dfvc, &din, &d);
   out->v_ref = d.v_ab_ref;
   out->i_pred = d.i_ab_mid;
-  out->i_dq = frames_park(in->i_ab, frames_sincos(in->theta_e));
+  /* rotor-frame currents: from the law's sin/cos of theta_e unless it
+   * faulted before computing them */
+  out->i_dq = ((d.fault & (DFVC_FAULT_INPUT | DFVC_FAULT_STATE)) != 0u)
+                  ? frames_park(in->i_ab, frames_sincos(in->theta_e))
+                  : d.i_dq_r;
   out->torque_min = fd_maxf(d.torque_min, -c->torque_max);
   out->torque_max = fd_minf(d.torque_max, c->torque_max);
   out->fault = d.fault;
@@ -129,8 +135,8 @@ static void ctrl_step_dfvc(ctrl_t *c, const ctrl_in_t *in, ctrl_out_t *out) {
                                .torque = d.torque};
 }
 
+/* Each law writes every field of *out (no zeroing of the whole struct per ISR). */
 void ctrl_step(ctrl_t *c, const ctrl_in_t *in, ctrl_out_t *out) {
-  *out = (ctrl_out_t){0};
   switch (c->law) {
   case DRIVE_LAW_FOC:
     ctrl_step_foc(c, in, out);
@@ -140,6 +146,7 @@ void ctrl_step(ctrl_t *c, const ctrl_in_t *in, ctrl_out_t *out) {
     ctrl_step_dfvc(c, in, out);
     break;
   default:
+    *out = (ctrl_out_t){0};
     out->fault = 1u;
     break;
   }

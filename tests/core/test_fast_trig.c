@@ -185,8 +185,10 @@ static void test_asin(void **state) {
 
 int main(void) {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_sincos_accuracy), cmocka_unit_test(test_sincos_edges),
-      cmocka_unit_test(test_atan2_accuracy),  cmocka_unit_test(test_atan2_edges),
+      cmocka_unit_test(test_sincos_accuracy),
+      cmocka_unit_test(test_sincos_edges),
+      cmocka_unit_test(test_atan2_accuracy),
+      cmocka_unit_test(test_atan2_edges),
       cmocka_unit_test(test_asin),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

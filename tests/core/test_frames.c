@@ -114,6 +114,10 @@ static void test_wrap_pi(void **state) {
   ASSERT_NEAR(frames_wrap_pi(3.0f * pi), -pi, 1e-5);
   ASSERT_NEAR(frames_wrap_pi(NAN), 0.0, 0.0);
   ASSERT_NEAR(frames_wrap_pi(INFINITY), 0.0, 0.0);
+  /* beyond the integer floor's range (floorf) and across it */
+  ASSERT_IN(frames_wrap_pi(3e9f), -pi, pi);
+  ASSERT_IN(frames_wrap_pi(-3e9f), -pi, pi);
+  ASSERT_NEAR(sin((double)frames_wrap_pi(-131.5f)), sin(-131.5), 1e-5);
   /* sweep: always inside [-pi, pi) and the same direction */
   for (int k = -2000; k <= 2000; k++) {
     const float th = 0.01f * (float)k + 1e-4f;
@@ -143,12 +147,30 @@ static void test_wrap_2pi(void **state) {
   }
 }
 
+/* e^{j(a+b)} and e^{j(a-b)} as products of unit vectors agree with the
+ * sin/cos of the summed angle. */
+static void test_sincos_add_sub(void **state) {
+  (void)state;
+  for (int k = -60; k <= 60; k++) {
+    const double a = 0.107 * k;
+    const double b = 0.0131 * k - 0.4;
+    const sincos_t sa = frames_sincos((float)a);
+    const sincos_t sb = frames_sincos((float)b);
+    const sincos_t p = frames_sincos_add(sa, sb);
+    const sincos_t m = frames_sincos_sub(sa, sb);
+    ASSERT_NEAR(p.s, sin((double)(float)a + (double)(float)b), 5e-7);
+    ASSERT_NEAR(p.c, cos((double)(float)a + (double)(float)b), 5e-7);
+    ASSERT_NEAR(m.s, sin((double)(float)a - (double)(float)b), 5e-7);
+    ASSERT_NEAR(m.c, cos((double)(float)a - (double)(float)b), 5e-7);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_clarke_balanced),   cmocka_unit_test(test_clarke_known),
       cmocka_unit_test(test_clarke_round_trip), cmocka_unit_test(test_park_known_angles),
       cmocka_unit_test(test_park_round_trip),   cmocka_unit_test(test_wrap_pi),
-      cmocka_unit_test(test_wrap_2pi),
+      cmocka_unit_test(test_wrap_2pi),          cmocka_unit_test(test_sincos_add_sub),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

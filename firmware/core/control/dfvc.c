@@ -72,31 +72,44 @@ void dfvc_reset(dfvc_t *c) {
   c->last_law = DFVC_LAW_DEADBEAT;
 }
 
-static int dfvc_finite_ab(ab_t x) {
-  return fd_isfinite(x.alpha) && fd_isfinite(x.beta);
+/* 0 for a finite vector, NaN otherwise (fd_zero_if_finite) */
+static inline float dfvc_zero_if_finite_ab(ab_t x) {
+  return fd_zero_if_finite(x.alpha) + fd_zero_if_finite(x.beta);
 }
 
 static int dfvc_inputs_ok(const dfvc_in_t *in) {
-  return (in->law == DFVC_LAW_DEADBEAT || in->law == DFVC_LAW_PI) && dfvc_finite_ab(in->i_ab) &&
-         dfvc_finite_ab(in->v_ab_applied) && fd_isfinite(in->theta_r) && fd_isfinite(in->omega_r) &&
-         fd_isfinite(in->v_dc) && fd_isfinite(in->torque_ref) && fd_isfinite(in->lambda_ref);
+  const float z = dfvc_zero_if_finite_ab(in->i_ab) + dfvc_zero_if_finite_ab(in->v_ab_applied) +
+                  fd_zero_if_finite(in->theta_r) + fd_zero_if_finite(in->omega_r) +
+                  fd_zero_if_finite(in->v_dc) + fd_zero_if_finite(in->torque_ref) +
+                  fd_zero_if_finite(in->lambda_ref);
+  return (in->law == DFVC_LAW_DEADBEAT || in->law == DFVC_LAW_PI) && fd_isfinite(z);
 }
 
 void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
   const dfvc_cfg_t *k = &c->cfg;
-  memset(out, 0, sizeof(*out));
+  /* every field of *out is written below (no zeroing per ISR); the fault
+   * paths clear it */
   if (!dfvc_inputs_ok(in)) {
+    memset(out, 0, sizeof(*out));
     out->fault = DFVC_FAULT_INPUT;
     return;
   }
 
+  /* One sin/cos of the rotor angle and one of the rotation over a period
+   * (with the model's coefficients) per ISR; the other angles' sin/cos are
+   * products of these unit vectors. */
+  current_predictor_speed_t w;
+  current_predictor_speed(&c->mpe, in->omega_r, &w);
+  const sincos_t scr = frames_sincos(in->theta_r);
+  const sincos_t scr1 = frames_sincos_add(scr, w.rot); /* theta_r(tau+1) */
+
   /* MPE, eq. (21): current at tau+1 */
-  const ab_t i1 =
-      current_predictor_step(&c->mpe, in->i_ab, in->v_ab_applied, in->theta_r, in->omega_r);
+  const ab_t i1 = current_predictor_step_sc(&c->mpe, &w, in->i_ab, in->v_ab_applied, scr);
 
   /* stator flux at tau and its prediction at tau+1, Fig. 3, eqs. (19)-(20) */
   flux_observer_out_t o;
-  flux_observer_update(&c->obs, in->i_ab, i1, in->v_ab_applied, in->theta_r, in->omega_r, &o);
+  flux_observer_update_sc(&c->obs, in->i_ab, i1, in->v_ab_applied, in->theta_r, scr, in->omega_r,
+                          &o);
   const float theta_r1 = in->theta_r + in->omega_r * k->ts;
   const dq_t i1_dqs = frames_park(i1, o.sc_s_next);
   const float delta1 = frames_wrap_pi(o.theta_s_next - theta_r1);
@@ -119,7 +132,8 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
     di.i_dqs_next = i1_dqs;
     di.omega_r = in->omega_r;
     di.omega_delta = (k->omega_delta_mode == DFVC_OMEGA_DELTA_TARGET)
-                         ? dfvc_deadbeat_omega_delta_target(&c->db, r.iqs_ref, i1_dqs.q, delta1)
+                         ? dfvc_deadbeat_omega_delta_target_sc(&c->db, r.iqs_ref, i1_dqs.q, delta1,
+                                                               frames_sincos_sub(o.sc_s_next, scr1))
                          : frames_wrap_pi(delta1 - o.delta) / k->ts;
     di.v_max = v_max;
     dfvc_deadbeat_out_t dout;
@@ -158,10 +172,12 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
   const ab_t v_ab = frames_park_inv(v_dqs, scv);
 
   /* double-step prediction (section IV.B): current at tau+2 under v_ab */
-  const ab_t i2 = current_predictor_step(&c->mpe, i1, v_ab, theta_r1, in->omega_r);
+  const ab_t i2 = current_predictor_step_sc(&c->mpe, &w, i1, v_ab, scr1);
 
-  if (!(dfvc_finite_ab(v_ab) && dfvc_finite_ab(i2) && dfvc_finite_ab(o.lambda_next) &&
-        fd_isfinite(r.lambda_ref) && fd_isfinite(r.iqs_ref))) {
+  const float z = dfvc_zero_if_finite_ab(v_ab) + dfvc_zero_if_finite_ab(i2) +
+                  dfvc_zero_if_finite_ab(o.lambda_next) + fd_zero_if_finite(r.lambda_ref) +
+                  fd_zero_if_finite(r.iqs_ref);
+  if (!fd_isfinite(z)) {
     dfvc_reset(c);
     memset(out, 0, sizeof(*out));
     out->fault = DFVC_FAULT_STATE;
@@ -183,6 +199,7 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
   out->i_qs = o.i_dqs.q;
   out->i_qs_ref = r.iqs_ref;
   out->i_qs_pred = i1_dqs.q;
+  out->i_dq_r = frames_park(in->i_ab, scr);
   out->torque = o.torque;
   /* torque at tau+1, eq. (16) */
   out->torque_pred = 1.5f * k->pole_pairs * o.lambda_s_next * i1_dqs.q;

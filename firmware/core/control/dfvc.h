@@ -137,6 +137,7 @@ typedef struct {
   float i_ds, i_qs;             /* stator-flux frame currents [A] */
   float i_qs_ref;               /* limited i_qs* [A] */
   float i_qs_pred;              /* predicted at tau+1 [A] */
+  dq_t i_dq_r;                  /* rotor-frame currents at tau (telemetry) [A] */
   float torque;                 /* 3/2 p lambda_s i_qs [N m] */
   float torque_pred;            /* predicted at tau+1 [N m] */
   float torque_min, torque_max; /* deliverable now [N m] (dfvc_refs.h) */

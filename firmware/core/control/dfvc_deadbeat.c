@@ -33,17 +33,29 @@ void dfvc_deadbeat_reset(dfvc_deadbeat_t *db) {
 
 float dfvc_deadbeat_omega_delta_target(const dfvc_deadbeat_t *db, float iqs_ref, float iqs_next,
                                        float delta_next) {
+  return dfvc_deadbeat_omega_delta_target_sc(db, iqs_ref, iqs_next, delta_next,
+                                             frames_sincos(delta_next));
+}
+
+float dfvc_deadbeat_omega_delta_target_sc(const dfvc_deadbeat_t *db, float iqs_ref, float iqs_next,
+                                          float delta_next, sincos_t sc_delta) {
   /* q_s row of Rubino 2020, eq. (16): Ls i_qs = lambda_m sin(delta), used
    * incrementally from the predicted state: sin(delta*) = sin(delta(t+1))
    * + Ls (i_qs* - i_qs(t+1)) / lambda_m. With exact parameters this is
    * asin(Ls i_qs* / lambda_m); with detuned ones the error scales the step
    * only and vanishes in steady state (no bias on v_qs). */
-  float sd;
-  float cd;
-  fd_sincosf(delta_next, &sd, &cd);
-  const float s = sd + db->cfg.ls * (iqs_ref - iqs_next) / db->cfg.lambda_m;
-  /* fd_asinf clamps s to [-1, 1] */
-  return frames_wrap_pi(fd_asinf(s) - delta_next) * db->inv_ts;
+  const float sd = sc_delta.s;
+  const float s = fd_clampf(sd + db->cfg.ls * (iqs_ref - iqs_next) / db->cfg.lambda_m, -1.0f, 1.0f);
+  if (!(sc_delta.c >= 0.0f)) {
+    /* |delta(t+1)| > pi/2, beyond the principal branch of asin */
+    return frames_wrap_pi(fd_asinf(s) - delta_next) * db->inv_ts;
+  }
+  /* delta* - delta(t+1) = asin(s) - asin(sin delta(t+1)) as the angle of
+   * e^{j asin(s)} e^{-j asin(sd)}: one atan2, no sin -> asin round trip,
+   * and exactly 0 in steady state (s = sd) */
+  const float qs = sqrtf((1.0f - s) * (1.0f + s));
+  const float qd = sqrtf(fd_maxf((1.0f - sd) * (1.0f + sd), 0.0f));
+  return fd_atan2f(s * qd - sd * qs, qs * qd + s * sd) * db->inv_ts;
 }
 
 void dfvc_deadbeat_step(const dfvc_deadbeat_t *db, const dfvc_deadbeat_in_t *in,

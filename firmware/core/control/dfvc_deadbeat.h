@@ -71,6 +71,9 @@ void dfvc_deadbeat_reset(dfvc_deadbeat_t *db);
 /* (delta* - delta_next)/Ts, delta* = asin(Ls i_qs* / lambda_m) [rad/s]. */
 float dfvc_deadbeat_omega_delta_target(const dfvc_deadbeat_t *db, float iqs_ref, float iqs_next,
                                        float delta_next);
+/* The same with sc_delta = (sin, cos) of delta_next given by the caller. */
+float dfvc_deadbeat_omega_delta_target_sc(const dfvc_deadbeat_t *db, float iqs_ref, float iqs_next,
+                                          float delta_next, sincos_t sc_delta);
 /* Eqs. (29) and (33) with the limits. */
 void dfvc_deadbeat_step(const dfvc_deadbeat_t *db, const dfvc_deadbeat_in_t *in,
                         dfvc_deadbeat_out_t *out);

@@ -48,4 +48,19 @@ void current_predictor_reset(current_predictor_t *p);
 ab_t current_predictor_step(const current_predictor_t *p, ab_t i, ab_t v, float theta_r,
                             float omega_r);
 
+/* What the predictions at one rotor speed share, computed once per ISR:
+ * the coefficients (12)-(15) at omega_r and the rotation over a period. */
+typedef struct {
+  float omega_r;            /* [rad/s] */
+  spm_discrete_coef_t coef; /* eqs. (14)-(15) at omega_xy = omega_r */
+  sincos_t rot;             /* e^{j omega_r Ts} */
+} current_predictor_speed_t;
+
+void current_predictor_speed(const current_predictor_t *p, float omega_r,
+                             current_predictor_speed_t *w);
+/* current_predictor_step() at the speed of w, with the rotor angle at t
+ * given by its sin and cos sc_r (no sin/cos evaluated). */
+ab_t current_predictor_step_sc(const current_predictor_t *p, const current_predictor_speed_t *w,
+                               ab_t i, ab_t v, sincos_t sc_r);
+
 #endif

@@ -49,8 +49,12 @@ void flux_observer_reset(flux_observer_t *o) {
 
 void flux_observer_update(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, float theta_r,
                           float omega_r, flux_observer_out_t *out) {
+  flux_observer_update_sc(o, i, i_next, v, theta_r, frames_sincos(theta_r), omega_r, out);
+}
+
+void flux_observer_update_sc(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, float theta_r,
+                             sincos_t scr, float omega_r, flux_observer_out_t *out) {
   const flux_observer_cfg_t *c = &o->cfg;
-  const sincos_t scr = frames_sincos(theta_r);
 
   /* current model, Rubino 2020, eq. (2) in (alpha, beta) */
   ab_t lcm;

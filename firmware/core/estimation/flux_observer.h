@@ -74,5 +74,8 @@ void flux_observer_reset(flux_observer_t *o);
  * angle [rad] and speed [rad/s] at t. */
 void flux_observer_update(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, float theta_r,
                           float omega_r, flux_observer_out_t *out);
+/* The same with sc_r = (sin, cos) of theta_r given by the caller. */
+void flux_observer_update_sc(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, float theta_r,
+                             sincos_t sc_r, float omega_r, flux_observer_out_t *out);
 
 #endif

@@ -27,19 +27,19 @@
 #define FD_TRIG_C1        1.5703125f
 #define FD_TRIG_C2        4.837512969970703125e-4f
 #define FD_TRIG_C3        7.54978995489188216e-8f
-#define FD_TRIG_S1        -1.6666654611e-1f
+#define FD_TRIG_S1        (-1.6666654611e-1f)
 #define FD_TRIG_S2        8.3321608736e-3f
-#define FD_TRIG_S3        -1.9515295891e-4f
+#define FD_TRIG_S3        (-1.9515295891e-4f)
 #define FD_TRIG_K1        4.166664568298827e-2f
-#define FD_TRIG_K2        -1.388731625493765e-3f
+#define FD_TRIG_K2        (-1.388731625493765e-3f)
 #define FD_TRIG_K3        2.443315711809948e-5f
 #define FD_TRIG_TAN_PI_8  0.414213562373095f
 #define FD_TRIG_PI        3.14159265358979f
 #define FD_TRIG_PI_2      1.57079632679490f
 #define FD_TRIG_PI_4      0.785398163397448f
-#define FD_TRIG_A1        -3.33329491539e-1f
+#define FD_TRIG_A1        (-3.33329491539e-1f)
 #define FD_TRIG_A2        1.99777106478e-1f
-#define FD_TRIG_A3        -1.38776856032e-1f
+#define FD_TRIG_A3        (-1.38776856032e-1f)
 #define FD_TRIG_A4        8.05374449538e-2f
 
 __attribute__((weak)) void fd_sincosf(float theta, float *s, float *c) {

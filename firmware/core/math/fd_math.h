@@ -14,6 +14,12 @@ static inline int fd_isfinite(float x) {
   return __builtin_isfinite(x);
 }
 
+/* 0 for a finite x, NaN for an infinite or NaN x (0 * x). A sum of these
+ * is finite only if every term's x is: one classification for many values. */
+static inline float fd_zero_if_finite(float x) {
+  return 0.0f * x;
+}
+
 /* The smaller of a and b; b when a is NaN (as fminf). b must not be NaN. */
 static inline float fd_minf(float a, float b) {
   return (a < b) ? a : b;

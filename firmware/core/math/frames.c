@@ -5,6 +5,7 @@
 #include "math/frames.h"
 
 #include <math.h>
+#include <stdint.h>
 
 #include "math/fd_math.h"
 
@@ -15,7 +16,20 @@ float frames_wrap_pi_slow(float theta) {
   if (!fd_isfinite(theta)) {
     return 0.0f;
   }
-  float r = theta - FRAMES_2PI * floorf((theta + FRAMES_PI) * FRAMES_INV_2PI);
+  /* r = theta - 2 pi floor(t): the floor by a conversion to an integer
+   * (exact, same value as floorf) while |t| < 2^30, floorf beyond */
+  const float t = (theta + FRAMES_PI) * FRAMES_INV_2PI;
+  float fl;
+  if (fabsf(t) < 1073741824.0f) {
+    const int32_t n = (int32_t)t; /* towards zero */
+    fl = (float)n;
+    if (fl > t) {
+      fl -= 1.0f;
+    }
+  } else {
+    fl = floorf(t);
+  }
+  float r = theta - FRAMES_2PI * fl;
   /* rounding can land just outside the half-open interval */
   if (r >= FRAMES_PI) {
     r -= FRAMES_2PI;

@@ -85,6 +85,22 @@ static inline ab_t frames_park_inv(dq_t x, sincos_t sc) {
   return y;
 }
 
+/* e^{j(a + b)} from e^{j a} and e^{j b} (one complex product; no sin/cos). */
+static inline sincos_t frames_sincos_add(sincos_t a, sincos_t b) {
+  sincos_t y;
+  y.s = a.s * b.c + a.c * b.s;
+  y.c = a.c * b.c - a.s * b.s;
+  return y;
+}
+
+/* e^{j(a - b)} from e^{j a} and e^{j b}. */
+static inline sincos_t frames_sincos_sub(sincos_t a, sincos_t b) {
+  sincos_t y;
+  y.s = a.s * b.c - a.c * b.s;
+  y.c = a.c * b.c + a.s * b.s;
+  return y;
+}
+
 /* frames_wrap_pi() beyond one turn either side, and non-finite input. */
 float frames_wrap_pi_slow(float theta);
 

@@ -36,6 +36,11 @@ int spm_discrete_init(spm_discrete_t *m, float rs, float ls, float ts) {
 }
 
 spm_discrete_coef_t spm_discrete_coef(const spm_discrete_t *m, float omega_xy) {
+  sincos_t rot;
+  return spm_discrete_coef_rot(m, omega_xy, &rot);
+}
+
+spm_discrete_coef_t spm_discrete_coef_rot(const spm_discrete_t *m, float omega_xy, sincos_t *rot) {
   spm_discrete_coef_t c;
   const float phi = omega_xy * m->ts; /* eq. (12) */
   /* one sin/cos evaluation at phi/2: sin phi = 2 sh ch, 1 - cos phi = 2 sh^2 */
@@ -44,8 +49,10 @@ spm_discrete_coef_t spm_discrete_coef(const spm_discrete_t *m, float omega_xy) {
   fd_sincosf(0.5f * phi, &sh, &ch);
   const float vers = 2.0f * sh * sh;
   /* Rubino 2020, eq. (14) */
-  c.a_xx = m->ks * (1.0f - vers);
-  c.a_xy = m->ks * (2.0f * sh * ch);
+  rot->c = 1.0f - vers;
+  rot->s = 2.0f * sh * ch;
+  c.a_xx = m->ks * rot->c;
+  c.a_xy = m->ks * rot->s;
   /* 1 - a_xx without cancellation: (1 - k) + k (1 - cos phi) */
   const float one_minus_axx = m->one_minus_k + m->ks * vers;
   /* Rubino 2020, eq. (15); 1/Rs * f/(f^2 + w^2) written as 1/(Ls (f^2 + w^2)) */

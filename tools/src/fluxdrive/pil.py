@@ -39,12 +39,13 @@ QEMU = "qemu-system-arm"
 
 #: Absolute tolerance on the duties (0..1). Both builds are IEEE-754 binary32
 #: without contraction (-std=c11 implies -ffp-contract=off on both) and
-#: agree bit for bit except where libm differs: glibc's sinf/cosf/atan2f/asinf
-#: (x86-64) and newlib's fdlibm float versions (Cortex-M4F) differ by 1-2 ulp.
-#: Those differences pass through the laws' gains (deadbeat: ~L/Ts, the
-#: inverse of the discrete model) and the modulator into the duties; with
-#: the applied voltage forced (docs/pil.md) they stay within a few tens of ulp
-#: of 1.0 (measured worst 2.4e-6). 2e-5 = ~170 ulp of 1.0 = 6 mV on 310 V.
+#: agree bit for bit except where a math library differs. The ISR path now
+#: uses the core's own trig (math/fast_trig.h) and VSQRT, and the measured
+#: deviation is 0; the tolerance stays for a CORDIC binding of fd_sincosf/
+#: fd_atan2f and compiler differences. With libm trig (glibc vs newlib, 1-2
+#: ulp apart) the duties differed by up to a few 1e-6 through the laws'
+#: gains (deadbeat: ~L/Ts) with the applied voltage forced (docs/pil.md).
+#: 2e-5 = ~170 ulp of 1.0 = 6 mV on 310 V.
 DUTY_TOL = 2e-5
 
 BUDGET_CYCLES = 10625  # 170 MHz / 16 kHz
@@ -85,6 +86,7 @@ BLOCKS = [
     ("modulation", ("modulation_",)),
     ("dead-time compensation", ("deadtime_comp_",)),
     ("frames (Clarke/Park, wrap)", ("frames_",)),
+    ("core trig fd_sincosf/fd_atan2f (math/fast_trig)", ("fd_",)),
     (
         "libm sinf/cosf (newlib)",
         ("sinf", "cosf", "__kernel_sinf", "__kernel_cosf", "__ieee754_rem_pio2f",

@@ -2,6 +2,7 @@
  * hal_pil.c - hal.h over a recorded input stream (see hal_pil.h).
  */
 #include "hal_pil.h"
+#include "hal_duty.h"
 
 #include "hal.h"
 
@@ -37,18 +38,10 @@ void hal_adc_read(hal_adc_sample_t *s) {
   *s = sample;
 }
 
-static float clamp01(float x) {
-  /* As hal/sil: NaN maps to 0.5 (no voltage). */
-  if (!(x >= 0.0f)) {
-    return x < 0.0f ? 0.0f : 0.5f;
-  }
-  return x > 1.0f ? 1.0f : x;
-}
-
 void hal_pwm_set_duty(float da, float db, float dc) {
-  duty[0] = clamp01(da);
-  duty[1] = clamp01(db);
-  duty[2] = clamp01(dc);
+  duty[0] = hal_duty_clamp01(da);
+  duty[1] = hal_duty_clamp01(db);
+  duty[2] = hal_duty_clamp01(dc);
 }
 
 void hal_pwm_enable(void) {

@@ -2,6 +2,7 @@
  * hal_sil.c - hal.h over a hal_sil_t context (see hal_sil.h).
  */
 #include "hal_sil.h"
+#include "hal_duty.h"
 
 #include <string.h>
 
@@ -20,18 +21,10 @@ void hal_adc_read(hal_adc_sample_t *s) {
   *s = bound->sample;
 }
 
-static float clamp01(float x) {
-  /* NaN compares false both ways: map it to 0.5 (no voltage). */
-  if (!(x >= 0.0f)) {
-    return x < 0.0f ? 0.0f : 0.5f;
-  }
-  return x > 1.0f ? 1.0f : x;
-}
-
 void hal_pwm_set_duty(float da, float db, float dc) {
-  bound->duty[0] = clamp01(da);
-  bound->duty[1] = clamp01(db);
-  bound->duty[2] = clamp01(dc);
+  bound->duty[0] = hal_duty_clamp01(da);
+  bound->duty[1] = hal_duty_clamp01(db);
+  bound->duty[2] = hal_duty_clamp01(dc);
 }
 
 void hal_pwm_enable(void) {

@@ -57,6 +57,7 @@ class Elf:
             self.segments.append(dict(type=p[0], offset=p[1], vaddr=p[2], paddr=p[3],
                                       filesz=p[4], memsz=p[5]))
         self.symbols = {}
+        self.binding = {}
         for s in self.sections:
             if s["type"] != SHT_SYMTAB:
                 continue
@@ -67,6 +68,7 @@ class Elf:
                 name = self._str(strs["offset"], name_off)
                 if name:
                     self.symbols[name] = (value, size)
+                    self.binding[name] = info >> 4  # 1 global, 2 weak
 
     def _str(self, base, off):
         end = self.data.index(b"\0", base + off)
@@ -163,6 +165,9 @@ def main(argv):
         a = addr(name)
         return a is not None and ccm_o <= a < ccm_o + ccm_l
 
+    # the core's trigonometry bound to the CORDIC (strong over weak)
+    for fn in ("fd_sincosf", "fd_atan2f"):
+        check(elf.binding.get(fn) == 1, "%s is the CORDIC binding (global, not the weak software one)" % fn)
     check(in_ccm("drive_isr"), "drive_isr in CCM SRAM (0x%08x)" % (addr("drive_isr") or 0))
     check(in_ccm("ADC1_2_IRQHandler"), "ADC1_2_IRQHandler in CCM SRAM")
     ccm = elf.section(".ccmram")

@@ -1,0 +1,19 @@
+/*
+ * cordic_bind.c - binds the core's trigonometry API (firmware/core/math/
+ * fast_trig.h) to the CORDIC co-processor: these strong definitions replace
+ * the core's weak software ones at link time (this file is an object of the
+ * firmware executable, not an archive member). Host, SIL and QEMU (PIL)
+ * builds keep the software versions. Accuracy: cordic.h (~6e-6 rad for
+ * atan2, ~2e-6 for sin/cos), against 2e-6 rad / 2e-7 in software.
+ * Selected by the CMake option FD_HW_CORDIC (default ON).
+ */
+#include "cordic.h"
+#include "math/fast_trig.h"
+
+void fd_sincosf(float theta, float *s, float *c) {
+  cordic_hw_sincosf(theta, s, c);
+}
+
+float fd_atan2f(float y, float x) {
+  return cordic_hw_atan2f(y, x);
+}

@@ -14,11 +14,14 @@
 #include "math/fd_math.h"
 #include "math/frames.h"
 
-#define TWO_PI_F 6.28318531f
-
-static void drive_trip(drive_t *drv, uint32_t bits) {
+/* All gates off, duties back to 50 % (no voltage when they come back). */
+static void drive_gates_off(void) {
   hal_pwm_disable();
   hal_pwm_set_duty(0.5f, 0.5f, 0.5f);
+}
+
+static void drive_trip(drive_t *drv, uint32_t bits) {
+  drive_gates_off();
   drv->faults |= bits;
   drv->state = DRIVE_STATE_FAULT;
 }
@@ -68,8 +71,7 @@ int drive_init(drive_t *drv, const drive_config_t *cfg, const char **field) {
   drv->torque_min_avail = -cfg->torque_max;
   drv->torque_max_avail = cfg->torque_max;
 
-  hal_pwm_disable();
-  hal_pwm_set_duty(0.5f, 0.5f, 0.5f);
+  drive_gates_off();
   return 0;
 }
 
@@ -139,7 +141,6 @@ static void drive_offset_cal(drive_t *drv, const hal_adc_sample_t *s) {
 }
 
 static void drive_run(drive_t *drv, const float i[3], float v_dc) {
-  const drive_config_t *c = &drv->cfg;
   ctrl_in_t in;
   in.i_ab = frames_clarke((abc_t){i[0], i[1], i[2]});
   in.theta_e = drv->pos.theta_e;
@@ -176,7 +177,6 @@ static void drive_run(drive_t *drv, const float i[3], float v_dc) {
   tm->torque_ref = in.torque_ref;
   tm->torque_est = out.tm.torque;
   tm->law_tm = out.tm;
-  (void)c;
 }
 
 void drive_isr(drive_t *drv) {
@@ -212,8 +212,7 @@ void drive_isr(drive_t *drv) {
     break;
   case DRIVE_STATE_RUN:
     if (!drv->ref.enable) {
-      hal_pwm_disable();
-      hal_pwm_set_duty(0.5f, 0.5f, 0.5f);
+      drive_gates_off();
       drv->state = DRIVE_STATE_IDLE;
     } else {
       drive_run(drv, i, s.v_dc);
@@ -313,7 +312,9 @@ bool drive_cmd_set_mode(drive_t *drv, drive_mode_t mode) {
   return true;
 }
 
-static float clampf(float x, float lo, float hi) {
+/* Command clamp: a non-finite command becomes 0 (not a limit, as
+ * fd_clampf would make it). */
+static float command_clamp(float x, float lo, float hi) {
   if (!fd_isfinite(x)) {
     return 0.0f;
   }
@@ -321,17 +322,17 @@ static float clampf(float x, float lo, float hi) {
 }
 
 void drive_cmd_torque(drive_t *drv, float torque) {
-  drv->cmd.torque = clampf(torque, -drv->cfg.torque_max, drv->cfg.torque_max);
+  drv->cmd.torque = command_clamp(torque, -drv->cfg.torque_max, drv->cfg.torque_max);
 }
 
 void drive_cmd_speed(drive_t *drv, float speed_m) {
-  drv->cmd.speed = clampf(speed_m, -drv->cfg.speed_max, drv->cfg.speed_max);
+  drv->cmd.speed = command_clamp(speed_m, -drv->cfg.speed_max, drv->cfg.speed_max);
 }
 
 void drive_cmd_current(drive_t *drv, float id, float iq) {
   float lim = drv->cfg.i_max;
-  id = clampf(id, -lim, lim);
-  iq = clampf(iq, -lim, lim);
+  id = command_clamp(id, -lim, lim);
+  iq = command_clamp(iq, -lim, lim);
   float mag = sqrtf(id * id + iq * iq);
   if (mag > lim) {
     id *= lim / mag;
@@ -342,7 +343,7 @@ void drive_cmd_current(drive_t *drv, float id, float iq) {
 }
 
 void drive_cmd_flux(drive_t *drv, float flux) {
-  drv->cmd.flux = clampf(flux, 0.0f, 10.0f);
+  drv->cmd.flux = command_clamp(flux, 0.0f, 10.0f);
 }
 
 int drive_set_config(drive_t *drv, const drive_config_t *cfg, const char **field) {

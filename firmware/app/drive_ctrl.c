@@ -65,7 +65,9 @@ void ctrl_reset(ctrl_t *c, drive_law_t law) {
   c->v_applied = (ab_t){0.0f, 0.0f};
 }
 
-static float clampf(float x, float lim) {
+/* Symmetric clamp that lets NaN through, so that a non-finite reference
+ * ends in the law's finiteness check (a fault), never at a limit. */
+static float clamp_sym_nan(float x, float lim) {
   return x > lim ? lim : (x < -lim ? -lim : x);
 }
 
@@ -77,7 +79,7 @@ static void ctrl_step_foc(ctrl_t *c, const ctrl_in_t *in, ctrl_out_t *out) {
   if (in->mode == DRIVE_MODE_CURRENT) {
     i_ref = (dq_t){in->id_ref, in->iq_ref};
   } else {
-    float t = clampf(in->torque_ref, t_lim);
+    float t = clamp_sym_nan(in->torque_ref, t_lim);
     i_ref = (dq_t){0.0f, pmsm_iq_for_torque(&c->machine, t)};
   }
   float mag = sqrtf(i_ref.d * i_ref.d + i_ref.q * i_ref.q);

@@ -2,24 +2,40 @@
  * hal_pil.c - hal.h over a recorded input stream (see hal_pil.h).
  */
 #include "hal_pil.h"
-#include "hal_duty.h"
+#include "hal_pattern.h"
 
 #include "hal.h"
 
-static hal_adc_sample_t sample;
-static float duty[3] = {0.5f, 0.5f, 0.5f};
+static hal_caps_t caps;
+static uint32_t counts;
+static hal_sample_t sample;
+static hal_pwm_t pwm;
 static bool gates_on;
 static bool hw_tripped;
 static uint32_t time_us;
+
+void hal_pil_set_caps(const hal_caps_t *c, uint32_t timer_counts) {
+  caps = *c;
+  counts = timer_counts;
+  pwm = hal_pwm_centred(0.5f, 0.5f, 0.5f);
+}
 
 void hal_pil_set_input(const isr_stream_in_t *in) {
   sample.i_abc[0] = in->i_abc[0];
   sample.i_abc[1] = in->i_abc[1];
   sample.i_abc[2] = in->i_abc[2];
   sample.v_dc = in->v_dc;
-  sample.v_star = in->v_star;
+  sample.t_i = in->t_i;
+  sample.v_star[0] = in->v_star[0];
+  sample.v_star[1] = in->v_star[1];
+  sample.t_star[0] = in->t_star[0];
+  sample.t_star[1] = in->t_star[1];
+  sample.n_star = (uint8_t)in->n_star;
+  sample.test_vector = (uint8_t)in->test_vector;
   sample.enc_angle = in->enc_angle;
+  sample.t_enc = in->t_enc;
   sample.enc_valid = (in->flags & ISR_IN_ENC_VALID) != 0u;
+  sample.valid = (in->flags & ISR_IN_VALID) != 0u;
   hw_tripped = (in->flags & ISR_IN_HW_TRIPPED) != 0u;
   if (hw_tripped) {
     gates_on = false; /* the break input turns the gates off in hardware */
@@ -28,20 +44,25 @@ void hal_pil_set_input(const isr_stream_in_t *in) {
 }
 
 void hal_pil_get_output(float d[3], bool *on) {
-  d[0] = duty[0];
-  d[1] = duty[1];
-  d[2] = duty[2];
+  d[0] = pwm.off[0] - pwm.on[0];
+  d[1] = pwm.off[1] - pwm.on[1];
+  d[2] = pwm.off[2] - pwm.on[2];
   *on = gates_on;
 }
 
-void hal_adc_read(hal_adc_sample_t *s) {
+const hal_caps_t *hal_caps(void) {
+  return &caps;
+}
+
+void hal_adc_read(hal_sample_t *s) {
   *s = sample;
 }
 
-void hal_pwm_set_duty(float da, float db, float dc) {
-  duty[0] = hal_duty_clamp01(da);
-  duty[1] = hal_duty_clamp01(db);
-  duty[2] = hal_duty_clamp01(dc);
+void hal_pwm_write(const hal_pwm_t *p, hal_pwm_t *applied) {
+  hal_pattern_apply(p, &caps, counts, &pwm);
+  if (applied != 0) {
+    *applied = pwm;
+  }
 }
 
 void hal_pwm_enable(void) {
@@ -81,3 +102,11 @@ void hal_fault_hw_clear(void) {
 }
 
 void hal_watchdog_kick(void) {}
+
+bool hal_reset_by_watchdog(void) {
+  return false;
+}
+
+void hal_isr_stats(hal_isr_stats_t *st) {
+  st->cycles_last = st->cycles_max = st->cycles_mean = st->overruns = 0u;
+}

@@ -3,9 +3,9 @@
  *
  * Reads pil_in.bin (an isr_stream recorded by `fluxdrive-sil --record-isr`)
  * through semihosting, initialises the drive with the recorded
- * configuration and replays the exact call sequence of the SIL run: per
- * record, drive_slow_loop() with the staged commands when the record says
- * so, then drive_isr() on the recorded HAL sample. Writes one
+ * configuration and board, and replays the exact inputs of the SIL run: per
+ * record, the main loop's command block as the ISR found it, then
+ * drive_isr() on the recorded HAL sample set. Writes one
  * isr_stream_out_t per ISR to pil_out.bin. With ISR_STREAM_FORCE_APPLIED in
  * the header, the law's applied-voltage memory is set to the host's before
  * each ISR (outside the counted ISR; docs/pil.md explains why).
@@ -45,32 +45,16 @@ static int fail(int code, const char *msg) {
   return code;
 }
 
-static void apply_commands(drive_t *d, const isr_stream_in_t *in) {
-  d->cmd.enable = (in->flags & ISR_IN_CMD_ENABLE) != 0u;
-  d->cmd.clear_fault = (in->flags & ISR_IN_CMD_CLEAR) != 0u;
-  d->cmd.law = (drive_law_t)in->cmd_law;
-  d->cmd.mode = (drive_mode_t)in->cmd_mode;
-  d->cmd.torque = in->cmd_torque;
-  d->cmd.speed = in->cmd_speed;
-  d->cmd.id = in->cmd_id;
-  d->cmd.iq = in->cmd_iq;
-  d->cmd.flux = in->cmd_flux;
-}
-
-/* One period of the SIL loop: slow loop (if due), external faults, ISR. */
+/* One period: the command block as the ISR found it, then the ISR. */
 static bool force_applied;
 
 __attribute__((noinline)) static void pil_step(const isr_stream_in_t *in, isr_stream_out_t *o) {
-  if ((in->flags & ISR_IN_SLOW) != 0u) {
-    apply_commands(&drv, in);
-    drive_slow_loop(&drv);
-  }
-  if (in->raise_fault != 0u) {
-    drive_raise_fault(&drv, in->raise_fault);
-  }
+  uint32_t seq;
+  isr_stream_cmd_get(in, &seq, &drv.req.cmd);
+  drv.req.seq = seq;
   hal_pil_set_input(in);
   if (force_applied) {
-    drv.ctrl.v_applied = (ab_t){in->v_applied[0], in->v_applied[1]};
+    drv.v_applied = (ab_t){in->v_applied[0], in->v_applied[1]};
   }
   drive_isr(&drv);
   bool on = false;
@@ -90,8 +74,8 @@ int main(void) {
     return fail(3, "pil_in.bin: short header");
   }
   if (h.magic != ISR_STREAM_MAGIC || h.version != ISR_STREAM_VERSION || h.header_size != sizeof h ||
-      h.config_size != 4u * ISR_STREAM_CONFIG_WORDS || h.in_size != sizeof(isr_stream_in_t) ||
-      h.out_size != sizeof(isr_stream_out_t)) {
+      h.config_size != 4u * ISR_STREAM_CONFIG_WORDS || h.caps_size != 4u * ISR_STREAM_CAPS_WORDS ||
+      h.in_size != sizeof(isr_stream_in_t) || h.out_size != sizeof(isr_stream_out_t)) {
     return fail(3, "pil_in.bin: not an isr_stream of this version/layout");
   }
   force_applied = (h.flags & ISR_STREAM_FORCE_APPLIED) != 0u;
@@ -101,9 +85,19 @@ int main(void) {
   }
   static drive_config_t cfg;
   isr_stream_config_get(&cfg, words);
-  const char *field = "";
-  if (drive_init(&drv, &cfg, &field) != 0) {
-    sh_puts(field);
+  static uint32_t cwords[ISR_STREAM_CAPS_WORDS];
+  if (sh_read(fin, cwords, sizeof cwords) != 0) {
+    return fail(3, "pil_in.bin: short capabilities");
+  }
+  hal_caps_t caps;
+  uint32_t counts;
+  isr_stream_caps_get(&caps, &counts, cwords);
+  hal_pil_set_caps(&caps, counts);
+  drive_config_err_t err;
+  if (drive_init(&drv, &cfg, &err) != 0) {
+    sh_puts(err.field);
+    sh_puts(": ");
+    sh_puts(err.reason);
     return fail(4, ": drive_init rejected the recorded configuration");
   }
   const int32_t fout = sh_open("pil_out.bin", "wb");

@@ -12,10 +12,10 @@
 /* clang-format off */
 static const can_sig_desc_t sigs[CAN_SIG_COUNT] = {
   /* name             start len signed float scale    offset min        max */
-  {"enable",            0,  8, false, false, 1.0f,    0.0f, 0.0f,      2.0f, 0, 2},
+  {"enable",            0,  8, false, false, 1.0f,    0.0f, 0.0f,      255.0f, 0, 255},
   {"clear_fault",       8,  8, false, false, 1.0f,    0.0f, 0.0f,      1.0f, 0, 1},
-  {"mode",             16,  8, false, false, 1.0f,    0.0f, 0.0f,      3.0f, 0, 3},
-  {"law",              24,  8, false, false, 1.0f,    0.0f, 0.0f,      3.0f, 0, 3},
+  {"mode",             16,  8, false, false, 1.0f,    0.0f, 0.0f,      255.0f, 0, 255},
+  {"law",              24,  8, false, false, 1.0f,    0.0f, 0.0f,      255.0f, 0, 255},
   {"cmd_torque",        0, 32, true,  false, 1e-4f,   0.0f, -10000.0f, 10000.0f, -100000000, 100000000},
   {"cmd_speed_rpm",     0, 32, true,  false, 0.01f,   0.0f, -200000.0f, 200000.0f, -20000000, 20000000},
   {"cmd_id",            0, 32, true,  false, 1e-4f,   0.0f, -10000.0f, 10000.0f, -100000000, 100000000},
@@ -53,6 +53,10 @@ static const can_sig_desc_t sigs[CAN_SIG_COUNT] = {
   {"flux_ref",         16, 16, false, false, 1e-4f,   0.0f, 0.0f,      6.5535f, 0, 65535},
   {"delta",            32, 16, true,  false, 1e-4f,   0.0f, -3.2768f,  3.2767f, -32768, 32767},
   {"i_qs_ref",         48, 16, true,  false, 0.01f,   0.0f, -327.68f,  327.67f, -32768, 32767},
+  {"isr_cycles_mean",   0, 16, false, false, 1.0f,    0.0f, 0.0f,      65535.0f, 0, 65535},
+  {"isr_cycles_max",   16, 16, false, false, 1.0f,    0.0f, 0.0f,      65535.0f, 0, 65535},
+  {"isr_load",         32, 16, false, false, 0.01f,   0.0f, 0.0f,      655.35f, 0, 65535},
+  {"isr_overruns",     48, 16, false, false, 1.0f,    0.0f, 0.0f,      65535.0f, 0, 65535},
   {"hb_count",          0,  8, false, false, 1.0f,    0.0f, 0.0f,      255.0f, 0, 255},
   {"hb_state",          8,  8, false, false, 1.0f,    0.0f, 0.0f,      255.0f, 0, 255},
 };
@@ -73,13 +77,14 @@ static const can_msg_desc_t msgs[CAN_MSG_COUNT] = {
   {"TM_PHASE",    0x320, 6, false, CAN_SIG_I_A,           3},
   {"TM_DQ",       0x330, 8, false, CAN_SIG_I_D,           4},
   {"TM_FLUX",     0x340, 8, false, CAN_SIG_FLUX,          4},
+  {"TM_CPU",      0x350, 8, false, CAN_SIG_ISR_CYCLES_MEAN, 4},
   {"HEARTBEAT",   0x700, 2, false, CAN_SIG_HB_COUNT,      2},
 };
 /* clang-format on */
 
 static const char *const result_names[] = {
-    "ok",        "out_of_range",      "bad_dlc",      "unknown_param",
-    "read_only", "not_while_running", "inconsistent", "timed_out"};
+    "ok",           "out_of_range", "bad_dlc",    "unknown_param", "read_only", "not_while_running",
+    "inconsistent", "timed_out",    "unavailable"};
 
 const can_msg_desc_t *can_codec_msg(can_msg_t m) {
   return (unsigned)m < (unsigned)CAN_MSG_COUNT ? &msgs[m] : 0;

@@ -32,6 +32,7 @@ typedef enum {
   CAN_MSG_TM_PHASE,
   CAN_MSG_TM_DQ,
   CAN_MSG_TM_FLUX,
+  CAN_MSG_TM_CPU,
   CAN_MSG_HEARTBEAT,
   CAN_MSG_COUNT
 } can_msg_t;
@@ -80,6 +81,10 @@ typedef enum {
   CAN_SIG_FLUX_REF,
   CAN_SIG_DELTA,
   CAN_SIG_I_QS_REF,
+  CAN_SIG_ISR_CYCLES_MEAN,
+  CAN_SIG_ISR_CYCLES_MAX,
+  CAN_SIG_ISR_LOAD,
+  CAN_SIG_ISR_OVERRUNS,
   CAN_SIG_HB_COUNT,
   CAN_SIG_HB_STATE,
   CAN_SIG_COUNT
@@ -94,8 +99,13 @@ typedef enum {
   CAN_RESULT_READ_ONLY = 4,
   CAN_RESULT_NOT_WHILE_RUNNING = 5,
   CAN_RESULT_INCONSISTENT = 6,
-  CAN_RESULT_TIMED_OUT = 7
+  CAN_RESULT_TIMED_OUT = 7,
+  CAN_RESULT_UNAVAILABLE = 8 /* law not available on this machine, or mode not on this law */
 } can_result_t;
+#define CAN_RESULT_COUNT 9u
+/* CMD_STATE.enable / mode / law: this value leaves the setting as it is
+ * (outside every range of laws and modes). */
+#define CAN_KEEP 255u
 
 typedef struct {
   const char *name;

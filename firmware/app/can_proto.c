@@ -18,13 +18,9 @@ void can_proto_cfg_default(can_proto_cfg_t *cfg) {
   cfg->node = 1;
   cfg->timeout_ms = 500;
   cfg->ramp_ms = 200;
-  cfg->period_ms[CAN_PERIOD_STATUS] = 100;
-  cfg->period_ms[CAN_PERIOD_HEARTBEAT] = 500;
-  cfg->period_ms[CAN_PERIOD_TM_SPEED] = 10;
-  cfg->period_ms[CAN_PERIOD_TM_TORQUE] = 10;
-  cfg->period_ms[CAN_PERIOD_TM_PHASE] = 10;
-  cfg->period_ms[CAN_PERIOD_TM_DQ] = 10;
-  cfg->period_ms[CAN_PERIOD_TM_FLUX] = 10;
+#define PERIOD_DEFAULT(E, n, ms) cfg->period_ms[CAN_PERIOD_##E] = (ms);
+  CAN_PERIOD_LIST(PERIOD_DEFAULT)
+#undef PERIOD_DEFAULT
 }
 
 int can_proto_init(can_proto_t *p, const can_proto_cfg_t *cfg) {
@@ -44,6 +40,15 @@ static void frame_init(hal_can_frame_t *f, can_msg_t m, uint8_t node) {
 }
 
 /* ---------------------------------------------------------------- params */
+const char *can_proto_param_name(uint8_t id) {
+#define PERIOD_NAME(E, n, ms) "can_" #n "_ms",
+  static const char *const names[CAN_PROTO_PARAM_COUNT] = {
+      "can_node", "can_timeout_ms", "can_ramp_ms", CAN_PERIOD_LIST(PERIOD_NAME)};
+#undef PERIOD_NAME
+  const unsigned k = (unsigned)id - CAN_PROTO_PARAM_FIRST;
+  return id >= CAN_PROTO_PARAM_FIRST && k < CAN_PROTO_PARAM_COUNT ? names[k] : NULL;
+}
+
 bool can_proto_param_get(const can_proto_t *p, uint8_t id, float *value) {
   if (id == CAN_PROTO_PARAM_FIRST) {
     *value = (float)p->cfg.node;
@@ -90,8 +95,10 @@ typedef struct {
   float value;
 } reply_t;
 
+/* Enabled as the main loop's last telemetry copy says (drive_background). */
 static bool enabled_state(const drive_t *drv) {
-  return drv->state == DRIVE_STATE_RUN || drv->state == DRIVE_STATE_OFFSET_CAL;
+  const drive_state_t s = drive_telemetry(drv)->state;
+  return s == DRIVE_STATE_RUN || s == DRIVE_STATE_OFFSET_CAL || s == DRIVE_STATE_ALIGN;
 }
 
 /* First signal of message m outside its DBC range, NO_SIGNAL if none. */
@@ -164,50 +171,76 @@ static void handle_param(can_proto_t *p, drive_t *drv, const uint8_t *d, reply_t
   }
 }
 
-/* What REPLY.reply_value reports for a CMD_* message. */
+/* What REPLY.reply_value reports for a CMD_* message: the command posted. */
 static float value_in_force(const drive_t *drv, can_msg_t m) {
+  const drive_cmd_t *c = drive_commands(drv);
   switch (m) {
   case CAN_MSG_CMD_STATE:
-    return drv->cmd.enable ? 1.0f : 0.0f;
+    return c->enable != 0u ? 1.0f : 0.0f;
   case CAN_MSG_CMD_TORQUE:
-    return drv->cmd.torque;
+    return c->torque;
   case CAN_MSG_CMD_SPEED:
-    return drv->cmd.speed * RPM_PER_RADS;
+    return c->speed * RPM_PER_RADS;
   case CAN_MSG_CMD_CURRENT:
-    return drv->cmd.id;
+    return c->id;
   case CAN_MSG_CMD_FLUX:
-    return drv->cmd.flux;
+    return c->flux;
   default:
     return 0.0f;
   }
 }
 
+/* CMD_STATE: checks every signal first, then applies all of it or
+ * nothing. */
+static void handle_state(const can_proto_t *p, drive_t *drv, const uint8_t *d, reply_t *r) {
+  const uint32_t en = can_codec_get_raw(CAN_SIG_ENABLE, d);
+  const uint32_t mode = can_codec_get_raw(CAN_SIG_MODE, d);
+  const uint32_t law = can_codec_get_raw(CAN_SIG_LAW, d);
+  if (en > 1u && en != CAN_KEEP) {
+    reply_error(r, CAN_RESULT_OUT_OF_RANGE, CAN_SIG_ENABLE);
+  } else if (mode >= (uint32_t)DRIVE_MODE_COUNT && mode != CAN_KEEP) {
+    reply_error(r, CAN_RESULT_OUT_OF_RANGE, CAN_SIG_MODE);
+  } else if (law >= (uint32_t)DRIVE_LAW_COUNT && law != CAN_KEEP) {
+    reply_error(r, CAN_RESULT_OUT_OF_RANGE, CAN_SIG_LAW);
+  } else if (!p->ramp) {
+    if (can_codec_get_raw(CAN_SIG_CLEAR_FAULT, d) == 1u) {
+      drive_cmd_clear_fault(drv);
+    }
+    /* mode before law when leaving current mode, law first when entering */
+    const bool into_current = mode == (uint32_t)DRIVE_MODE_CURRENT;
+    const char *why = NULL;
+    if (law != CAN_KEEP && !into_current) {
+      why = drive_cmd_set_law(drv, (drive_law_t)law);
+    }
+    if (why == NULL && mode != CAN_KEEP) {
+      why = drive_cmd_set_mode(drv, (drive_mode_t)mode);
+      if (why != NULL) {
+        reply_error(r, CAN_RESULT_UNAVAILABLE, CAN_SIG_MODE);
+      }
+    } else if (why != NULL) {
+      reply_error(r, CAN_RESULT_UNAVAILABLE, CAN_SIG_LAW);
+    }
+    if (why == NULL && law != CAN_KEEP && into_current) {
+      why = drive_cmd_set_law(drv, (drive_law_t)law);
+      if (why != NULL) {
+        reply_error(r, CAN_RESULT_UNAVAILABLE, CAN_SIG_LAW);
+      }
+    }
+    if (why == NULL && en != CAN_KEEP) {
+      drive_cmd_enable(drv, en == 1u);
+    }
+  }
+  r->value = value_in_force(drv, CAN_MSG_CMD_STATE);
+}
+
 /* Applies a CMD_* frame (DLC and DBC ranges already checked). */
 static void handle_cmd(const can_proto_t *p, drive_t *drv, can_msg_t m, const uint8_t *d,
                        reply_t *r) {
-  const drive_config_t *c = &drv->cfg;
+  const drive_config_t *c = drive_requested_config(drv);
   switch (m) {
-  case CAN_MSG_CMD_STATE: {
-    uint32_t en = can_codec_get_raw(CAN_SIG_ENABLE, d);
-    uint32_t mode = can_codec_get_raw(CAN_SIG_MODE, d);
-    uint32_t law = can_codec_get_raw(CAN_SIG_LAW, d);
-    if (!p->ramp) {
-      if (can_codec_get_raw(CAN_SIG_CLEAR_FAULT, d) == 1u) {
-        drive_cmd_clear_fault(drv);
-      }
-      if (law < (uint32_t)DRIVE_LAW_COUNT) {
-        (void)drive_cmd_set_law(drv, (drive_law_t)law);
-      }
-      if (mode < (uint32_t)DRIVE_MODE_COUNT) {
-        (void)drive_cmd_set_mode(drv, (drive_mode_t)mode);
-      }
-      if (en <= 1u) {
-        drive_cmd_enable(drv, en == 1u);
-      }
-    }
-    r->value = value_in_force(drv, m);
+  case CAN_MSG_CMD_STATE:
+    handle_state(p, drv, d, r);
     return;
-  }
   case CAN_MSG_CMD_TORQUE: {
     float t = can_codec_get(CAN_SIG_CMD_TORQUE, d);
     if (fabsf(t) > c->torque_max) {
@@ -320,8 +353,8 @@ static void timeout_step(can_proto_t *p, drive_t *drv, uint32_t now) {
     }
     p->ramp = true;
     p->ramp_t0_us = now;
-    p->ramp_torque0 = drv->tm.torque_ref;
-    p->ramp_mode = drv->cmd.mode;
+    p->ramp_torque0 = drive_telemetry(drv)->torque_ref;
+    p->ramp_mode = drive_commands(drv)->mode;
     (void)drive_cmd_set_mode(drv, DRIVE_MODE_TORQUE);
   }
   if (!enabled) { /* the drive stopped on its own (fault, disable) */
@@ -336,7 +369,7 @@ static void timeout_step(can_proto_t *p, drive_t *drv, uint32_t now) {
     drive_cmd_current(drv, 0.0f, 0.0f);
     (void)drive_cmd_set_mode(drv, p->ramp_mode);
     drive_cmd_enable(drv, false);
-    drive_raise_fault(drv, DRIVE_FAULT_CMD_TIMEOUT);
+    drive_request_fault(drv, DRIVE_FAULT_CMD_TIMEOUT);
     p->ramp = false;
     p->stats.timeouts++;
     return;
@@ -353,12 +386,12 @@ static void send_periodic(can_proto_t *p, can_period_t which, const drive_t *drv
   case CAN_PERIOD_STATUS:
     frame_init(&f, CAN_MSG_STATUS, node);
     can_codec_set_raw(CAN_SIG_STATE, f.data, (uint32_t)tm->state);
-    can_codec_set_raw(CAN_SIG_CTRL_MODE, f.data, (uint32_t)drv->ref.mode);
-    can_codec_set_raw(CAN_SIG_CTRL_LAW, f.data, (uint32_t)drv->ref.law);
+    can_codec_set_raw(CAN_SIG_CTRL_MODE, f.data, (uint32_t)tm->mode);
+    can_codec_set_raw(CAN_SIG_CTRL_LAW, f.data, (uint32_t)tm->law);
     can_codec_set_raw(CAN_SIG_FAULTS, f.data, tm->faults);
     can_codec_set(CAN_SIG_V_DC, f.data, tm->v_dc);
     can_codec_set_raw(CAN_SIG_TIMEOUT_RAMP, f.data, p->ramp ? 1u : 0u);
-    can_codec_set_raw(CAN_SIG_CMD_ENABLED, f.data, drv->cmd.enable ? 1u : 0u);
+    can_codec_set_raw(CAN_SIG_CMD_ENABLED, f.data, drive_commands(drv)->enable != 0u ? 1u : 0u);
     can_codec_set_raw(CAN_SIG_ERR_COUNT, f.data, p->stats.rx_errors & 0xFFu);
     p->st_state = tm->state;
     p->st_faults = tm->faults;
@@ -393,13 +426,28 @@ static void send_periodic(can_proto_t *p, can_period_t which, const drive_t *drv
     can_codec_set(CAN_SIG_I_QS, f.data, tm->law_tm.i_qs);
     break;
   case CAN_PERIOD_TM_FLUX:
-  default:
     frame_init(&f, CAN_MSG_TM_FLUX, node);
     can_codec_set(CAN_SIG_FLUX, f.data, tm->law_tm.flux);
     can_codec_set(CAN_SIG_FLUX_REF, f.data, tm->law_tm.flux_ref);
     can_codec_set(CAN_SIG_DELTA, f.data, tm->law_tm.delta);
     can_codec_set(CAN_SIG_I_QS_REF, f.data, tm->law_tm.i_qs_ref);
     break;
+  case CAN_PERIOD_TM_CPU:
+  default: {
+    /* the board's measured ISR cycles (hal_isr_stats, DWT): the figure
+     * docs/benchmarks.md estimates, confirmed on hardware */
+    hal_isr_stats_t st;
+    hal_isr_stats(&st);
+    const hal_caps_t *caps = hal_caps();
+    frame_init(&f, CAN_MSG_TM_CPU, node);
+    can_codec_set(CAN_SIG_ISR_CYCLES_MEAN, f.data, (float)st.cycles_mean);
+    can_codec_set(CAN_SIG_ISR_CYCLES_MAX, f.data, (float)st.cycles_max);
+    can_codec_set(CAN_SIG_ISR_LOAD, f.data,
+                  caps->cpu_hz > 0.0f ? 100.0f * (float)st.cycles_mean / (caps->cpu_hz * caps->ts)
+                                      : 0.0f);
+    can_codec_set(CAN_SIG_ISR_OVERRUNS, f.data, (float)st.overruns);
+    break;
+  }
   }
   if (!hal_can_send(&f)) {
     p->stats.tx_dropped++;

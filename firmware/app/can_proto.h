@@ -1,12 +1,16 @@
 /*
  * can_proto.h - the CAN protocol of the drive (can/fluxdrive.dbc): commands,
  * parameter get/set with replies, status, telemetry, heartbeat, command
- * timeout. Runs in the slow-loop context, never in the ISR:
+ * timeout. Runs in the main loop, never in the ISR:
  *
- *   can_proto_poll(&p, &drv, hal_time_us());   each slow period, before
- *   drive_slow_loop(&drv);                      the slow loop (commands are
- *                                               staged through drive_cmd_*
- *                                               and take effect there)
+ *   can_proto_poll(&p, &drv, hal_time_us());   each slow period; commands
+ *   drive_background(&drv);                     are posted (drive_cmd_*) and
+ *                                               taken by the next ISR
+ *
+ * CMD_STATE: enable 0/1, mode and law by number; CAN_KEEP (255) in any of
+ * them leaves that setting as it is. An unknown value is out_of_range; a
+ * law the machine cannot run (or current mode with a law that has none) is
+ * unavailable, and nothing of the frame changes.
  *
  * Receive: at most CAN_PROTO_RX_MAX frames per call (a flood cannot take
  * the slow context's time, and never the ISR's). Frames of other nodes,
@@ -21,7 +25,7 @@
  * if no well-formed frame for this node (command, parameter request or
  * host heartbeat, valid or rejected) arrives for timeout_ms, the drive is
  * put in torque mode and its torque reference ramped linearly from the
- * torque in force to zero over ramp_ms; then drive_raise_fault(
+ * torque in force to zero over ramp_ms; then drive_request_fault(
  * DRIVE_FAULT_CMD_TIMEOUT) turns the gates off and latches the fault, and
  * the references are zeroed (speed, torque, currents; the previous mode is
  * restored) so that clear_fault + enable restarts from rest. During the
@@ -39,17 +43,22 @@
 
 #define CAN_PROTO_RX_MAX 16u /* frames read per call */
 
-/* Periodic transmissions (index of can_proto_cfg_t.period_ms). */
-typedef enum {
-  CAN_PERIOD_STATUS = 0,
-  CAN_PERIOD_HEARTBEAT,
-  CAN_PERIOD_TM_SPEED,
-  CAN_PERIOD_TM_TORQUE,
-  CAN_PERIOD_TM_PHASE,
-  CAN_PERIOD_TM_DQ,
-  CAN_PERIOD_TM_FLUX,
-  CAN_PERIOD_COUNT
-} can_period_t;
+/* Periodic transmissions: X(ENUM, name, default period [ms]); the index of
+ * can_proto_cfg_t.period_ms and, from CAN_PROTO_PARAM_FIRST + 3, the
+ * parameter "can_<name>_ms". Append only. */
+#define CAN_PERIOD_LIST(X)                                                                         \
+  X(STATUS, status, 100)                                                                           \
+  X(HEARTBEAT, heartbeat, 500)                                                                     \
+  X(TM_SPEED, tm_speed, 10)                                                                        \
+  X(TM_TORQUE, tm_torque, 10)                                                                      \
+  X(TM_PHASE, tm_phase, 10)                                                                        \
+  X(TM_DQ, tm_dq, 10)                                                                              \
+  X(TM_FLUX, tm_flux, 10)                                                                          \
+  X(TM_CPU, tm_cpu, 100)
+
+#define CAN_PERIOD_ENUM(E, n, ms) CAN_PERIOD_##E,
+typedef enum { CAN_PERIOD_LIST(CAN_PERIOD_ENUM) CAN_PERIOD_COUNT } can_period_t;
+#undef CAN_PERIOD_ENUM
 
 typedef struct {
   uint8_t node;                         /* 0..CAN_NODE_MAX */
@@ -95,6 +104,9 @@ void can_proto_poll(can_proto_t *p, drive_t *drv, uint32_t now_us);
  * only), timeout, ramp and the periods. Same conventions as drive_params. */
 #define CAN_PROTO_PARAM_FIRST 64u
 #define CAN_PROTO_PARAM_COUNT (3u + (unsigned)CAN_PERIOD_COUNT)
+/* Name of protocol parameter id ("can_node", "can_status_ms", ...), NULL
+ * when there is none. */
+const char *can_proto_param_name(uint8_t id);
 bool can_proto_param_get(const can_proto_t *p, uint8_t id, float *value);
 /* Returns a can_result_t. */
 can_result_t can_proto_param_set(can_proto_t *p, uint8_t id, float value);

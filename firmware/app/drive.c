@@ -1,40 +1,55 @@
 /*
- * drive.c - the drive: state machine, ISR body, slow loop and commands.
+ * drive.c - the drive: state machine, ISR body, protections, loss-of-control
+ * monitor, and the main loop's side of the concurrency contract (drive.h).
  *
- * idle -> offset calibration -> run -> (fault). Protections run every ISR
- * on the sample just read; a fault disables the gates in the same ISR,
- * latches its cause and keeps it until drive_cmd_clear_fault().
+ * idle -> offset calibration -> [align] -> run -> (fault). The ISR takes the
+ * main loop's requests at its start, evaluates the protections on the
+ * sample just read, and a fault disables the gates in the same ISR,
+ * latches its cause and keeps it until a clear request.
  */
 #include "drive.h"
 
 #include <math.h>
+#include <stdatomic.h>
+#include <string.h>
 
 #include "control/modulation.h"
-#include "hal.h"
 #include "math/fd_math.h"
 #include "math/frames.h"
 
-/* All gates off, duties back to 50 % (no voltage when they come back). */
-static void drive_gates_off(void) {
+/* Orders the accesses of one context around a shared word. The ISR and the
+ * main loop run on one core (the ISR preempts, is never preempted by the
+ * main loop): a compiler barrier is all the ordering they need. */
+#define DRIVE_BARRIER() atomic_signal_fence(memory_order_seq_cst)
+
+/* Attempts of drive_telemetry_read: a copy takes far less than a period,
+ * so at most one attempt is ever preempted. */
+#define DRIVE_TM_TRIES 4
+
+static bool gates_on_state(drive_state_t s) {
+  return s == DRIVE_STATE_RUN || s == DRIVE_STATE_ALIGN;
+}
+
+static bool enabled_state(drive_state_t s) {
+  return s == DRIVE_STATE_OFFSET_CAL || gates_on_state(s);
+}
+
+/* All gates off, the pattern back to the middle of the duty range (no
+ * voltage when the gates come back). */
+static void drive_gates_off(const drive_t *drv) {
   hal_pwm_disable();
-  hal_pwm_set_duty(0.5f, 0.5f, 0.5f);
+  const float mid = 0.5f * (drv->caps->duty_min + drv->caps->duty_max);
+  const hal_pwm_t p = hal_pwm_centred(mid, mid, mid);
+  hal_pwm_write(&p, NULL);
 }
 
 static void drive_trip(drive_t *drv, uint32_t bits) {
-  drive_gates_off();
+  drive_gates_off(drv);
   drv->faults |= bits;
   drv->state = DRIVE_STATE_FAULT;
 }
 
-static void refs_from_cmd(drive_t *drv) {
-  drv->ref.enable = drv->cmd.enable;
-  drv->ref.mode = drv->cmd.mode;
-  drv->ref.torque = drv->cmd.torque;
-  drv->ref.speed = drv->cmd.speed;
-  drv->ref.id = drv->cmd.id;
-  drv->ref.iq = drv->cmd.iq;
-  drv->ref.flux = drv->cmd.flux;
-}
+/* ------------------------------------------------------------ configure */
 
 static void speed_cfg_from(speed_ctrl_cfg_t *scfg, const drive_config_t *cfg) {
   speed_ctrl_design(scfg, cfg->inertia, cfg->speed_bw);
@@ -43,114 +58,341 @@ static void speed_cfg_from(speed_ctrl_cfg_t *scfg, const drive_config_t *cfg) {
   scfg->torque_max = cfg->torque_max;
 }
 
-int drive_init(drive_t *drv, const drive_config_t *cfg, const char **field) {
-  const char *dummy = "";
-  if (field == 0) {
-    field = &dummy;
-  }
-  int err = drive_config_check(cfg, field);
-  if (err != 0) {
-    return err;
-  }
-  *drv = (drive_t){0};
-  drv->cfg = *cfg;
-  drv->state = DRIVE_STATE_IDLE;
-  drv->cmd.law = cfg->law;
-  drv->cmd.mode = cfg->mode;
-  drv->ref.law = cfg->law;
-  refs_from_cmd(drv);
-  if (ctrl_init(&drv->ctrl, cfg) != 0) {
-    *field = "law parameters";
+/* From the current sample to the centre of the interval the output acts:
+ * the next period [Ts, 2 Ts) after the period start (hal.h). */
+static float drive_t_out(const drive_t *drv, const drive_config_t *cfg) {
+  return 1.5f * cfg->ts - drv->caps->t_i;
+}
+
+int drive_config_usable(const drive_config_t *cfg, drive_law_t law, machine_t *m,
+                        drive_config_err_t *err) {
+  if (drive_config_check(cfg, err) != 0) {
     return -1;
   }
-  angle_pll_init(&drv->pll, cfg->pll_bw, cfg->ts);
-
-  speed_ctrl_cfg_t scfg;
-  speed_cfg_from(&scfg, cfg);
-  speed_ctrl_init(&drv->speed, &scfg);
-  drv->torque_min_avail = -cfg->torque_max;
-  drv->torque_max_avail = cfg->torque_max;
-
-  drive_gates_off();
+  if (machine_init_linear(m, cfg->pole_pairs, cfg->rs, cfg->ld, cfg->lq, cfg->lambda_m) != 0) {
+    err->field = "ld";
+    err->reason = "the machine model refused the machine parameters";
+    return -1;
+  }
+  const ctrl_law_t *row = ctrl_law(law);
+  const ctrl_setup_t su = {cfg, m, 1.5f * cfg->ts};
+  const char *why = row != NULL ? row->check(&su) : "no such law";
+  if (why != NULL) {
+    err->field = "law";
+    err->reason = why;
+    return -1;
+  }
+  if (cfg->mode == DRIVE_MODE_CURRENT && (row->caps & CTRL_CAP_CURRENT) == 0u) {
+    err->field = "mode";
+    err->reason = "the law has no current mode";
+    return -1;
+  }
   return 0;
 }
 
-/* Protections on the raw sample; returns the fault bits found. */
-static uint32_t drive_protect(const drive_t *drv, const hal_adc_sample_t *s, const float i[3]) {
+/* Everything derived from the parameter set (ISR-owned; gates off). */
+static int drive_configure(drive_t *drv, const drive_config_t *cfg, drive_law_t law,
+                           drive_config_err_t *err) {
+  machine_t m;
+  if (drive_config_usable(cfg, law, &m, err) != 0) {
+    return -1;
+  }
+  drv->cfg = *cfg;
+  drv->machine = m;
+  const char *reason = "";
+  if (ctrl_init(&drv->ctrl, &drv->cfg, &drv->machine, drive_t_out(drv, cfg), law, &reason) != 0) {
+    err->field = "law";
+    err->reason = reason;
+    return -1;
+  }
+  drv->pos_src = pos_source(cfg->pos_source);
+  drv->pos_src->init(&drv->pos_st, cfg);
+  speed_ctrl_cfg_t scfg;
+  speed_cfg_from(&scfg, cfg);
+  speed_ctrl_init(&drv->speed, &scfg);
+  const current_ctrl_cfg_t acfg = {&drv->machine, cfg->current_bw, cfg->ts};
+  current_ctrl_init(&drv->align_cc, &acfg);
+  drv->torque_min_avail = -cfg->torque_max;
+  drv->torque_max_avail = cfg->torque_max;
+  /* scales of the loss-of-control monitor: torque and flux on MTPA at i_max */
+  const dq_t i_rated = machine_mtpa_current(&drv->machine, machine_mtpa_torque(&m, cfg->i_max));
+  const dq_t l_rated = machine_flux(&drv->machine, i_rated);
+  drv->torque_scale = machine_torque(&drv->machine, i_rated);
+  drv->flux_scale = sqrtf(l_rated.d * l_rated.d + l_rated.q * l_rated.q);
+  return 0;
+}
+
+/* The LIVE parameters of cfg into the set in force (running). Returns true
+ * when cfg differs from the set in force in anything else. */
+static bool configure_live(drive_t *drv, const drive_config_t *cfg) {
+  unsigned n;
+  const drive_param_t *t = drive_params_table(&n);
+  bool rest = false;
+  for (unsigned k = 0; k < n; ++k) {
+    const float v = drive_param_get(cfg, &t[k]);
+    if (t[k].access == DRIVE_PARAM_LIVE) {
+      drive_param_set(&drv->cfg, &t[k], v);
+    } else {
+      const float w = drive_param_get(&drv->cfg, &t[k]);
+      rest = rest || v < w || v > w;
+    }
+  }
+  speed_ctrl_cfg_t scfg;
+  speed_cfg_from(&scfg, &drv->cfg);
+  /* new gains and limits; the integral and the ramp carry on */
+  drv->speed.cfg = scfg;
+  drv->speed.cfg.torque_max = fabsf(scfg.torque_max);
+  drv->speed.pi.kp = scfg.kp;
+  drv->speed.pi.ki = scfg.ki;
+  return rest;
+}
+
+int drive_init(drive_t *drv, const drive_config_t *cfg, drive_config_err_t *err) {
+  drive_config_err_t dummy;
+  if (err == NULL) {
+    err = &dummy;
+  }
+  memset(drv, 0, sizeof *drv);
+  drv->caps = hal_caps();
+  if (drive_configure(drv, cfg, cfg->law, err) != 0) {
+    return -1;
+  }
+  drv->state = DRIVE_STATE_IDLE;
+  drv->cmd.law = cfg->law;
+  drv->cmd.mode = cfg->mode;
+  drv->armed = true;
+  drv->req.cmd = drv->cmd;
+  drv->creq.cfg = *cfg;
+  drv->host.machine = drv->machine;
+  if (hal_reset_by_watchdog()) {
+    drv->faults = DRIVE_FAULT_WATCHDOG;
+    drv->state = DRIVE_STATE_FAULT;
+  }
+  drive_gates_off(drv);
+  drv->tm.state = drv->state;
+  drv->tm.faults = drv->faults;
+  drv->tm.law = drv->ctrl.law;
+  drv->tm.mode = drv->cmd.mode;
+  drv->host.tm = drv->tm;
+  err->field = "";
+  err->reason = "";
+  return 0;
+}
+
+/* ------------------------------------------------------------- requests */
+
+/* The main loop's parameter request (creq): all of it with the gates off,
+ * the LIVE part while running (the rest when the gates are off again). */
+static void take_config(drive_t *drv) {
+  const uint32_t seq = drv->creq.seq;
+  if ((seq & 1u) != 0u || (seq == drv->cfg_seen && !drv->cfg_pending)) {
+    return;
+  }
+  DRIVE_BARRIER();
+  drv->cfg_seen = seq;
+  if (gates_on_state(drv->state) || drv->state == DRIVE_STATE_OFFSET_CAL) {
+    drv->cfg_pending = configure_live(drv, &drv->creq.cfg);
+    return;
+  }
+  drv->cfg_pending = false;
+  const drive_config_t prev = drv->cfg;
+  const drive_law_t prev_law = drv->ctrl.law;
+  drive_config_err_t err;
+  /* with the law commanded: the main loop validated the request against it */
+  if (drive_configure(drv, &drv->creq.cfg, drv->cmd.law, &err) != 0) {
+    /* cannot happen (validated): keep the set in force and say so */
+    (void)drive_configure(drv, &prev, prev_law, &err);
+    drive_trip(drv, DRIVE_FAULT_CONFIG);
+  }
+}
+
+/* The main loop's command block (req): references, enable, law and mode,
+ * then fault requests and clears in the order the main loop made them. */
+static void take_commands(drive_t *drv) {
+  const uint32_t seq = drv->req.seq;
+  if ((seq & 1u) != 0u || seq == drv->cmd.seq) {
+    return;
+  }
+  DRIVE_BARRIER();
+  drv->cmd = drv->req.cmd;
+  drv->cmd.seq = seq;
+  if (drv->cmd.clear_count != drv->clear_seen) {
+    drv->clear_seen = drv->cmd.clear_count;
+    /* requests made before the clear are void */
+    memcpy(drv->fault_seen, drv->cmd.clear_mark, sizeof drv->fault_seen);
+    if (drv->state == DRIVE_STATE_FAULT) {
+      hal_fault_hw_clear();
+      drv->faults = 0u;
+      drv->state = DRIVE_STATE_IDLE;
+      drv->armed = false; /* a fresh enable is needed */
+    }
+  }
+  uint32_t req = 0u;
+  for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {
+    if (drv->cmd.fault_count[b] != drv->fault_seen[b]) {
+      drv->fault_seen[b] = drv->cmd.fault_count[b];
+      req |= 1u << b;
+    }
+  }
+  if (req != 0u) {
+    drive_trip(drv, req);
+  }
+}
+
+/* ---------------------------------------------------------- protections */
+
+static uint32_t drive_protect(const drive_t *drv, const hal_sample_t *s, const float i[3]) {
   const drive_config_t *c = &drv->cfg;
-  uint32_t f = 0;
-  if (!(fd_isfinite(i[0]) && fd_isfinite(i[1]) && fd_isfinite(i[2]) && fd_isfinite(s->v_dc))) {
+  if (!s->valid ||
+      !(fd_isfinite(i[0]) && fd_isfinite(i[1]) && fd_isfinite(i[2]) && fd_isfinite(s->v_dc))) {
     return DRIVE_FAULT_SAMPLE;
   }
+  uint32_t f = 0u;
   if (fabsf(i[0]) > c->i_trip || fabsf(i[1]) > c->i_trip || fabsf(i[2]) > c->i_trip) {
     f |= DRIVE_FAULT_OVERCURRENT;
   }
   if (s->v_dc > c->v_dc_max) {
     f |= DRIVE_FAULT_OVERVOLTAGE;
   }
-  if (drv->state == DRIVE_STATE_RUN && s->v_dc < c->v_dc_min) {
+  if (gates_on_state(drv->state) && s->v_dc < c->v_dc_min) {
     f |= DRIVE_FAULT_UNDERVOLTAGE;
   }
-  if (fabsf(drv->pos.omega_m) > c->speed_trip) {
+  if (fabsf(drv->omega_m) > c->speed_trip) {
     f |= DRIVE_FAULT_OVERSPEED;
   }
   if (hal_fault_hw_tripped()) {
     f |= DRIVE_FAULT_HW_OVERCURRENT;
   }
+  /* the position must be usable before the gates go on, and plausible
+   * while they are */
+  if (enabled_state(drv->state) &&
+      (!drv->pos.valid || (drv->state == DRIVE_STATE_RUN && drv->pos.health > c->pos_err_max))) {
+    f |= DRIVE_FAULT_POSITION;
+  }
   return f;
 }
 
-static void drive_update_position(drive_t *drv, const hal_adc_sample_t *s) {
-  if (s->enc_valid && fd_isfinite(s->enc_angle)) {
-    /* The encoder angle is sampled at the ADC instant: Park uses it as is;
-     * the PLL gives the speed. */
-    const float th = frames_wrap_pi(drv->cfg.pole_pairs * s->enc_angle - drv->cfg.enc_offset);
-    angle_pll_update(&drv->pll, th);
-    drv->pos.theta_e = th;
-  } else {
-    drv->pos.theta_e = drv->pll.theta;
+/* Loss of control: each condition must hold for lc_time before the trip. */
+static void drive_monitor(drive_t *drv, const ctrl_in_t *in, const ctrl_out_t *out) {
+  const drive_config_t *c = &drv->cfg;
+  uint32_t cond = 0u;
+  const float i_lim = c->lc_current * c->i_max;
+  if (out->i_dq.d * out->i_dq.d + out->i_dq.q * out->i_dq.q > i_lim * i_lim) {
+    cond |= DRIVE_LC_CURRENT;
   }
-  drv->pos.omega_e = drv->pll.omega;
-  drv->pos.omega_m = drv->pll.omega / drv->cfg.pole_pairs;
-  drv->pos.rate_acc += drv->pll.omega_rate;
-  drv->pos.rate_n++;
-}
-
-static void drive_offset_cal(drive_t *drv, const hal_adc_sample_t *s) {
-  for (int x = 0; x < 3; ++x) {
-    drv->offset_acc[x] += s->i_abc[x];
-  }
-  drv->offset_n++;
-  if (drv->offset_n < drv->cfg.offset_samples) {
-    return;
-  }
-  float n = (float)drv->offset_n;
-  for (int x = 0; x < 3; ++x) {
-    drv->offset[x] = drv->offset_acc[x] / n;
-    if (fabsf(drv->offset[x]) > drv->cfg.offset_max) {
-      drive_trip(drv, DRIVE_FAULT_OFFSET);
-      return;
+  if (in->mode != DRIVE_MODE_CURRENT) {
+    /* the torque the law says it can deliver now, against its estimate,
+     * on the scale of the torque at i_max */
+    const float t_ref = fd_clampf(in->torque_ref, out->torque_min, out->torque_max);
+    if (fabsf(out->tm.torque - t_ref) > c->lc_track * drv->torque_scale) {
+      cond |= DRIVE_LC_TORQUE;
     }
   }
-  ctrl_reset(&drv->ctrl, drv->ref.law);
-  speed_ctrl_reset(&drv->speed, drv->pos.omega_m, 0.0f);
-  drv->speed_torque = 0.0f;
-  hal_pwm_set_duty(0.5f, 0.5f, 0.5f);
-  hal_pwm_enable();
-  drv->state = DRIVE_STATE_RUN;
+  if ((drv->ctrl.impl->caps & CTRL_CAP_FLUX) != 0u) {
+    if (fabsf(out->tm.delta) > c->delta_max + c->lc_delta) {
+      cond |= DRIVE_LC_DELTA;
+    }
+    if (fabsf(out->tm.flux - out->tm.flux_ref) > c->lc_track * out->tm.flux_ref) {
+      cond |= DRIVE_LC_FLUX;
+    }
+    /* the observer against its current model, on the scale of the flux at
+     * i_max: a detuned model (Rubino 2020, Figs. 19-20) differs by tens of
+     * per cent of that at most, a diverging integration by more */
+    if (out->tm.obs_err > c->lc_track * drv->flux_scale) {
+      cond |= DRIVE_LC_OBSERVER;
+    }
+  }
+  /* current and load angle within lc_time; tracking within lc_track_time */
+  const float n_fast = c->lc_time / c->ts, n_track = c->lc_track_time / c->ts;
+  uint32_t trip = 0u;
+  for (unsigned k = 0; k < DRIVE_LC_COUNT; ++k) {
+    drv->lc_n[k] = (cond & (1u << k)) != 0u ? drv->lc_n[k] + 1u : 0u;
+    const uint32_t bit = 1u << k;
+    const float n_max = (bit & (DRIVE_LC_CURRENT | DRIVE_LC_DELTA)) != 0u ? n_fast : n_track;
+    if ((float)drv->lc_n[k] >= n_max) {
+      trip |= bit;
+    }
+  }
+  if (trip != 0u) {
+    drv->tm.lc_cause = trip;
+    drive_trip(drv, DRIVE_FAULT_LOST_CONTROL);
+  }
 }
 
-static void drive_run(drive_t *drv, const float i[3], float v_dc) {
+/* ------------------------------------------------------------- the loop */
+
+/* Writes duties (gates on states), returns the voltage the board applies
+ * over the next period, rebuilt from the pattern the HAL reports it will
+ * really apply (rounding, limits) less the dead-time correction where the
+ * leg switches (no switching, no dead-time error). */
+static ab_t drive_write(drive_t *drv, const float duty[3], const float dtc[3], float v_dc) {
+  float dc[3];
+  for (int x = 0; x < 3; ++x) {
+    dc[x] = fd_clampf(duty[x] + dtc[x], 0.0f, 1.0f);
+  }
+  const hal_pwm_t req = hal_pwm_centred(dc[0], dc[1], dc[2]);
+  hal_pwm_t got;
+  hal_pwm_write(&req, &got);
+  float pole[3];
+  for (int x = 0; x < 3; ++x) {
+    const float d = got.off[x] - got.on[x];
+    drv->tm.duty[x] = d;
+    pole[x] = (d > 0.0f && d < 1.0f) ? d - dtc[x] : d;
+  }
+  return frames_clarke((abc_t){pole[0] * v_dc, pole[1] * v_dc, pole[2] * v_dc});
+}
+
+/* The speed loop, every slow_div ISRs, on the angle rate averaged over that
+ * period (no lag under acceleration). */
+static void drive_speed_loop(drive_t *drv) {
+  const drive_config_t *c = &drv->cfg;
+  if ((drv->isr_count - 1u) % c->slow_div != 0u) {
+    return;
+  }
+  const float w =
+      drv->rate_n > 0u ? drv->rate_acc / ((float)drv->rate_n * c->pole_pairs) : drv->omega_m;
+  drv->rate_acc = 0.0f;
+  drv->rate_n = 0u;
+  if (drv->state == DRIVE_STATE_RUN && drv->cmd.mode == DRIVE_MODE_SPEED) {
+    if (!drv->speed_active) {
+      speed_ctrl_reset(&drv->speed, w, drv->tm.torque_ref);
+      drv->speed_active = true;
+    }
+    /* the limit in force re-clamps the reference (a live speed_max write) */
+    const float w_ref = fd_clampf(drv->cmd.speed, -c->speed_max, c->speed_max);
+    drv->speed_torque =
+        speed_ctrl_update(&drv->speed, w_ref, w, drv->torque_min_avail, drv->torque_max_avail);
+  } else {
+    speed_ctrl_reset(&drv->speed, drv->omega_m, 0.0f);
+    drv->speed_active = false;
+    drv->speed_torque = 0.0f;
+  }
+  drv->tm.speed_ref = drv->speed_active ? drv->speed.w_ref_ramped : 0.0f;
+}
+
+/* The mode in force: current mode only with a law that has it. */
+static drive_mode_t mode_in_force(const drive_t *drv) {
+  const drive_mode_t m = drv->cmd.mode;
+  if ((unsigned)m >= (unsigned)DRIVE_MODE_COUNT ||
+      (m == DRIVE_MODE_CURRENT && (drv->ctrl.impl->caps & CTRL_CAP_CURRENT) == 0u)) {
+    return DRIVE_MODE_TORQUE;
+  }
+  return m;
+}
+
+static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
   ctrl_in_t in;
   in.i_ab = frames_clarke((abc_t){i[0], i[1], i[2]});
-  in.theta_e = drv->pos.theta_e;
-  in.omega_e = drv->pos.omega_e;
-  in.v_dc = v_dc;
-  in.mode = drv->ref.mode;
-  in.torque_ref = drv->ref.mode == DRIVE_MODE_SPEED ? drv->speed_torque : drv->ref.torque;
-  in.id_ref = drv->ref.id;
-  in.iq_ref = drv->ref.iq;
-  in.flux_ref = drv->ref.flux;
+  in.v_applied = drv->v_applied;
+  /* the angle at the current sample, from the source's timestamp */
+  in.theta_e = frames_wrap_pi(drv->pos.theta + drv->pos.omega * (s->t_i - drv->pos.t));
+  in.omega_e = drv->pos.omega;
+  in.v_lin = drv->v_lin;
+  in.mode = mode_in_force(drv);
+  in.torque_ref = in.mode == DRIVE_MODE_SPEED ? drv->speed_torque : drv->cmd.torque;
+  in.id_ref = drv->cmd.id;
+  in.iq_ref = drv->cmd.iq;
+  in.flux_ref = drv->cmd.flux;
 
   ctrl_out_t out;
   ctrl_step(&drv->ctrl, &in, &out);
@@ -158,64 +400,160 @@ static void drive_run(drive_t *drv, const float i[3], float v_dc) {
     drive_trip(drv, DRIVE_FAULT_CONTROL);
     return;
   }
-  modulation_out_t m = modulation_minmax(out.v_ref, v_dc);
-  float d[3] = {m.duty[0], m.duty[1], m.duty[2]};
-  ctrl_compensate_deadtime(&drv->ctrl, &out, d);
-  hal_pwm_set_duty(d[0], d[1], d[2]);
-  ctrl_set_applied(&drv->ctrl, m.v_applied);
+  const hal_caps_t *caps = drv->caps;
+  const modulation_out_t m = modulation_minmax(out.v_ref, s->v_dc, caps->duty_min, caps->duty_max);
+  float dtc[3];
+  ctrl_deadtime_delta(&drv->ctrl, &out, dtc);
+  drv->v_applied = drive_write(drv, m.duty, dtc, s->v_dc);
   drv->torque_min_avail = out.torque_min;
   drv->torque_max_avail = out.torque_max;
 
   drive_telemetry_t *tm = &drv->tm;
   tm->i_dq[0] = out.i_dq.d;
   tm->i_dq[1] = out.i_dq.q;
-  tm->v_ab_applied[0] = m.v_applied.alpha;
-  tm->v_ab_applied[1] = m.v_applied.beta;
-  tm->duty[0] = d[0];
-  tm->duty[1] = d[1];
-  tm->duty[2] = d[2];
+  tm->theta_e = in.theta_e;
   tm->torque_ref = in.torque_ref;
   tm->torque_est = out.tm.torque;
   tm->law_tm = out.tm;
+  drive_monitor(drv, &in, &out);
+}
+
+/* Alignment: d current along theta = 0 for align_time, then the position
+ * source takes theta = 0 as its reference. */
+static void drive_align(drive_t *drv, const float i[3], const hal_sample_t *s) {
+  const drive_config_t *c = &drv->cfg;
+  const ab_t i_ab = frames_clarke((abc_t){i[0], i[1], i[2]});
+  const dq_t v = current_ctrl_update(&drv->align_cc, (dq_t){c->align_current, 0.0f},
+                                     (dq_t){i_ab.alpha, i_ab.beta}, 0.0f, c->v_margin * drv->v_lin);
+  const modulation_out_t m =
+      modulation_minmax((ab_t){v.d, v.q}, s->v_dc, drv->caps->duty_min, drv->caps->duty_max);
+  const float none[3] = {0.0f, 0.0f, 0.0f};
+  drv->v_applied = drive_write(drv, m.duty, none, s->v_dc);
+  if ((float)++drv->align_n * c->ts >= c->align_time) {
+    drv->pos_src->align(&drv->pos_st, c, s, 0.0f);
+    ctrl_reset(&drv->ctrl);
+    drv->v_applied = (ab_t){0.0f, 0.0f};
+    drv->state = DRIVE_STATE_RUN;
+  }
+}
+
+static void drive_start(drive_t *drv) {
+  ctrl_reset(&drv->ctrl);
+  drv->speed_active = false;
+  drv->speed_torque = 0.0f;
+  memset(drv->lc_n, 0, sizeof drv->lc_n);
+  drv->tm.lc_cause = 0u;
+  drv->v_applied = (ab_t){0.0f, 0.0f};
+  const bool align = drv->cfg.align_time > 0.0f && (drv->pos_src->caps & POS_CAP_ALIGN) != 0u;
+  if (align) {
+    current_ctrl_reset(&drv->align_cc);
+    drv->align_n = 0u;
+  }
+  const float mid = 0.5f * (drv->caps->duty_min + drv->caps->duty_max);
+  const hal_pwm_t p = hal_pwm_centred(mid, mid, mid);
+  hal_pwm_write(&p, NULL);
+  hal_pwm_enable();
+  drv->state = align ? DRIVE_STATE_ALIGN : DRIVE_STATE_RUN;
+}
+
+static void drive_offset_cal(drive_t *drv, const hal_sample_t *s) {
+  for (int x = 0; x < 3; ++x) {
+    drv->offset_acc[x] += s->i_abc[x];
+  }
+  drv->offset_n++;
+  if (drv->offset_n < drv->cfg.offset_samples) {
+    return;
+  }
+  const float n = (float)drv->offset_n;
+  for (int x = 0; x < 3; ++x) {
+    drv->offset[x] = drv->offset_acc[x] / n;
+    if (fabsf(drv->offset[x]) > drv->cfg.offset_max) {
+      drive_trip(drv, DRIVE_FAULT_OFFSET);
+      return;
+    }
+  }
+  drive_start(drv);
+}
+
+static void drive_publish(drive_t *drv, const hal_sample_t *s, const float i[3]) {
+  drive_telemetry_t *tm = &drv->tm;
+  tm->isr_count = drv->isr_count;
+  tm->state = drv->state;
+  tm->faults = drv->faults;
+  tm->law = drv->ctrl.law;
+  tm->mode = drv->cmd.mode;
+  tm->v_dc = s->v_dc;
+  tm->i_abc[0] = i[0];
+  tm->i_abc[1] = i[1];
+  tm->i_abc[2] = i[2];
+  tm->v_ab_applied[0] = drv->v_applied.alpha;
+  tm->v_ab_applied[1] = drv->v_applied.beta;
+  tm->omega_m = drv->omega_m;
+  tm->pos_health = drv->pos.health;
+  tm->cmd_seq = drv->cmd.seq;
+  if (drv->state != DRIVE_STATE_RUN) {
+    tm->theta_e = drv->pos.theta;
+  }
+  tm->isr_count_end = drv->isr_count;
+  DRIVE_BARRIER();
+  drv->tm_seq++; /* the main loop's copy is consistent iff it saw no change */
 }
 
 void drive_isr(drive_t *drv) {
-  hal_adc_sample_t s;
+  hal_sample_t s;
   hal_adc_read(&s);
   drv->isr_count++;
+  take_commands(drv); /* first: a parameter set is validated with the law commanded */
+  take_config(drv);
 
   float i[3];
   for (int x = 0; x < 3; ++x) {
     i[x] = s.i_abc[x] - drv->offset[x];
   }
-  drive_update_position(drv, &s);
+  drive_speed_loop(drv); /* on the rates of the previous slow_div periods */
+  drv->pos_src->update(&drv->pos_st, &drv->cfg, &s, &drv->pos);
+  drv->omega_m = drv->pos.omega / drv->cfg.pole_pairs;
+  drv->rate_acc += drv->pos.rate;
+  drv->rate_n++;
+  drv->v_lin = modulation_v_max(s.v_dc, drv->caps->duty_min, drv->caps->duty_max);
 
-  uint32_t f = drive_protect(drv, &s, i);
+  const uint32_t f = drive_protect(drv, &s, i);
   if (f != 0u) {
     drive_trip(drv, f);
   }
+  if (!drv->cmd.enable) {
+    drv->armed = true;
+  }
+  const bool enable = drv->cmd.enable && drv->armed;
 
   switch (drv->state) {
   case DRIVE_STATE_IDLE:
-    if (drv->ref.enable) {
+    if (drv->cmd.law != drv->ctrl.law) {
+      (void)ctrl_select(&drv->ctrl, drv->cmd.law); /* refused: the law in force stays */
+    }
+    if (enable) {
       drv->offset_acc[0] = drv->offset_acc[1] = drv->offset_acc[2] = 0.0f;
-      drv->offset_n = 0;
+      drv->offset_n = 0u;
+      drv->pos_src->reset(&drv->pos_st);
       drv->state = DRIVE_STATE_OFFSET_CAL;
     }
     break;
   case DRIVE_STATE_OFFSET_CAL:
-    if (!drv->ref.enable) {
+    if (!enable) {
       drv->state = DRIVE_STATE_IDLE;
     } else {
       drive_offset_cal(drv, &s);
     }
     break;
+  case DRIVE_STATE_ALIGN:
   case DRIVE_STATE_RUN:
-    if (!drv->ref.enable) {
-      drive_gates_off();
+    if (!enable) {
+      drive_gates_off(drv);
       drv->state = DRIVE_STATE_IDLE;
+    } else if (drv->state == DRIVE_STATE_ALIGN) {
+      drive_align(drv, i, &s);
     } else {
-      drive_run(drv, i, s.v_dc);
+      drive_run(drv, i, &s);
     }
     break;
   case DRIVE_STATE_FAULT:
@@ -223,97 +561,66 @@ void drive_isr(drive_t *drv) {
     hal_pwm_disable();
     break;
   }
-  if (drv->state != DRIVE_STATE_RUN) {
-    ctrl_set_applied(&drv->ctrl, (ab_t){0.0f, 0.0f});
+  if (!gates_on_state(drv->state)) {
+    drv->v_applied = (ab_t){0.0f, 0.0f};
   }
-
-  drive_telemetry_t *tm = &drv->tm;
-  tm->state = drv->state;
-  tm->faults = drv->faults;
-  tm->v_dc = s.v_dc;
-  tm->i_abc[0] = i[0];
-  tm->i_abc[1] = i[1];
-  tm->i_abc[2] = i[2];
-  tm->theta_e = drv->pos.theta_e;
-  tm->omega_m = drv->pos.omega_m;
-  tm->isr_count = drv->isr_count;
-  hal_watchdog_kick();
+  drive_publish(drv, &s, i);
 }
 
-void drive_slow_loop(drive_t *drv) {
-  drv->slow_count++;
-  if (drv->pos.rate_n > 0u) {
-    drv->pos.omega_m_slow = drv->pos.rate_acc / ((float)drv->pos.rate_n * drv->cfg.pole_pairs);
-    drv->pos.rate_acc = 0.0f;
-    drv->pos.rate_n = 0u;
-  }
-  if (drv->cmd.clear_fault) {
-    drv->cmd.clear_fault = false;
-    if (drv->state == DRIVE_STATE_FAULT) {
-      /* Clearing needs a fresh enable: the operator re-arms explicitly. */
-      hal_fault_hw_clear();
-      drv->faults = 0;
-      drv->cmd.enable = false;
-      drv->ref.enable = false;
-      drv->state = DRIVE_STATE_IDLE;
+/* ------------------------------------------------------------ main loop */
+
+bool drive_telemetry_read(drive_t *drv, drive_telemetry_t *out) {
+  for (int n = 0; n < DRIVE_TM_TRIES; ++n) {
+    const uint32_t s1 = drv->tm_seq;
+    DRIVE_BARRIER();
+    *out = drv->tm;
+    DRIVE_BARRIER();
+    if (drv->tm_seq == s1) {
+      return true;
     }
+    drv->host.tm_retries++;
   }
-  /* A law change takes effect only while the gates are off. */
-  if (drv->state != DRIVE_STATE_RUN && drv->state != DRIVE_STATE_OFFSET_CAL) {
-    drv->ref.law = drv->cmd.law;
-  }
-  if (drv->state == DRIVE_STATE_FAULT) {
-    drv->cmd.enable = false;
-  }
-  /* The mode (torque/speed/current) may change on the fly except into
-   * current mode with a DFVC law. */
-  if (drv->cmd.mode == DRIVE_MODE_CURRENT && drv->ref.law != DRIVE_LAW_FOC) {
-    drv->cmd.mode = drv->ref.mode == DRIVE_MODE_CURRENT ? DRIVE_MODE_TORQUE : drv->ref.mode;
-  }
-  bool was_speed = drv->ref.mode == DRIVE_MODE_SPEED;
-  refs_from_cmd(drv);
-
-  if (drv->state == DRIVE_STATE_RUN && drv->ref.mode == DRIVE_MODE_SPEED) {
-    if (!was_speed) {
-      speed_ctrl_reset(&drv->speed, drv->pos.omega_m_slow, drv->tm.torque_ref);
-    }
-    drv->speed_torque = speed_ctrl_update(&drv->speed, drv->ref.speed, drv->pos.omega_m_slow,
-                                          drv->torque_min_avail, drv->torque_max_avail);
-  } else {
-    speed_ctrl_reset(&drv->speed, drv->pos.omega_m, 0.0f);
-    drv->speed_torque = 0.0f;
-  }
-  drv->tm.law = drv->ref.law;
-  drv->tm.mode = drv->ref.mode;
-  drv->tm.speed_ref = drv->ref.mode == DRIVE_MODE_SPEED ? drv->speed.w_ref_ramped : 0.0f;
+  return false;
 }
 
-void drive_cmd_enable(drive_t *drv, bool enable) {
-  drv->cmd.enable = enable;
-}
-
-void drive_cmd_clear_fault(drive_t *drv) {
-  drv->cmd.clear_fault = true;
-}
-
-bool drive_cmd_set_law(drive_t *drv, drive_law_t law) {
-  if ((unsigned)law >= (unsigned)DRIVE_LAW_COUNT) {
-    return false;
+void drive_background(drive_t *drv) {
+  drive_telemetry_t tm;
+  if (drive_telemetry_read(drv, &tm)) {
+    drv->host.tm = tm;
   }
-  drv->cmd.law = law;
-  return true;
-}
-
-bool drive_cmd_set_mode(drive_t *drv, drive_mode_t mode) {
-  if ((unsigned)mode >= (unsigned)DRIVE_MODE_COUNT) {
-    return false;
+  const uint32_t n = drv->isr_count; /* one aligned word: read atomically */
+  if (n != drv->host.isr_seen) {
+    drv->host.isr_seen = n;
+    hal_watchdog_kick();
   }
-  drv->cmd.mode = mode;
-  return true;
 }
 
-/* Command clamp: a non-finite command becomes 0 (not a limit, as
- * fd_clampf would make it). */
+const drive_telemetry_t *drive_telemetry(const drive_t *drv) {
+  return &drv->host.tm;
+}
+
+const drive_cmd_t *drive_commands(const drive_t *drv) {
+  return &drv->req.cmd;
+}
+
+const drive_config_t *drive_requested_config(const drive_t *drv) {
+  return &drv->creq.cfg;
+}
+
+/* The command block is written between cmd_begin and cmd_end (seq odd). */
+static drive_cmd_t *cmd_begin(drive_t *drv) {
+  drv->req.seq++;
+  DRIVE_BARRIER();
+  return &drv->req.cmd;
+}
+
+static void cmd_end(drive_t *drv) {
+  drv->req.cmd.seq++;
+  DRIVE_BARRIER();
+  drv->req.seq++;
+}
+
+/* Command clamp: a non-finite command becomes 0 (not a limit). */
 static float command_clamp(float x, float lo, float hi) {
   if (!fd_isfinite(x)) {
     return 0.0f;
@@ -321,119 +628,117 @@ static float command_clamp(float x, float lo, float hi) {
   return x < lo ? lo : (x > hi ? hi : x);
 }
 
+void drive_cmd_enable(drive_t *drv, bool enable) {
+  drive_cmd_t *c = cmd_begin(drv);
+  c->enable = enable ? 1u : 0u;
+  cmd_end(drv);
+}
+
+void drive_cmd_clear_fault(drive_t *drv) {
+  drive_cmd_t *c = cmd_begin(drv);
+  c->clear_count++;
+  memcpy(c->clear_mark, c->fault_count, sizeof c->clear_mark);
+  c->enable = 0u;
+  cmd_end(drv);
+}
+
+static ctrl_setup_t host_setup(const drive_t *drv) {
+  const ctrl_setup_t su = {&drv->creq.cfg, &drv->host.machine, 1.5f * drv->creq.cfg.ts};
+  return su;
+}
+
+const char *drive_cmd_set_law(drive_t *drv, drive_law_t law) {
+  const ctrl_law_t *row = ctrl_law(law);
+  if (row == NULL) {
+    return "no such law";
+  }
+  const ctrl_setup_t su = host_setup(drv);
+  const char *why = row->check(&su);
+  if (why != NULL) {
+    return why;
+  }
+  if (drv->req.cmd.mode == DRIVE_MODE_CURRENT && (row->caps & CTRL_CAP_CURRENT) == 0u) {
+    return "this law has no current mode: leave current mode first";
+  }
+  drive_cmd_t *c = cmd_begin(drv);
+  c->law = law;
+  cmd_end(drv);
+  return NULL;
+}
+
+const char *drive_cmd_set_mode(drive_t *drv, drive_mode_t mode) {
+  if ((unsigned)mode >= (unsigned)DRIVE_MODE_COUNT) {
+    return "no such mode";
+  }
+  const ctrl_law_t *row = ctrl_law(drv->req.cmd.law);
+  if (mode == DRIVE_MODE_CURRENT && (row->caps & CTRL_CAP_CURRENT) == 0u) {
+    return "the law has no current mode";
+  }
+  drive_cmd_t *c = cmd_begin(drv);
+  c->mode = mode;
+  cmd_end(drv);
+  return NULL;
+}
+
 void drive_cmd_torque(drive_t *drv, float torque) {
-  drv->cmd.torque = command_clamp(torque, -drv->cfg.torque_max, drv->cfg.torque_max);
+  const float lim = drv->creq.cfg.torque_max;
+  drive_cmd_t *c = cmd_begin(drv);
+  c->torque = command_clamp(torque, -lim, lim);
+  cmd_end(drv);
 }
 
 void drive_cmd_speed(drive_t *drv, float speed_m) {
-  drv->cmd.speed = command_clamp(speed_m, -drv->cfg.speed_max, drv->cfg.speed_max);
+  const float lim = drv->creq.cfg.speed_max;
+  drive_cmd_t *c = cmd_begin(drv);
+  c->speed = command_clamp(speed_m, -lim, lim);
+  cmd_end(drv);
 }
 
 void drive_cmd_current(drive_t *drv, float id, float iq) {
-  float lim = drv->cfg.i_max;
+  const float lim = drv->creq.cfg.i_max;
   id = command_clamp(id, -lim, lim);
   iq = command_clamp(iq, -lim, lim);
-  float mag = sqrtf(id * id + iq * iq);
+  const float mag = sqrtf(id * id + iq * iq);
   if (mag > lim) {
     id *= lim / mag;
     iq *= lim / mag;
   }
-  drv->cmd.id = id;
-  drv->cmd.iq = iq;
+  drive_cmd_t *c = cmd_begin(drv);
+  c->id = id;
+  c->iq = iq;
+  cmd_end(drv);
 }
 
 void drive_cmd_flux(drive_t *drv, float flux) {
-  drv->cmd.flux = command_clamp(flux, 0.0f, 10.0f);
+  drive_cmd_t *c = cmd_begin(drv);
+  c->flux = command_clamp(flux, 0.0f, 10.0f);
+  cmd_end(drv);
 }
 
-int drive_set_config(drive_t *drv, const drive_config_t *cfg, const char **field) {
-  const char *dummy = "";
-  if (field == 0) {
-    field = &dummy;
-  }
-  const bool enabled = drv->state == DRIVE_STATE_RUN || drv->state == DRIVE_STATE_OFFSET_CAL;
-  drive_config_t next = *cfg;
-  if (enabled) {
-    next = drv->cfg;
-    next.i_trip = cfg->i_trip;
-    next.v_dc_max = cfg->v_dc_max;
-    next.v_dc_min = cfg->v_dc_min;
-    next.speed_trip = cfg->speed_trip;
-    next.offset_max = cfg->offset_max;
-    next.speed_max = cfg->speed_max;
-    next.torque_max = cfg->torque_max;
-    next.accel_max = cfg->accel_max;
-    next.speed_bw = cfg->speed_bw;
-  }
-  int err = drive_config_check(&next, field);
-  if (err != 0) {
-    return err;
-  }
-  speed_ctrl_cfg_t scfg;
-  speed_cfg_from(&scfg, &next);
-  if (enabled) {
-    /* live: new gains and limits, the integral and ramp carry on */
-    drv->speed.cfg.kp = scfg.kp;
-    drv->speed.cfg.ki = scfg.ki;
-    drv->speed.cfg.j_ff = scfg.j_ff;
-    drv->speed.cfg.accel_max = scfg.accel_max;
-    drv->speed.cfg.torque_max = fabsf(scfg.torque_max);
-    drv->speed.pi.kp = scfg.kp;
-    drv->speed.pi.ki = scfg.ki;
-    drv->ctrl.torque_max = next.torque_max;
-  } else {
-    drive_law_t law = drv->ctrl.law;
-    if (ctrl_init(&drv->ctrl, &next) != 0) {
-      /* the laws refused: restore the previous (valid) set */
-      (void)ctrl_init(&drv->ctrl, &drv->cfg);
-      drv->ctrl.law = law;
-      *field = "law parameters";
-      return -1;
-    }
-    drv->ctrl.law = law;
-    angle_pll_init(&drv->pll, next.pll_bw, next.ts);
-    speed_ctrl_init(&drv->speed, &scfg);
-  }
-  drv->cfg = next;
-  return 0;
-}
-
-void drive_raise_fault(drive_t *drv, uint32_t fault_bits) {
-  drive_trip(drv, fault_bits);
-  drv->tm.state = drv->state;
-  drv->tm.faults = drv->faults;
-}
-
-const drive_telemetry_t *drive_telemetry(const drive_t *drv) {
-  return &drv->tm;
-}
-
-const char *drive_state_name(drive_state_t s) {
-  switch (s) {
-  case DRIVE_STATE_IDLE:
-    return "idle";
-  case DRIVE_STATE_OFFSET_CAL:
-    return "offset_cal";
-  case DRIVE_STATE_RUN:
-    return "run";
-  case DRIVE_STATE_FAULT:
-    return "fault";
-  default:
-    return "unknown";
-  }
-}
-
-const char *drive_fault_name(uint32_t fault_bits) {
-  static const char *const names[] = {"overcurrent", "overvoltage",    "undervoltage",
-                                      "overspeed",   "hw_overcurrent", "offset",
-                                      "control",     "cmd_timeout",    "sample"};
-  if (fault_bits == 0u) {
-    return "none";
-  }
-  for (unsigned b = 0; b < sizeof names / sizeof names[0]; ++b) {
+void drive_request_fault(drive_t *drv, uint32_t fault_bits) {
+  drive_cmd_t *c = cmd_begin(drv);
+  for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {
     if ((fault_bits & (1u << b)) != 0u) {
-      return names[b];
+      c->fault_count[b]++;
     }
   }
-  return "unknown";
+  cmd_end(drv);
+}
+
+int drive_request_config(drive_t *drv, const drive_config_t *cfg, drive_config_err_t *err) {
+  drive_config_err_t dummy;
+  if (err == NULL) {
+    err = &dummy;
+  }
+  machine_t m;
+  if (drive_config_usable(cfg, drv->req.cmd.law, &m, err) != 0) {
+    return -1;
+  }
+  drv->host.machine = m;
+  drv->creq.seq++;
+  DRIVE_BARRIER();
+  drv->creq.cfg = *cfg;
+  DRIVE_BARRIER();
+  drv->creq.seq++;
+  return 0;
 }

@@ -1,14 +1,38 @@
 /*
- * drive.h - the drive: state machine, ISR body, slow loop, protections and
- * the command interface used by the SIL runner and the CAN protocol.
+ * drive.h - the drive: state machine, ISR body, protections, the command
+ * interface of the main loop, telemetry.
  *
- * Call pattern (board or SIL):
- *   drive_init(&drv, &cfg, &err)    once; cfg is validated
- *   drive_isr(&drv)                 every PWM period, right after the ADC
- *   drive_slow_loop(&drv)           every cfg.slow_div ISRs (e.g. 1 kHz),
- *                                   outside the ISR; applies commands
- *   drive_cmd_*(&drv, ...)          any time from the slow context; staged,
- *                                   they take effect at the next slow loop
+ * Concurrency contract (docs/architecture.md, "Concurrency"). Two contexts
+ * touch a drive_t: the PWM-period interrupt (drive_isr) and the main loop
+ * (drive_cmd_*, drive_params_set, drive_background, can_proto). The ISR
+ * preempts the main loop, never the reverse.
+ *  - The ISR is the only writer of drive state: state, faults, the
+ *    parameter set in force, the machine, laws, position, speed loop,
+ *    offsets. Nothing else writes them.
+ *  - The main loop posts requests; it is the only writer of:
+ *      req   the command block (enable, law, mode, references, clear-fault
+ *            and fault-request counters), published under a sequence lock:
+ *            seq odd while writing; the ISR takes a copy when seq is even
+ *            and changed (it cannot be preempted by the writer, so an even
+ *            seq seen at its start means the block is consistent);
+ *      creq  a requested parameter set, same protocol; the ISR applies it
+ *            at its next period (all of it with the gates off, the LIVE
+ *            parameters while running, the rest as soon as the gates are
+ *            off again);
+ *      host  the main loop's own view (telemetry copy, watchdog bookkeeping).
+ *    Counters (clear, fault requests) are compared, never reset, so a
+ *    request is never lost and never applied twice.
+ *  - Telemetry leaves the ISR under a sequence lock (tm_seq);
+ *    drive_telemetry_read() copies it consistently (bounded retries).
+ *  - The watchdog is refreshed by drive_background() only, and only when
+ *    the ISR has run since the last refresh: a hung main loop or a stopped
+ *    interrupt both reset the MCU.
+ *
+ * Call pattern (board, SIL, PIL):
+ *   drive_init(&drv, &cfg, &err)   once, before the interrupt starts
+ *   drive_isr(&drv)                every PWM period, right after the samples
+ *   drive_cmd_*(&drv, ...)         main loop: post commands (next ISR)
+ *   drive_background(&drv)         main loop, every slow period (~1 kHz)
  */
 #ifndef FLUXDRIVE_DRIVE_H
 #define FLUXDRIVE_DRIVE_H
@@ -16,33 +40,27 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "drive_config.h"
+#include "control/current_ctrl.h"
 #include "control/speed_ctrl.h"
-#include "drive_ctrl.h"
-#include "estimation/angle_pll.h"
+#include "ctrl.h"
+#include "drive_config.h"
+#include "hal.h"
+#include "model/machine.h"
+#include "pos_source.h"
 
-typedef enum {
-  DRIVE_STATE_IDLE = 0,       /* gates off, waiting for enable */
-  DRIVE_STATE_OFFSET_CAL = 1, /* gates off, averaging current offsets */
-  DRIVE_STATE_RUN = 2,        /* gates on, control law active */
-  DRIVE_STATE_FAULT = 3       /* gates off, cause latched until cleared */
-} drive_state_t;
-
-/* Fault causes: bits, latched until drive_cmd_clear_fault(). */
+/* Loss-of-control conditions (drive_telemetry_t.lc_cause). */
 enum {
-  DRIVE_FAULT_OVERCURRENT = 1u << 0,    /* |i_x| sample above i_trip */
-  DRIVE_FAULT_OVERVOLTAGE = 1u << 1,    /* v_dc above v_dc_max */
-  DRIVE_FAULT_UNDERVOLTAGE = 1u << 2,   /* v_dc below v_dc_min while running */
-  DRIVE_FAULT_OVERSPEED = 1u << 3,      /* |speed| above speed_trip */
-  DRIVE_FAULT_HW_OVERCURRENT = 1u << 4, /* hardware break input tripped */
-  DRIVE_FAULT_OFFSET = 1u << 5,         /* current offset beyond offset_max */
-  DRIVE_FAULT_CONTROL = 1u << 6,        /* control law reported a fault */
-  DRIVE_FAULT_CMD_TIMEOUT = 1u << 7,    /* no command / heartbeat in time */
-  DRIVE_FAULT_SAMPLE = 1u << 8          /* non-finite ADC sample */
+  DRIVE_LC_CURRENT = 1u << 0, /* |i| above lc_current * i_max */
+  DRIVE_LC_DELTA = 1u << 1,   /* |load angle| beyond delta_max + lc_delta */
+  DRIVE_LC_TORQUE = 1u << 2,  /* torque off its (deliverable) reference */
+  DRIVE_LC_FLUX = 1u << 3,    /* flux off its reference */
+  DRIVE_LC_OBSERVER = 1u << 4 /* observer flux off the current model */
 };
+#define DRIVE_LC_COUNT 5
 
-/* Everything the drive exposes for telemetry and logs. */
+/* Everything the drive exposes for telemetry (CAN) and logs. */
 typedef struct {
+  uint32_t isr_count; /* written first ... */
   drive_state_t state;
   uint32_t faults; /* latched fault bits */
   drive_law_t law;
@@ -50,115 +68,150 @@ typedef struct {
   float v_dc;            /* [V] */
   float i_abc[3];        /* offset-corrected phase currents [A] */
   float i_dq[2];         /* rotor frame currents [A] */
-  float v_ab_applied[2]; /* voltage the last duties apply [V] */
-  float duty[3];
-  float theta_e;           /* electrical angle used by the control [rad] */
-  float omega_m;           /* mechanical speed estimate [rad/s] */
-  float speed_ref;         /* ramped speed reference [rad/s] */
-  float torque_ref;        /* [N m] */
-  float torque_est;        /* [N m] */
-  ctrl_telemetry_t law_tm; /* law-specific values (flux, load angle, i_qs) */
-  uint32_t isr_count;
+  float v_ab_applied[2]; /* voltage the last pattern applies [V] */
+  float duty[3];         /* duties as the HAL applies them */
+  float theta_e;         /* electrical angle at the current sample [rad] */
+  float omega_m;         /* mechanical speed estimate [rad/s] */
+  float speed_ref;       /* ramped speed reference [rad/s] */
+  float torque_ref;      /* [N m] */
+  float torque_est;      /* [N m] */
+  float pos_health;      /* position source: |measured - predicted| [rad] */
+  uint32_t lc_cause;     /* DRIVE_LC_* that tripped lost_control */
+  uint32_t cmd_seq;      /* last command block taken (drive_cmd_t.seq) */
+  ctrl_telemetry_t law_tm;
+  uint32_t isr_count_end; /* ... and last: equal to isr_count in a consistent copy */
 } drive_telemetry_t;
 
+/* The command block the main loop publishes (drive_t.req). */
 typedef struct {
-  drive_config_t cfg;
+  uint32_t seq;    /* incremented by every drive_cmd_* (echoed in telemetry) */
+  uint32_t enable; /* 0 or 1 */
+  drive_law_t law;
+  drive_mode_t mode;
+  float torque;
+  float speed;                             /* mechanical [rad/s] */
+  float id, iq;                            /* current mode [A] */
+  float flux;                              /* stator flux amplitude reference, 0 = automatic [Vs] */
+  uint32_t clear_count;                    /* drive_cmd_clear_fault() calls */
+  uint32_t fault_count[DRIVE_FAULT_COUNT]; /* drive_request_fault() per bit */
+  uint32_t clear_mark[DRIVE_FAULT_COUNT];  /* fault_count at the last clear */
+} drive_cmd_t;
+
+typedef struct {
+  /* ===== owned by the ISR ===== */
+  drive_config_t cfg; /* in force */
+  machine_t machine;
+  const hal_caps_t *caps;
   drive_state_t state;
   uint32_t faults;
   uint32_t isr_count;
-  uint32_t slow_count;
+  drive_cmd_t cmd;     /* the commands in force (the ISR's copy of req) */
+  uint32_t clear_seen; /* req.clear_count taken */
+  uint32_t fault_seen[DRIVE_FAULT_COUNT];
+  uint32_t cfg_seen; /* creq.seq taken */
+  bool cfg_pending;  /* a parameter set waits for the gates to go off */
+  bool armed;        /* enable seen low since the last clear */
 
   /* offset calibration */
   float offset[3];
   float offset_acc[3];
   uint32_t offset_n;
 
-  /* commands staged by drive_cmd_*, applied at the slow loop */
-  struct {
-    bool enable;
-    bool clear_fault;
-    drive_law_t law;
-    drive_mode_t mode;
-    float torque;
-    float speed;  /* mechanical [rad/s] */
-    float id, iq; /* current mode [A] */
-    float flux;   /* stator flux amplitude reference, 0 = automatic [Vs] */
-  } cmd;
+  /* alignment (state align): d current along theta = 0 */
+  current_ctrl_t align_cc;
+  uint32_t align_n;
 
-  /* references in force (written by the slow loop, read by the ISR; each
-   * field is one 32-bit word, so an ISR that preempts the copy sees at worst
-   * a mix of the previous and the new command for one period) */
-  struct {
-    bool enable;
-    drive_law_t law;
-    drive_mode_t mode;
-    float torque;
-    float speed;
-    float id, iq;
-    float flux;
-  } ref;
+  /* position */
+  const pos_source_row_t *pos_src;
+  pos_state_t pos_st;
+  pos_estimate_t pos;
+  float omega_m;  /* mechanical speed (source, per ISR) [rad/s] */
+  float rate_acc; /* sum of the angle rate over the speed-loop period */
+  uint32_t rate_n;
 
-  /* speed and position (encoder + PLL) */
-  angle_pll_t pll;
-  struct {
-    float theta_e;
-    float omega_e;
-    float omega_m;  /* PLL speed, per ISR (protection, control laws) */
-    float rate_acc; /* sum of the PLL angle rate over the slow period */
-    uint32_t rate_n;
-    float omega_m_slow; /* mean angle rate over the last slow period: no
-                           lag under acceleration (speed loop) */
-  } pos;
-
-  ctrl_t ctrl;                              /* control laws (FOC, PI-DFVC, DB-DFVC) */
-  speed_ctrl_t speed;                       /* speed loop, run by the slow loop */
+  /* control */
+  ctrl_t ctrl;
+  ab_t v_applied;     /* voltage applied over the period ending at this sample */
+  speed_ctrl_t speed; /* run every slow_div ISRs */
+  bool speed_active;
   float speed_torque;                       /* torque reference from the speed loop [N m] */
-  float torque_min_avail, torque_max_avail; /* what the law can deliver */
+  float torque_min_avail, torque_max_avail; /* what the law can deliver now */
+  uint32_t lc_n[DRIVE_LC_COUNT];            /* periods each condition has held */
+  float torque_scale, flux_scale;           /* torque and flux amplitude on MTPA at i_max */
+  float v_lin;                              /* linear voltage range now [V] */
 
-  /* last sample and outputs, for telemetry */
+  /* telemetry, under a sequence lock */
+  volatile uint32_t tm_seq;
   drive_telemetry_t tm;
+
+  /* ===== written by the main loop only ===== */
+  struct {
+    volatile uint32_t seq; /* odd while being written */
+    drive_cmd_t cmd;
+  } req;
+  struct {
+    volatile uint32_t seq;
+    drive_config_t cfg;
+  } creq;
+  struct {
+    machine_t machine;    /* of the requested parameter set (law checks) */
+    uint32_t isr_seen;    /* ISR count at the last watchdog refresh */
+    drive_telemetry_t tm; /* last consistent telemetry copy */
+    uint32_t tm_retries;  /* copies that had to be retried (preemption) */
+  } host;
 } drive_t;
 
-/* Validates cfg (drive_config_check) and initialises. Returns 0 or a
- * negative number with *field naming the bad parameter. Gates are off. */
-int drive_init(drive_t *drv, const drive_config_t *cfg, const char **field);
+/* Validates cfg, initialises everything and latches DRIVE_FAULT_WATCHDOG
+ * if the last reset was the watchdog's. 0, or -1 with *err naming the
+ * parameter (its reason, e.g. the start-up law is unavailable on this
+ * machine). Gates are off. err may be NULL. */
+int drive_init(drive_t *drv, const drive_config_t *cfg, drive_config_err_t *err);
 
-/* The PWM-period interrupt body: read the HAL sample, protect, estimate,
- * control, write duties. Bounded time, never blocks. */
+/* Whether cfg is valid and can run `law` on its machine (drive_config_check,
+ * the machine model, the law's check), without touching a drive: 0, or -1
+ * with *err (field and reason). *m receives the machine. */
+int drive_config_usable(const drive_config_t *cfg, drive_law_t law, machine_t *m,
+                        drive_config_err_t *err);
+
+/* The PWM-period interrupt body. Bounded time, never blocks. */
 void drive_isr(drive_t *drv);
 
-/* The slow loop (cfg.slow_div ISRs): applies staged commands, runs the speed
- * loop and refreshes the telemetry snapshot. */
-void drive_slow_loop(drive_t *drv);
+/* Main loop, every slow period: telemetry copy (drv->host.tm) and the
+ * watchdog refresh (only if the ISR advanced). */
+void drive_background(drive_t *drv);
 
-/* Commands (staged). Values are clamped to the configured limits; an
- * unknown law or mode is ignored and returns false. */
+/* Commands (main loop), in force from the next ISR. Values are clamped to
+ * the configured limits (non-finite: 0). */
 void drive_cmd_enable(drive_t *drv, bool enable);
+/* Clears the latched faults (the drive returns to idle) and drops the
+ * enable: the operator enables again. */
 void drive_cmd_clear_fault(drive_t *drv);
-bool drive_cmd_set_law(drive_t *drv, drive_law_t law);
-bool drive_cmd_set_mode(drive_t *drv, drive_mode_t mode);
+/* NULL when accepted, else why not (unknown law, unavailable on this
+ * machine); the law changes when the gates are off. */
+const char *drive_cmd_set_law(drive_t *drv, drive_law_t law);
+/* NULL when accepted, else why not (unknown, or current mode with a law
+ * that has no current mode). */
+const char *drive_cmd_set_mode(drive_t *drv, drive_mode_t mode);
 void drive_cmd_torque(drive_t *drv, float torque);
 void drive_cmd_speed(drive_t *drv, float speed_m);
 void drive_cmd_current(drive_t *drv, float id, float iq);
 void drive_cmd_flux(drive_t *drv, float flux);
+/* Asks the ISR to latch a fault (e.g. the CAN command timeout). */
+void drive_request_fault(drive_t *drv, uint32_t fault_bits);
 
-/* Replace the parameter set from the slow context (CAN parameter writes).
- * cfg is validated by drive_config_check (on failure nothing changes and
- * *field names the parameter). With the gates off (idle, fault) everything
- * is re-derived: control laws, PLL and speed loop (their states reset).
- * While enabled (offset calibration, run) only the live parameters are
- * taken from cfg - i_trip, v_dc_max, v_dc_min, speed_trip, offset_max,
- * speed_max, torque_max, accel_max, speed_bw (the speed loop keeps its
- * integral) - and the others keep their values. Returns 0 or negative. */
-int drive_set_config(drive_t *drv, const drive_config_t *cfg, const char **field);
+/* Requests a new parameter set (main loop): validated here (on failure
+ * nothing changes and *err names the field), applied by the next ISR; the
+ * parameters that are not LIVE wait until the gates are off. 0 or -1. */
+int drive_request_config(drive_t *drv, const drive_config_t *cfg, drive_config_err_t *err);
+/* The parameter set most recently requested (or in force). */
+const drive_config_t *drive_requested_config(const drive_t *drv);
 
-/* Latch a fault from outside the ISR (e.g. the CAN command timeout):
- * gates off at once. */
-void drive_raise_fault(drive_t *drv, uint32_t fault_bits);
-
+/* Consistent copy of the ISR's telemetry (main loop); false when every
+ * retry was preempted (*out then holds the previous copy). */
+bool drive_telemetry_read(drive_t *drv, drive_telemetry_t *out);
+/* The main loop's last copy (drive_background). */
 const drive_telemetry_t *drive_telemetry(const drive_t *drv);
-const char *drive_state_name(drive_state_t s);
-/* Name of the lowest set fault bit, "none" for 0. */
-const char *drive_fault_name(uint32_t fault_bits);
+/* The command block the main loop published last. */
+const drive_cmd_t *drive_commands(const drive_t *drv);
 
 #endif /* FLUXDRIVE_DRIVE_H */

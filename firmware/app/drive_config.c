@@ -1,103 +1,172 @@
 /*
- * drive_config.c - defaults and validation of the drive parameter set.
+ * drive_config.c - defaults, descriptors and validation of the parameter
+ * set, all generated from DRIVE_PARAM_TABLE (drive_param_table.h).
  */
 #include "drive_config.h"
 
 #include <math.h>
+#include <stddef.h>
+#include <string.h>
 
-#define PI_F        3.14159265f
-#define RPM_TO_RADS (2.0f * PI_F / 60.0f)
+/* Enum ranges: 0 .. count - 1. */
+#define PARAM_MAX_F32(m)  (m)
+#define PARAM_MAX_U16(m)  (m)
+#define PARAM_MAX_U32(m)  (m)
+#define PARAM_MAX_LAW(m)  ((float)(DRIVE_LAW_COUNT - 1))
+#define PARAM_MAX_MODE(m) ((float)(DRIVE_MODE_COUNT - 1))
+#define PARAM_MAX_POS(m)  ((float)(POS_SOURCE_COUNT - 1))
+
+#define PARAM_ROW(id_, name_, type_, unit_, def_, min_, max_, access_, scen_, doc_)                \
+  {.name = #name_,                                                                                 \
+   .unit = unit_,                                                                                  \
+   .scenario = scen_,                                                                              \
+   .doc = doc_,                                                                                    \
+   .def = def_,                                                                                    \
+   .min = min_,                                                                                    \
+   .max = PARAM_MAX_##type_(max_),                                                                 \
+   .offset = (uint16_t)offsetof(drive_config_t, name_),                                            \
+   .id = id_,                                                                                      \
+   .type = (uint8_t)DRIVE_PARAM_##type_,                                                           \
+   .access = (uint8_t)DRIVE_PARAM_##access_},
+
+static const drive_param_t table[DRIVE_PARAM_COUNT] = {DRIVE_PARAM_TABLE(PARAM_ROW)};
+
+const drive_param_t *drive_params_table(unsigned *count) {
+  *count = (unsigned)DRIVE_PARAM_COUNT;
+  return table;
+}
+
+const drive_param_t *drive_params_find(uint8_t id) {
+  for (unsigned i = 0; i < (unsigned)DRIVE_PARAM_COUNT; ++i) {
+    if (table[i].id == id) {
+      return &table[i];
+    }
+  }
+  return NULL;
+}
+
+const drive_param_t *drive_params_by_name(const char *name) {
+  for (unsigned i = 0; name != NULL && i < (unsigned)DRIVE_PARAM_COUNT; ++i) {
+    if (strcmp(table[i].name, name) == 0) {
+      return &table[i];
+    }
+  }
+  return NULL;
+}
+
+/* Enums are stored as their C type, whose size the compiler chooses
+ * (arm-none-eabi: short enums): read and write through the right width. */
+static unsigned field_size(const drive_param_t *p) {
+  switch ((drive_param_type_t)p->type) {
+  case DRIVE_PARAM_U16:
+    return sizeof(uint16_t);
+  case DRIVE_PARAM_LAW:
+    return sizeof(drive_law_t);
+  case DRIVE_PARAM_MODE:
+    return sizeof(drive_mode_t);
+  case DRIVE_PARAM_POS:
+    return sizeof(pos_source_t);
+  case DRIVE_PARAM_F32:
+  case DRIVE_PARAM_U32:
+  default:
+    return 4u;
+  }
+}
+
+static uint32_t read_uint(const unsigned char *base, unsigned size) {
+  if (size == 1u) {
+    uint8_t u;
+    memcpy(&u, base, 1u);
+    return u;
+  }
+  if (size == 2u) {
+    uint16_t u;
+    memcpy(&u, base, 2u);
+    return u;
+  }
+  uint32_t u;
+  memcpy(&u, base, 4u);
+  return u;
+}
+
+static void write_uint(unsigned char *base, unsigned size, uint32_t v) {
+  if (size == 1u) {
+    const uint8_t u = (uint8_t)v;
+    memcpy(base, &u, 1u);
+  } else if (size == 2u) {
+    const uint16_t u = (uint16_t)v;
+    memcpy(base, &u, 2u);
+  } else {
+    memcpy(base, &v, 4u);
+  }
+}
+
+float drive_param_get(const drive_config_t *cfg, const drive_param_t *p) {
+  const unsigned char *base = (const unsigned char *)cfg + p->offset;
+  if (p->type == DRIVE_PARAM_F32) {
+    float f;
+    memcpy(&f, base, sizeof f);
+    return f;
+  }
+  return (float)read_uint(base, field_size(p));
+}
+
+void drive_param_set(drive_config_t *cfg, const drive_param_t *p, float v) {
+  unsigned char *base = (unsigned char *)cfg + p->offset;
+  if (p->type == DRIVE_PARAM_F32) {
+    memcpy(base, &v, sizeof v);
+  } else {
+    write_uint(base, field_size(p), (uint32_t)v);
+  }
+}
+
+int drive_param_in_range(const drive_param_t *p, float v) {
+  if (!(isfinite(v) && v >= p->min && v <= p->max)) {
+    return 0;
+  }
+  return p->type == DRIVE_PARAM_F32 || !(v - floorf(v) > 0.0f);
+}
 
 void drive_config_default(drive_config_t *cfg) {
-  /* Machine: Rubino 2020, Table I (SPM, 20 N m, 1200 rpm, 2.5 A rms). */
-  cfg->pole_pairs = 21.0f;
-  cfg->rs = 7.1f;
-  cfg->ld = 0.057f;
-  cfg->lq = 0.057f;
-  cfg->lambda_m = 0.19f;
-  cfg->inertia = 0.021f;
-
-  cfg->ts = 1.0f / 16000.0f;
-  cfg->slow_div = 16; /* 1 kHz slow loop */
-  cfg->dead_time = 1.0e-6f;
-
-  cfg->i_max = 2.5f * 1.41421356f; /* rated 2.5 A rms, peak */
-  cfg->i_trip = 2.0f * cfg->i_max;
-  cfg->v_dc_max = 400.0f;
-  cfg->v_dc_min = 150.0f;
-  cfg->speed_max = 1200.0f * RPM_TO_RADS;
-  cfg->speed_trip = 1.25f * cfg->speed_max;
-  cfg->offset_max = 0.5f;
-  cfg->offset_samples = 256;
-  cfg->torque_max = 20.0f;
-  cfg->v_margin = 0.95f;
-
-  cfg->law = DRIVE_LAW_FOC;
-  cfg->mode = DRIVE_MODE_TORQUE;
-  cfg->current_bw = 2000.0f; /* ~ 320 Hz; wc*Ts = 0.125 */
-  cfg->speed_bw = 60.0f;
-  cfg->accel_max = 1200.0f * RPM_TO_RADS; /* 1200 rpm/s */
-  cfg->pll_bw = 400.0f;
-  cfg->enc_offset = 0.0f;
-
-  cfg->flux_obs_wc = 125.0f;                 /* Rubino 2020, section III.B */
-  cfg->delta_max = 80.0f * PI_F / 180.0f;    /* Rubino 2020, Table I */
-  cfg->vsd_max = 60.0f;                      /* Rubino 2020, section III.D */
-  cfg->flux_min = 0.2f * cfg->lambda_m;      /* below the flux at top speed */
-  cfg->dfvc_flux_bw = 2.0f * PI_F * 1000.0f; /* Rubino 2020, IV.7: 1 kHz */
-  cfg->dfvc_iqs_bw = 2.0f * PI_F * 1000.0f;
+  memset(cfg, 0, sizeof *cfg);
+  for (unsigned i = 0; i < (unsigned)DRIVE_PARAM_COUNT; ++i) {
+    drive_param_set(cfg, &table[i], table[i].def);
+  }
 }
 
-/* A parameter that must be finite and inside [lo, hi]. */
-static int in_range(float x, float lo, float hi) {
-  return isfinite(x) && x >= lo && x <= hi;
-}
-
-#define CHECK(cond, name)                                                                          \
+#define RULE(cond, name, why)                                                                      \
   do {                                                                                             \
     if (!(cond)) {                                                                                 \
-      *field = (name);                                                                             \
+      e->field = (name);                                                                           \
+      e->reason = (why);                                                                           \
       return -1;                                                                                   \
     }                                                                                              \
   } while (0)
 
-int drive_config_check(const drive_config_t *cfg, const char **field) {
-  CHECK(in_range(cfg->pole_pairs, 1.0f, 100.0f) &&
-            fabsf(cfg->pole_pairs - roundf(cfg->pole_pairs)) < 1e-6f,
-        "pole_pairs");
-  CHECK(in_range(cfg->rs, 1e-5f, 1e3f), "rs");
-  CHECK(in_range(cfg->ld, 1e-7f, 10.0f), "ld");
-  CHECK(in_range(cfg->lq, 1e-7f, 10.0f), "lq");
-  CHECK(in_range(cfg->lambda_m, 0.0f, 10.0f), "lambda_m");
-  CHECK(in_range(cfg->inertia, 1e-9f, 1e3f), "inertia");
-  CHECK(in_range(cfg->ts, 1e-6f, 1e-2f), "ts");
-  CHECK(cfg->slow_div >= 1 && cfg->slow_div <= 1000, "slow_div");
-  CHECK(in_range(cfg->dead_time, 0.0f, 0.25f * cfg->ts), "dead_time");
-  CHECK(in_range(cfg->i_max, 1e-3f, 1e4f), "i_max");
-  CHECK(in_range(cfg->i_trip, cfg->i_max, 1e4f), "i_trip");
-  CHECK(in_range(cfg->v_dc_max, 1.0f, 1e4f), "v_dc_max");
-  CHECK(in_range(cfg->v_dc_min, 0.0f, cfg->v_dc_max), "v_dc_min");
-  CHECK(in_range(cfg->speed_max, 0.0f, 1e5f), "speed_max");
-  CHECK(in_range(cfg->speed_trip, cfg->speed_max, 1e5f) && cfg->speed_trip > 0.0f, "speed_trip");
-  CHECK(in_range(cfg->offset_max, 0.0f, 1e3f), "offset_max");
-  CHECK(cfg->offset_samples >= 1 && cfg->offset_samples <= 60000, "offset_samples");
-  CHECK(in_range(cfg->torque_max, 0.0f, 1e5f), "torque_max");
-  CHECK(in_range(cfg->v_margin, 0.1f, 1.0f), "v_margin");
-  CHECK((unsigned)cfg->law < (unsigned)DRIVE_LAW_COUNT, "law");
-  CHECK((unsigned)cfg->mode < (unsigned)DRIVE_MODE_COUNT, "mode");
-  CHECK(cfg->mode != DRIVE_MODE_CURRENT || cfg->law == DRIVE_LAW_FOC, "mode");
-  /* Discrete PI current loop: wc*Ts beyond ~0.5 is not a sane design. */
-  CHECK(in_range(cfg->current_bw, 1.0f, 0.5f / cfg->ts), "current_bw");
-  CHECK(in_range(cfg->speed_bw, 0.1f, 0.25f * cfg->current_bw), "speed_bw");
-  CHECK(in_range(cfg->accel_max, 1e-3f, 1e7f), "accel_max");
-  CHECK(in_range(cfg->pll_bw, 1.0f, 0.5f / cfg->ts), "pll_bw");
-  CHECK(in_range(cfg->enc_offset, -7.0f, 7.0f), "enc_offset");
-  CHECK(in_range(cfg->flux_obs_wc, 0.0f, 0.25f / cfg->ts), "flux_obs_wc");
-  CHECK(in_range(cfg->delta_max, 0.1f, 1.5f), "delta_max");
-  CHECK(in_range(cfg->vsd_max, 0.0f, 1e4f), "vsd_max");
-  CHECK(in_range(cfg->flux_min, 0.0f, 10.0f), "flux_min");
-  CHECK(in_range(cfg->dfvc_flux_bw, 1.0f, 0.5f / cfg->ts), "dfvc_flux_bw");
-  CHECK(in_range(cfg->dfvc_iqs_bw, 1.0f, 0.5f / cfg->ts), "dfvc_iqs_bw");
-  *field = "";
+int drive_config_check(const drive_config_t *cfg, drive_config_err_t *err) {
+  drive_config_err_t dummy;
+  drive_config_err_t *e = err != NULL ? err : &dummy;
+  e->field = "";
+  e->reason = "";
+  for (unsigned i = 0; i < (unsigned)DRIVE_PARAM_COUNT; ++i) {
+    RULE(drive_param_in_range(&table[i], drive_param_get(cfg, &table[i])), table[i].name,
+         "outside its range");
+  }
+  const float c = cfg->ts;
+  RULE(!(cfg->pole_pairs - floorf(cfg->pole_pairs) > 0.0f), "pole_pairs", "must be an integer");
+  RULE(cfg->i_trip >= cfg->i_max, "i_trip", "must be at least i_max");
+  RULE(cfg->v_dc_min <= cfg->v_dc_max, "v_dc_min", "must not exceed v_dc_max");
+  RULE(cfg->speed_trip >= cfg->speed_max, "speed_trip", "must be at least speed_max");
+  RULE(cfg->dead_time <= 0.25f * c, "dead_time", "must be at most a quarter of the period ts");
+  /* discrete loops: a bandwidth beyond ~0.5/Ts is not a sane design */
+  RULE(cfg->current_bw <= 0.5f / c, "current_bw", "must be at most 0.5/ts");
+  RULE(cfg->speed_bw <= 0.25f * cfg->current_bw, "speed_bw", "must be at most current_bw/4");
+  RULE(cfg->pll_bw <= 0.5f / c, "pll_bw", "must be at most 0.5/ts");
+  RULE(cfg->flux_obs_wc <= 0.25f / c, "flux_obs_wc", "must be at most 0.25/ts");
+  RULE(cfg->dfvc_flux_bw <= 0.5f / c, "dfvc_flux_bw", "must be at most 0.5/ts");
+  RULE(cfg->dfvc_iqs_bw <= 0.5f / c, "dfvc_iqs_bw", "must be at most 0.5/ts");
+  RULE(cfg->align_time <= 0.0f || cfg->align_current > 0.0f, "align_current",
+       "must be positive when align_time > 0");
+  RULE(cfg->align_current <= cfg->i_max, "align_current", "must be at most i_max");
   return 0;
 }

@@ -1,75 +1,86 @@
 /*
- * drive_config.h - the drive's parameter set: machine, limits, protections,
- * controller tuning. Validated as a whole by drive_config_check() before it
- * is used; drive_config_default() gives a safe, documented starting point.
+ * drive_config.h - the drive's parameter set: the struct generated from the
+ * parameter table (drive_param_table.h), its defaults, the descriptors of
+ * its fields and its validation.
  */
 #ifndef FLUXDRIVE_DRIVE_CONFIG_H
 #define FLUXDRIVE_DRIVE_CONFIG_H
 
 #include <stdint.h>
 
-typedef enum {
-  DRIVE_LAW_FOC = 0,     /* rotor-frame PI current control (baseline) */
-  DRIVE_LAW_PI_DFVC = 1, /* PI direct flux vector control (Rubino 2020 IV.7) */
-  DRIVE_LAW_DB_DFVC = 2, /* deadbeat DFVC (Rubino 2020) */
-  DRIVE_LAW_COUNT
-} drive_law_t;
+#include "drive_enums.h"
+#include "drive_param_table.h"
 
-typedef enum {
-  DRIVE_MODE_TORQUE = 0,  /* torque reference */
-  DRIVE_MODE_SPEED = 1,   /* speed loop produces the torque reference */
-  DRIVE_MODE_CURRENT = 2, /* dq current references (FOC only) */
-  DRIVE_MODE_COUNT
-} drive_mode_t;
+#define DRIVE_PARAM_CTYPE_F32  float
+#define DRIVE_PARAM_CTYPE_U16  uint16_t
+#define DRIVE_PARAM_CTYPE_U32  uint32_t
+#define DRIVE_PARAM_CTYPE_LAW  drive_law_t
+#define DRIVE_PARAM_CTYPE_MODE drive_mode_t
+#define DRIVE_PARAM_CTYPE_POS  pos_source_t
 
+/* One field per row of DRIVE_PARAM_TABLE, in table order. */
 typedef struct {
-  /* machine (the controller's estimates, may differ from the plant) */
-  float pole_pairs;
-  float rs;       /* [Ohm] */
-  float ld, lq;   /* [H] */
-  float lambda_m; /* [Vs] */
-  float inertia;  /* [kg m^2], for the speed-loop design */
-
-  /* timing */
-  float ts;          /* PWM / ISR period [s] */
-  uint16_t slow_div; /* slow loop every slow_div ISRs */
-  float dead_time;   /* inverter dead time [s], for compensation */
-
-  /* protections (evaluated every ISR) */
-  float i_trip;            /* phase current trip [A] */
-  float v_dc_max;          /* overvoltage trip [V] */
-  float v_dc_min;          /* undervoltage trip while running [V] */
-  float speed_trip;        /* overspeed trip, mechanical [rad/s] */
-  float offset_max;        /* largest acceptable current offset [A] */
-  uint16_t offset_samples; /* ISRs averaged by the offset calibration */
-
-  /* limits used by the references */
-  float i_max;      /* current amplitude limit [A peak] */
-  float torque_max; /* [N m] */
-  float speed_max;  /* speed reference limit, mechanical [rad/s] */
-  float v_margin;   /* usable fraction of the linear voltage range (0..1] */
-
-  /* control */
-  drive_law_t law;
-  drive_mode_t mode;
-  float current_bw; /* FOC current-loop bandwidth [rad/s] */
-  float speed_bw;   /* speed-loop bandwidth [rad/s] */
-  float accel_max;  /* speed reference slew limit [rad/s^2] */
-  float pll_bw;     /* encoder angle PLL bandwidth [rad/s] */
-  float enc_offset; /* electrical angle at encoder zero [rad] */
-
-  /* DFVC (Rubino 2020) */
-  float flux_obs_wc;  /* hybrid observer crossover omega_c [rad/s] */
-  float delta_max;    /* load-angle (MTPV) limit [rad] */
-  float vsd_max;      /* flux-axis voltage limit v_sd,max [V] */
-  float flux_min;     /* minimum flux reference [Vs] */
-  float dfvc_flux_bw; /* PI-DFVC flux loop bandwidth [rad/s] */
-  float dfvc_iqs_bw;  /* PI-DFVC i_qs loop bandwidth [rad/s] */
+#define DRIVE_CONFIG_FIELD(id, name, type, ...) DRIVE_PARAM_CTYPE_##type name;
+  DRIVE_PARAM_TABLE(DRIVE_CONFIG_FIELD)
+#undef DRIVE_CONFIG_FIELD
 } drive_config_t;
 
-/* A safe default for a small SPM machine; callers overwrite the machine. */
+/* Number of parameters (rows of the table). */
+#define DRIVE_PARAM_ONE(...) +1
+enum { DRIVE_PARAM_COUNT = 0 DRIVE_PARAM_TABLE(DRIVE_PARAM_ONE) };
+#undef DRIVE_PARAM_ONE
+
+typedef enum {
+  DRIVE_PARAM_F32 = 0,
+  DRIVE_PARAM_U16,
+  DRIVE_PARAM_U32,
+  DRIVE_PARAM_LAW,
+  DRIVE_PARAM_MODE,
+  DRIVE_PARAM_POS
+} drive_param_type_t;
+
+typedef enum {
+  DRIVE_PARAM_RO = 0,
+  DRIVE_PARAM_IDLE = 1,
+  DRIVE_PARAM_LIVE = 2
+} drive_param_access_t;
+
+/* A row of the table as data. min/max of an enum are 0 and count - 1. */
+typedef struct {
+  const char *name;
+  const char *unit;
+  const char *scenario; /* scenario key, "section.key" */
+  const char *doc;
+  float def, min, max;
+  uint16_t offset; /* offsetof(drive_config_t, name) */
+  uint8_t id;
+  uint8_t type;   /* drive_param_type_t */
+  uint8_t access; /* drive_param_access_t */
+} drive_param_t;
+
+/* The table, its length; lookup by CAN id and by name (NULL if unknown). */
+const drive_param_t *drive_params_table(unsigned *count);
+const drive_param_t *drive_params_find(uint8_t id);
+const drive_param_t *drive_params_by_name(const char *name);
+/* Field value as float (integers and enums converted exactly). */
+float drive_param_get(const drive_config_t *cfg, const drive_param_t *p);
+/* Sets the field from a float, without any check. */
+void drive_param_set(drive_config_t *cfg, const drive_param_t *p, float v);
+/* 1 when v is finite, inside [min, max] and, for integer and enum types,
+ * an integer. */
+int drive_param_in_range(const drive_param_t *p, float v);
+
+/* Why a parameter set was refused: the field and a short reason (static
+ * strings). field is "" when the set is valid. */
+typedef struct {
+  const char *field;
+  const char *reason;
+} drive_config_err_t;
+
+/* The table's defaults (Rubino 2020, Table I machine). */
 void drive_config_default(drive_config_t *cfg);
-/* 0 when valid, else negative with *field naming the first bad parameter. */
-int drive_config_check(const drive_config_t *cfg, const char **field);
+/* 0 when valid, else -1 with *err naming the first bad field: its range
+ * (table) first, then the relations between fields. err may be NULL. */
+int drive_config_check(const drive_config_t *cfg, drive_config_err_t *err);
 
 #endif

@@ -2,29 +2,47 @@
  * hal_sil.c - hal.h over a hal_sil_t context (see hal_sil.h).
  */
 #include "hal_sil.h"
-#include "hal_duty.h"
+#include "hal_pattern.h"
 
 #include <string.h>
 
 static hal_sil_t *bound;
 
-void hal_sil_init(hal_sil_t *h) {
+void hal_sil_init(hal_sil_t *h, const hal_sil_board_t *board) {
   memset(h, 0, sizeof *h);
-  h->duty[0] = h->duty[1] = h->duty[2] = 0.5f;
+  h->caps.ts = board->ts;
+  h->caps.t_count = board->timer_counts > 0u ? board->ts / (float)board->timer_counts : 0.0f;
+  h->caps.dead_time = board->dead_time;
+  h->caps.duty_min = board->duty_min;
+  h->caps.duty_max = board->duty_max;
+  h->caps.t_i = 0.0f;       /* the plant samples at the valley */
+  h->caps.t_i_clear = 0.0f; /* an ideal sampler */
+  h->caps.t_enc = 0.0f;
+  h->caps.cpu_hz = 0.0f;
+  h->caps.features =
+      HAL_CAP_ENCODER | HAL_CAP_STAR_POINT | (board->asym_edges ? HAL_CAP_ASYM_EDGES : 0u);
+  h->timer_counts = board->timer_counts;
+  h->watchdog_timeout_us = board->watchdog_ms * 1000u;
+  h->pwm = hal_pwm_centred(0.5f, 0.5f, 0.5f);
 }
 
 void hal_sil_bind(hal_sil_t *h) {
   bound = h;
 }
 
-void hal_adc_read(hal_adc_sample_t *s) {
+const hal_caps_t *hal_caps(void) {
+  return &bound->caps;
+}
+
+void hal_adc_read(hal_sample_t *s) {
   *s = bound->sample;
 }
 
-void hal_pwm_set_duty(float da, float db, float dc) {
-  bound->duty[0] = hal_duty_clamp01(da);
-  bound->duty[1] = hal_duty_clamp01(db);
-  bound->duty[2] = hal_duty_clamp01(dc);
+void hal_pwm_write(const hal_pwm_t *p, hal_pwm_t *applied) {
+  hal_pattern_apply(p, &bound->caps, bound->timer_counts, &bound->pwm);
+  if (applied != NULL) {
+    *applied = bound->pwm;
+  }
 }
 
 void hal_pwm_enable(void) {
@@ -83,4 +101,17 @@ void hal_fault_hw_clear(void) {
 
 void hal_watchdog_kick(void) {
   bound->watchdog_kicks++;
+  bound->watchdog_last_us = bound->time_us;
+}
+
+bool hal_sil_watchdog_expired(const hal_sil_t *h, uint32_t now_us) {
+  return h->watchdog_timeout_us > 0u && now_us - h->watchdog_last_us > h->watchdog_timeout_us;
+}
+
+bool hal_reset_by_watchdog(void) {
+  return bound->reset_by_watchdog;
+}
+
+void hal_isr_stats(hal_isr_stats_t *st) {
+  memset(st, 0, sizeof *st); /* no cycle counter on the host */
 }

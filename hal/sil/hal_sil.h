@@ -1,8 +1,13 @@
 /*
  * hal_sil.h - the SIL implementation of hal.h. The runner owns a
  * hal_sil_t, binds it, fills `sample` from the plant before each ISR and
- * reads back the duties and the gate state after it. CAN frames pass
- * through two bounded queues (the transport of the CAN issue feeds them).
+ * reads back the pattern and the gate state after it. The board it models
+ * (duty range, timer resolution, watchdog) is set by the scenario
+ * (docs/scenarios.md, "board"); CAN frames pass through two bounded queues
+ * (the transports feed them).
+ *
+ * The plant samples currents, DC link and encoder at the carrier valley:
+ * t_i = t_enc = 0 (hal_caps_t), and one star-point sample at the valley.
  */
 #ifndef FLUXDRIVE_HAL_SIL_H
 #define FLUXDRIVE_HAL_SIL_H
@@ -20,20 +25,39 @@ typedef struct {
   uint32_t dropped;
 } hal_sil_can_queue_t;
 
+/* The board the SIL models. */
 typedef struct {
-  hal_adc_sample_t sample; /* what hal_adc_read returns */
-  float duty[3];           /* preloaded duties (act from the next period) */
+  float duty_min, duty_max; /* hal_caps_t */
+  uint32_t timer_counts;    /* compare steps per period (ARR); 0: exact duties */
+  float dead_time;          /* [s] */
+  float ts;                 /* [s] */
+  uint32_t watchdog_ms;     /* watchdog timeout; 0: none */
+  bool asym_edges;          /* HAL_CAP_ASYM_EDGES */
+} hal_sil_board_t;
+
+typedef struct {
+  hal_caps_t caps;
+  uint32_t timer_counts;
+  hal_sample_t sample; /* what hal_adc_read returns */
+  hal_pwm_t pwm;       /* preloaded pattern (acts from the next period) */
   bool gates_on;
   bool hw_tripped; /* break input latch (set by the runner) */
   uint32_t time_us;
+  /* watchdog: the runner calls hal_sil_watchdog_expired() every period */
+  uint32_t watchdog_timeout_us;
+  uint32_t watchdog_last_us;
   uint32_t watchdog_kicks;
+  bool reset_by_watchdog;     /* what hal_reset_by_watchdog() reports */
   hal_sil_can_queue_t can_rx; /* towards the firmware */
   hal_sil_can_queue_t can_tx; /* from the firmware */
 } hal_sil_t;
 
-void hal_sil_init(hal_sil_t *h);
+void hal_sil_init(hal_sil_t *h, const hal_sil_board_t *board);
 /* All hal_* calls act on the bound context (one drive per process). */
 void hal_sil_bind(hal_sil_t *h);
+/* True when the watchdog was not refreshed for its timeout at time now_us
+ * (the runner then resets the MCU: gates off, drive_init). */
+bool hal_sil_watchdog_expired(const hal_sil_t *h, uint32_t now_us);
 
 bool hal_sil_can_push(hal_sil_can_queue_t *q, const hal_can_frame_t *f);
 bool hal_sil_can_pop(hal_sil_can_queue_t *q, hal_can_frame_t *f);

@@ -40,10 +40,24 @@ static reg32_t *s_jdr[SIG_COUNT];
 static struct {
   uint32_t isr_count;
   uint32_t overruns;
-  bool overrun_flag;
   uint32_t cycles_last;
   uint32_t cycles_max;
+  uint32_t cycles_acc; /* 256 x the exponential mean (time constant 256 periods) */
+  bool adc2_timeout;   /* this period's ADC2 sequence did not finish in time */
 } s_isr;
+
+/* Sampling cycles of the ADC_SMP_* codes (RM0440 21.4.12), x2 (half cycles). */
+static const uint16_t k_smp_half_cycles[8] = {5u, 13u, 25u, 49u, 95u, 185u, 495u, 1281u};
+
+/* The instant the phase currents are sampled after the valley: the
+ * trigger (TIM1 TRGO at the update) plus ~2 ADC clock cycles of latency,
+ * then the middle of the first conversion's sampling window (42.5 MHz ADC
+ * clock, synchronous: the delay is fixed). */
+static float adc_sample_instant(void) {
+  const float f_adc = (float)BOARD_SYSCLK_HZ / 4.0f;
+  const float half = (float)k_smp_half_cycles[k_sig[SIG_IA].smp & 7u];
+  return (2.0f + 0.25f * half) / f_adc;
+}
 
 static adc_regs_t *adc_of(uint32_t n) {
   return (n == 1u) ? ADC1 : ADC2;
@@ -158,7 +172,7 @@ HOT static float raw_volts(const reg32_t *jdr) {
   return (float)(*jdr & 0xFFFFu) * (BOARD_VDDA / 4095.0f);
 }
 
-HOT void hal_adc_read(hal_adc_sample_t *s) {
+HOT void hal_adc_read(hal_sample_t *s) {
   float i[3];
   int missing = -1;
   float sum = 0.0f;
@@ -178,12 +192,23 @@ HOT void hal_adc_read(hal_adc_sample_t *s) {
   s->i_abc[1] = i[1];
   s->i_abc[2] = i[2];
   s->v_dc = (s_jdr[SIG_VDC] != 0) ? raw_volts(s_jdr[SIG_VDC]) * BOARD_VDC_RATIO : 0.0f;
-  /* star point measured to ground; hal.h wants it w.r.t. the DC midpoint */
-  s->v_star = (s_jdr[SIG_VSTAR] != 0)
-                  ? raw_volts(s_jdr[SIG_VSTAR]) * BOARD_VSTAR_RATIO - 0.5f * s->v_dc
-                  : 0.0f;
+  s->t_i = hal_caps()->t_i;
+  /* star point measured to ground; hal.h wants it w.r.t. the DC midpoint;
+   * sampled with the currents (the DFC window needs HAL_CAP_STAR_POINT) */
+  s->n_star = (s_jdr[SIG_VSTAR] != 0) ? 1u : 0u;
+  s->v_star[0] = (s_jdr[SIG_VSTAR] != 0)
+                     ? raw_volts(s_jdr[SIG_VSTAR]) * BOARD_VSTAR_RATIO - 0.5f * s->v_dc
+                     : 0.0f;
+  s->t_star[0] = s->t_i;
+  s->v_star[1] = 0.0f;
+  s->t_star[1] = 0.0f;
+  s->test_vector = 0u;
   s->enc_angle = 0.0f; /* no encoder interface on these boards yet */
+  s->t_enc = 0.0f;
   s->enc_valid = false;
+  /* ADC2's sequence did not end in the wait of ADC1_2_IRQHandler: its data
+   * registers hold the previous period's values */
+  s->valid = !s_isr.adc2_timeout;
 }
 
 /* End of ADC1's injected sequence: the PWM-period interrupt. */
@@ -191,8 +216,13 @@ void ADC1_2_IRQHandler(void);
 HOT void ADC1_2_IRQHandler(void) {
   const uint32_t t0 = DWT->CYCCNT;
   ADC1->ISR = ADC_ISR_JEOC | ADC_ISR_JEOS;
-  for (uint32_t t = 0; t < 200u && (ADC2->ISR & ADC_ISR_JEOS) == 0u; t++) {
+  /* ADC2's sequence is shorter and started on the same trigger: it is done
+   * or ends within a few conversions; 200 polls (~2.4 us) bound the wait */
+  uint32_t t = 0;
+  while (t < 200u && (ADC2->ISR & ADC_ISR_JEOS) == 0u) {
+    t++;
   }
+  s_isr.adc2_timeout = (ADC2->JSQR & (3u << ADC_JSQR_JEXTEN_Pos)) != 0u && t >= 200u;
   ADC2->ISR = ADC_ISR_JEOC | ADC_ISR_JEOS;
   hal_tim1_clear_update(); /* set at this period's valley */
 
@@ -200,7 +230,6 @@ HOT void ADC1_2_IRQHandler(void) {
 
   /* Overrun: the next valley (update) came before the ISR finished. */
   if (hal_tim1_update_pending()) {
-    s_isr.overrun_flag = true;
     s_isr.overruns++;
   }
   s_isr.isr_count++;
@@ -209,24 +238,35 @@ HOT void ADC1_2_IRQHandler(void) {
   if (dt > s_isr.cycles_max) {
     s_isr.cycles_max = dt;
   }
+  s_isr.cycles_acc += dt - (s_isr.cycles_acc >> 8);
 }
 
-bool hal_isr_overrun(void) {
+void hal_isr_stats(hal_isr_stats_t *st) {
   const uint32_t pm = hal_irq_save();
-  const bool f = s_isr.overrun_flag;
-  s_isr.overrun_flag = false;
+  st->cycles_last = s_isr.cycles_last;
+  st->cycles_max = s_isr.cycles_max;
+  st->cycles_mean = s_isr.cycles_acc >> 8;
+  st->overruns = s_isr.overruns;
   hal_irq_restore(pm);
-  return f;
 }
 
-uint32_t hal_isr_overrun_count(void) {
-  return s_isr.overruns;
-}
-
-uint32_t hal_isr_count(void) {
-  return s_isr.isr_count;
-}
-
-uint32_t hal_isr_cycles_max(void) {
-  return s_isr.cycles_max;
+/* What the board can do (hal.h), fixed by its header and the ADC set-up. */
+const hal_caps_t *hal_caps(void) {
+  static hal_caps_t caps;
+  static bool done;
+  if (!done) {
+    const float ts = (float)(2u * BOARD_PWM_ARR) / (float)BOARD_SYSCLK_HZ;
+    caps.ts = ts;
+    caps.t_count = ts / (float)BOARD_PWM_ARR;
+    caps.dead_time = (float)BOARD_DEAD_TIME_NS * 1e-9f;
+    caps.duty_min = 0.0f;
+    caps.duty_max = BOARD_DUTY_MAX;
+    caps.t_i = adc_sample_instant();
+    caps.t_i_clear = (1.0f - BOARD_DUTY_MAX) * ts; /* low sides on around the valley */
+    caps.t_enc = 0.0f;
+    caps.cpu_hz = (float)BOARD_SYSCLK_HZ;
+    caps.features = HAL_CAP_DWT_CYCLES; /* centred pulses, no encoder, star point at the valley */
+    done = true;
+  }
+  return &caps;
 }

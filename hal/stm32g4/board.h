@@ -16,8 +16,9 @@
 #error "define FD_BOARD_G474 or FD_BOARD_B_G431B_ESC1 (FD_BOARD cache variable)"
 #endif
 
-#define BOARD_SYSCLK_HZ 170000000u
+#include "board_clock.h"
+
 /* TIM1 centre-aligned: f_pwm = f_tim / (2 ARR) */
-#define BOARD_PWM_ARR (BOARD_SYSCLK_HZ / (2u * BOARD_PWM_HZ))
+#define BOARD_PWM_ARR BOARD_PWM_ARR_AT(BOARD_PWM_HZ)
 
 #endif

@@ -1,7 +1,7 @@
 /*
  * board_main.c - main() of the STM32G4 firmware: drive configuration from
  * the board header, peripheral bring-up, the PWM-period interrupt body and
- * the 1 kHz slow loop (SysTick tick, run in thread mode, outside the ISR).
+ * the 1 kHz main loop (SysTick tick, thread mode: CAN, background service).
  */
 #include <stdint.h>
 
@@ -43,6 +43,7 @@ static void systick_start_1khz(void) {
 
 static void board_config(drive_config_t *cfg) {
   drive_config_default(cfg);
+  cfg->enc_cpr = 0u; /* no encoder input on these boards: the position fault refuses to run */
   cfg->ts = (float)(2u * BOARD_PWM_ARR) / (float)BOARD_SYSCLK_HZ;
   cfg->slow_div = (uint16_t)(BOARD_PWM_HZ / 1000u);
   cfg->dead_time = (float)BOARD_DEAD_TIME_NS * 1.0e-9f;
@@ -63,9 +64,10 @@ int main(void) {
   board_config(&cfg);
 
   uint32_t err = hal_stm32g4_init(); /* gates off */
-  const char *field = 0;
-  if (drive_init(&s_drv, &cfg, &field) != 0) {
-    g_board_config_field = field;
+  (void)hal_reset_by_watchdog();     /* latch the reset cause before anything */
+  drive_config_err_t cerr;
+  if (drive_init(&s_drv, &cfg, &cerr) != 0) {
+    g_board_config_field = cerr.field;
     err |= 0x80000000u;
   }
   can_proto_cfg_t can_cfg;
@@ -86,22 +88,16 @@ int main(void) {
   hal_watchdog_start(BOARD_IWDG_TIMEOUT_MS);
 
   uint32_t done = s_ticks;
-  uint32_t isr_seen = hal_isr_count();
   for (;;) {
     const uint32_t now = s_ticks;
     if (now != done) {
-      /* one slow loop per tick; after a long stall, skip the missed ones */
+      /* one main-loop pass per tick; after a long stall, skip the missed ones */
       done = (now - done > 4u) ? now : done + 1u;
-      /* CAN commands are staged here and take effect in the slow loop */
+      /* telemetry copy, and the watchdog refresh: only here, and only when
+       * the PWM-period interrupt advanced since the last one (drive.h) */
+      drive_background(&s_drv);
+      /* CAN commands are posted here and taken by the next ISR */
       can_proto_poll(&s_can, &s_drv, hal_time_us());
-      drive_slow_loop(&s_drv);
-      /* Refresh only while both contexts run: the slow loop is here and
-       * the PWM-period interrupt advanced since the last refresh. */
-      const uint32_t isr_now = hal_isr_count();
-      if (isr_now != isr_seen) {
-        isr_seen = isr_now;
-        hal_watchdog_kick();
-      }
     } else {
       __asm__ volatile("wfi");
     }

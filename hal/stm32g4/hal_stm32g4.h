@@ -26,13 +26,7 @@ uint32_t hal_stm32g4_start(void);
  * interrupt (ADC1 JEOS) every PWM period. */
 void board_control_isr(void);
 
-/* ISR overrun: true when, since the last call, a PWM-period interrupt was
- * still running at the next carrier valley. Read-and-clear. */
-bool hal_isr_overrun(void);
-uint32_t hal_isr_overrun_count(void);
-uint32_t hal_isr_count(void);
-/* Longest ISR seen, in core cycles (170 per microsecond). */
-uint32_t hal_isr_cycles_max(void);
+/* ISR execution statistics (cycles, overruns): hal_isr_stats() in hal.h. */
 
 /* CAN acceptance: standard and extended identifiers whose bits under
  * `mask` equal node_id, plus the broadcast identifier 0 under the same mask

@@ -30,3 +30,14 @@ void hal_watchdog_start(uint32_t timeout_ms) {
 void hal_watchdog_kick(void) {
   IWDG->KR = IWDG_KEY_RELOAD;
 }
+
+/* RCC_CSR (RM0440 7.4.29): IWDGRSTF bit 29, cleared with RMVF bit 23.
+ * Read once, at the first call (before anything clears it). */
+bool hal_reset_by_watchdog(void) {
+  static int cause = -1;
+  if (cause < 0) {
+    cause = (RCC->CSR & (1u << 29)) != 0u ? 1 : 0;
+    RCC->CSR |= 1u << 23; /* RMVF: the next reset reports its own cause */
+  }
+  return cause != 0;
+}

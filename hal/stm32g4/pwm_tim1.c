@@ -155,6 +155,9 @@ HOT bool hal_tim1_update_pending(void) {
 
 /* ---- hal.h: PWM and hardware fault ---- */
 
+/* Centred pulses only (hal_caps_t.features has no HAL_CAP_ASYM_EDGES):
+ * the duty off - on, limited to [0, BOARD_DUTY_MAX] (NaN: 0), rounded to a
+ * compare step. */
 HOT static uint32_t duty_to_ccr(float d) {
   if (!(d > 0.0f)) { /* also NaN */
     d = 0.0f;
@@ -165,10 +168,26 @@ HOT static uint32_t duty_to_ccr(float d) {
   return (uint32_t)((1.0f - d) * (float)BOARD_PWM_ARR + 0.5f);
 }
 
-HOT void hal_pwm_set_duty(float da, float db, float dc) {
-  TIM1->CCR1 = duty_to_ccr(da);
-  TIM1->CCR2 = duty_to_ccr(db);
-  TIM1->CCR3 = duty_to_ccr(dc);
+HOT static void ccr_to_pattern(uint32_t ccr, int x, hal_pwm_t *a) {
+  const float d = 1.0f - (float)ccr * (1.0f / (float)BOARD_PWM_ARR);
+  a->on[x] = 0.5f * (1.0f - d);
+  a->off[x] = 0.5f * (1.0f + d);
+}
+
+HOT void hal_pwm_write(const hal_pwm_t *p, hal_pwm_t *applied) {
+  const uint32_t c1 = duty_to_ccr(p->off[0] - p->on[0]);
+  const uint32_t c2 = duty_to_ccr(p->off[1] - p->on[1]);
+  const uint32_t c3 = duty_to_ccr(p->off[2] - p->on[2]);
+  TIM1->CCR1 = c1;
+  TIM1->CCR2 = c2;
+  TIM1->CCR3 = c3;
+  if (applied != 0) {
+    ccr_to_pattern(c1, 0, applied);
+    ccr_to_pattern(c2, 1, applied);
+    ccr_to_pattern(c3, 2, applied);
+    applied->test_vector = 0u;
+    applied->n_star = 0u;
+  }
 }
 
 void hal_pwm_enable(void) {

@@ -45,8 +45,7 @@ int plant_init(plant_t *pl, const plant_params_t *p, const char **field) {
   memset(pl, 0, sizeof *pl);
   pl->p = *p;
   plant_aux_t *a = &pl->aux;
-  a->inv_ld = 1.0 / p->machine.ld;
-  a->inv_lq = 1.0 / p->machine.lq;
+  a->mag = plant_mag_linear(p->machine.ld, p->machine.lq, p->machine.lambda_m);
   a->inv_j = 1.0 / p->mech.j;
   a->inv_r = p->dclink.kind == PLANT_DC_RC ? 1.0 / p->dclink.r : 0.0;
   a->inv_c = p->dclink.kind == PLANT_DC_RC ? 1.0 / p->dclink.c : 0.0;
@@ -62,8 +61,7 @@ int plant_init(plant_t *pl, const plant_params_t *p, const char **field) {
   a->gates_prev = 0;
   a->v_star = 0.0;
   pl->t = 0.0;
-  pl->lambda_d = p->machine.lambda_m; /* zero current */
-  pl->lambda_q = 0.0;
+  plant_mag_flux0(&a->mag, &pl->lambda_d, &pl->lambda_q); /* zero current */
   pl->theta_m = wrap_2pi(p->mech.theta0);
   pl->omega_m =
       p->mech.mode == PLANT_MECH_IMPOSED ? profile_eval(&p->mech.speed, 0.0) : p->mech.omega0;
@@ -81,7 +79,23 @@ static double clamp_duty(double d) {
 }
 
 void plant_step(plant_t *pl, const double duty[3], bool gates_on) {
-  const double d[3] = {clamp_duty(duty[0]), clamp_duty(duty[1]), clamp_duty(duty[2])};
+  double on[3], off[3];
+  for (int j = 0; j < 3; j++) {
+    const double d = clamp_duty(duty[j]);
+    on[j] = 0.5 * (1.0 - d);
+    off[j] = 0.5 * (1.0 + d);
+  }
+  plant_step_pattern(pl, on, off, gates_on);
+}
+
+void plant_step_pattern(plant_t *pl, const double on_in[3], const double off_in[3], bool gates_on) {
+  double on[3], off[3], d[3];
+  for (int j = 0; j < 3; j++) {
+    on[j] = clamp_duty(on_in[j]);
+    off[j] = clamp_duty(off_in[j]);
+    off[j] = off[j] < on[j] ? on[j] : off[j];
+    d[j] = off[j] - on[j];
+  }
   const double ts = pl->p.ts;
   plant_mech_input_refresh(pl);
   double x[X_N] = {pl->lambda_d, pl->lambda_q, pl->theta_m, pl->omega_m, pl->v_dc, 0, 0, 0, 0};
@@ -95,7 +109,7 @@ void plant_step(plant_t *pl, const double duty[3], bool gates_on) {
     pl->aux.all_zero = 0;
     pl->aux.gates_prev = 1;
   } else {
-    plant_inverter_sw_period(pl, d, gates_on, x);
+    plant_inverter_sw_period(pl, on, off, gates_on, x);
   }
   const double inv_ts = pl->aux.inv_ts;
   pl->v_abc_avg[0] = x[X_VA] * inv_ts;

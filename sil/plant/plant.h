@@ -16,6 +16,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "plant_magnetics.h"
 #include "profile.h"
 
 typedef struct {
@@ -123,9 +124,10 @@ typedef struct {
  * API: read the state through plant_get_state(). */
 typedef struct {
   /* constants */
-  double inv_ld, inv_lq, inv_j, inv_c, inv_r; /* 1/Ld, 1/Lq, 1/J, 1/C, 1/R */
-  double kdt;                                 /* dead_time / ts */
-  double inv_ts;                              /* 1 / ts */
+  plant_mag_t mag;            /* the magnetic model (plant_magnetics.h) */
+  double inv_j, inv_c, inv_r; /* 1/J, 1/C, 1/R */
+  double kdt;                 /* dead_time / ts */
+  double inv_ts;              /* 1 / ts */
   double inv_band;  /* 1 / width of the smooth sign of the average-model dead time [1/A] */
   uint64_t n_steps; /* periods done: t = n_steps * ts exactly */
   /* switching-level inverter memory, per leg: time of the last commanded
@@ -171,9 +173,14 @@ typedef struct {
 int plant_check(const plant_params_t *p, const char **field);
 /* Initialises (calls plant_check first). Returns 0 or the error. */
 int plant_init(plant_t *pl, const plant_params_t *p, const char **field);
-/* Advances one PWM period with the given duties (clamped to [0, 1]).
- * gates_on = false: all six switches off, only the diodes conduct. */
+/* Advances one PWM period with the given duties (clamped to [0, 1]),
+ * centred pulses. gates_on = false: all six switches off, only the diodes
+ * conduct. */
 void plant_step(plant_t *pl, const double duty[3], bool gates_on);
+/* The same with a pattern: leg x's high side commanded on over
+ * [on[x], off[x]) in fractions of the period (0 <= on <= off <= 1). The
+ * average model uses the duty off - on. */
+void plant_step_pattern(plant_t *pl, const double on[3], const double off[3], bool gates_on);
 /* Sensor readings at the present plant time (the carrier valley). */
 void plant_sample(plant_t *pl, plant_adc_t *out);
 void plant_get_state(const plant_t *pl, plant_state_t *out);

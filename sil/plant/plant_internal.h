@@ -124,7 +124,8 @@ void plant_machine_zero_phase_current(const plant_t *pl, double *x, int leg);
 int plant_inverter_check(const plant_inverter_t *inv, double ts, const char **field);
 void plant_inverter_init(plant_t *pl);
 void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, double cs_end[2]);
-void plant_inverter_sw_period(plant_t *pl, const double duty[3], bool gates_on, double *x);
+void plant_inverter_sw_period(plant_t *pl, const double on[3], const double off[3], bool gates_on,
+                              double *x);
 
 /* plant_dclink.c */
 int plant_dclink_check(const plant_dclink_t *d, const char **field);

@@ -38,7 +38,7 @@ int plant_inverter_check(const plant_inverter_t *inv, double ts, const char **fi
 void plant_inverter_init(plant_t *pl) {
   const plant_params_t *p = &pl->p;
   const double h = p->ts / p->inverter.substeps;
-  const double lmin = fmin(p->machine.ld, p->machine.lq);
+  const double lmin = plant_mag_l_min(&pl->aux.mag);
   const double band = 2.0 * pl->aux.kdt * p->dclink.v_source * h / lmin;
   pl->aux.inv_band = 1.0 / fmax(band, INV_BAND_MIN);
 }

@@ -62,7 +62,8 @@ static inline void stage_cos_sin(const angle_ref_t *r, double th, double *c, dou
 
 /* Constants of one period, in locals (no reloads through pl in the stages). */
 typedef struct {
-  double pp, lm, inv_ld, inv_lq, rs, nb, b, inv_j, vsrc, inv_r, inv_c;
+  plant_mag_t mag;
+  double pp, rs, nb, b, inv_j, vsrc, inv_r, inv_c;
   double d[3], kd[3]; /* duties; td/Ts for a switching leg (0 < d < 1), else 0 */
   int imposed, ideal; /* mech.mode == IMPOSED, dclink.kind == IDEAL */
 } avg_k_t;
@@ -72,8 +73,8 @@ typedef struct {
  * DC link, with the parameters hoisted. */
 static inline void avg_deriv(const avg_k_t *restrict k, int ideal, int imposed, double c, double s,
                              const double *restrict x, double m, double *restrict dx) {
-  const double id = (x[X_LD] - k->lm) * k->inv_ld;
-  const double iq = x[X_LQ] * k->inv_lq;
+  double id, iq;
+  plant_mag_current(&k->mag, x[X_LD], x[X_LQ], &id, &iq);
   const double ial = id * c - iq * s, ibe = id * s + iq * c;
   const double ia = ial, ib = -0.5 * ial + PLANT_SQRT3_2 * ibe, ic = -ia - ib;
   const double vdc = ideal ? k->vsrc : (x[X_VC] > 0.0 ? x[X_VC] : 0.0);
@@ -177,9 +178,7 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
   const plant_params_t *p = &pl->p;
   avg_k_t k;
   k.pp = (double)p->machine.pole_pairs;
-  k.lm = p->machine.lambda_m;
-  k.inv_ld = pl->aux.inv_ld;
-  k.inv_lq = pl->aux.inv_lq;
+  k.mag = pl->aux.mag;
   k.rs = p->machine.rs;
   k.nb = pl->aux.inv_band;
   k.b = p->mech.b;

@@ -13,7 +13,7 @@
  *   i_x = 0 -> blocked: the leg floats at the voltage u that keeps
  *              di_x/dt = 0, valid while 0 <= u <= v_dc.
  * With two legs blocked all currents are zero ("all-zero" state): the flux
- * linkages are held at (lambda_m, 0) exactly, the phase voltages are the
+ * linkages are held at their zero-current value (the PM flux) exactly, the phase voltages are the
  * back-EMF, and conduction resumes when no star-point potential keeps every
  * leg within its allowed range (gap > 0), between the two legs that violate
  * it. This gives extinction without chattering below the rectifier
@@ -58,8 +58,8 @@ static void phase_currents(const plant_t *pl, const double *x, double i[3], doub
                            double *ibe) {
   const double th = pl->p.machine.pole_pairs * x[X_TH];
   const double c = cos(th), s = sin(th);
-  const double id = (x[X_LD] - pl->p.machine.lambda_m) * pl->aux.inv_ld;
-  const double iq = x[X_LQ] * pl->aux.inv_lq;
+  double id, iq;
+  plant_mag_current(&pl->aux.mag, x[X_LD], x[X_LQ], &id, &iq);
   *ial = id * c - iq * s;
   *ibe = id * s + iq * c;
   i[0] = *ial;
@@ -76,8 +76,13 @@ static void leg_range(int type, double vdc, double *lo, double *hi) {
 static void backemf(const plant_t *pl, const double *x, double w, double e[3]) {
   const double pp = (double)pl->p.machine.pole_pairs;
   const double th = pp * x[X_TH];
-  const double k = pp * w * pl->p.machine.lambda_m;
-  const double eal = -k * sin(th), ebe = k * cos(th);
+  /* zero current: the flux is lambda(0) turning with the rotor, e = w_e J lambda */
+  double l0d, l0q;
+  plant_mag_flux0(&pl->aux.mag, &l0d, &l0q);
+  const double c = cos(th), s = sin(th);
+  const double lal = l0d * c - l0q * s, lbe = l0d * s + l0q * c;
+  const double we = pp * w;
+  const double eal = -we * lbe, ebe = we * lal;
   e[0] = eal;
   e[1] = -0.5 * eal + PLANT_SQRT3_2 * ebe;
   e[2] = -e[0] - e[1];
@@ -110,8 +115,8 @@ static void sw_deriv(const plant_t *pl, const sw_cfg_t *cf, const double *x, dou
   } else {
     const double th = pp * x[X_TH];
     const double c = cos(th), s = sin(th);
-    const double id = (x[X_LD] - mp->lambda_m) * pl->aux.inv_ld;
-    const double iq = x[X_LQ] * pl->aux.inv_lq;
+    double id, iq;
+    plant_mag_current(&pl->aux.mag, x[X_LD], x[X_LQ], &id, &iq);
     const double ial = id * c - iq * s, ibe = id * s + iq * c;
     const double i[3] = {ial, -0.5 * ial + PLANT_SQRT3_2 * ibe, -0.5 * ial - PLANT_SQRT3_2 * ibe};
     double v[3];
@@ -127,13 +132,16 @@ static void sw_deriv(const plant_t *pl, const sw_cfg_t *cf, const double *x, dou
     o->u = 0.0;
     if (cf->blocked >= 0) {
       /* leg j blocked: choose its potential u so that di_j/dt = 0;
-       * di_j/dt = p.(D dlambda) + w_e c_j.(J i_ab), p = R(-theta) c_j, and
-       * u enters as dlambda += (2/3) u p. */
+       * di_j/dt = p.(G dlambda) + w_e c_j.(J i_ab), p = R(-theta) c_j,
+       * G = d i / d lambda (plant_magnetics.h), and u enters as
+       * dlambda += (2/3) u p. */
       const int j = cf->blocked;
       const double p1 = CX[j][0] * c + CX[j][1] * s, p2 = -CX[j][0] * s + CX[j][1] * c;
-      const double dij = p1 * dld * pl->aux.inv_ld + p2 * dlq * pl->aux.inv_lq +
-                         we * (-CX[j][0] * ibe + CX[j][1] * ial);
-      const double g = (2.0 / 3.0) * (p1 * p1 * pl->aux.inv_ld + p2 * p2 * pl->aux.inv_lq);
+      double G[2][2];
+      plant_mag_jacobian(&pl->aux.mag, x[X_LD], x[X_LQ], G);
+      const double gp1 = G[0][0] * p1 + G[1][0] * p2, gp2 = G[0][1] * p1 + G[1][1] * p2; /* G^T p */
+      const double dij = gp1 * dld + gp2 * dlq + we * (-CX[j][0] * ibe + CX[j][1] * ial);
+      const double g = (2.0 / 3.0) * (gp1 * p1 + gp2 * p2);
       const double u = -dij / g;
       dld += (2.0 / 3.0) * u * p1;
       dlq += (2.0 / 3.0) * u * p2;
@@ -157,8 +165,7 @@ static void sw_deriv(const plant_t *pl, const sw_cfg_t *cf, const double *x, dou
 }
 
 static void enter_all_zero(const plant_t *pl, sw_cfg_t *cf, double *x) {
-  x[X_LD] = pl->p.machine.lambda_m;
-  x[X_LQ] = 0.0;
+  plant_mag_flux0(&pl->aux.mag, &x[X_LD], &x[X_LQ]);
   cf->all_zero = 1;
   cf->blocked = -1;
   for (int j = 0; j < 3; j++) {
@@ -409,7 +416,8 @@ static int leg_type_at(const edges_t *e, double tau, double td) {
   return e->cmd[k] ? LEG_HI : LEG_LO;
 }
 
-void plant_inverter_sw_period(plant_t *pl, const double duty[3], bool gates_on, double *x) {
+void plant_inverter_sw_period(plant_t *pl, const double on[3], const double off[3], bool gates_on,
+                              double *x) {
   plant_aux_t *a = &pl->aux;
   const double ts = pl->p.ts, td = pl->p.inverter.dead_time;
   edges_t ed[3];
@@ -425,16 +433,20 @@ void plant_inverter_sw_period(plant_t *pl, const double duty[3], bool gates_on, 
     if (!gates_on) {
       continue;
     }
-    const double d = duty[j];
-    const int h0 = d >= 1.0;
+    /* high over [on, off): on at the period start when on = 0 (and off
+     * = 1: the whole period) */
+    const double d = off[j] - on[j];
+    const int h0 = d > 0.0 && on[j] <= 0.0;
     if (!a->gates_prev || h0 != a->edge_cmd[j]) {
       e->te[e->n] = 0.0;
       e->cmd[e->n++] = h0;
     }
-    if (d > 0.0 && d < 1.0) {
-      e->te[e->n] = 0.5 * (1.0 - d) * ts;
+    if (d > 0.0 && on[j] > 0.0) {
+      e->te[e->n] = on[j] * ts;
       e->cmd[e->n++] = 1;
-      e->te[e->n] = 0.5 * (1.0 + d) * ts;
+    }
+    if (d > 0.0 && off[j] < 1.0) {
+      e->te[e->n] = off[j] * ts;
       e->cmd[e->n++] = 0;
     }
     for (int k = 0; k < e->n; k++) {

@@ -1,7 +1,8 @@
 /*
- * plant_machine.c - PM synchronous machine with constant Ld, Lq, lambda_m,
- * Rs (SPM: Ld = Lq; IPM: Ld < Lq). State: rotor-frame flux linkages
- *   lambda_d = Ld i_d + lambda_m,  lambda_q = Lq i_q   (d on the magnet)
+ * plant_machine.c - PM synchronous machine in the rotor frame, d on the
+ * magnet. State: rotor-frame flux linkages; the currents follow from the
+ * magnetic model (plant_magnetics.h; linear: lambda_d = Ld i_d + lambda_m,
+ * lambda_q = Lq i_q, SPM Ld = Lq, IPM Ld < Lq):
  *   d lambda_d/dt = v_d - Rs i_d + w_e lambda_q
  *   d lambda_q/dt = v_q - Rs i_q - w_e lambda_d
  *   T_e = 1.5 p (lambda_d i_q - lambda_q i_d),  theta_e = p theta_m.
@@ -40,8 +41,8 @@ void plant_machine_cur_fill(const plant_t *pl, plant_cur_cache_t *c, double co, 
   c->key[1] = pl->lambda_q;
   c->key[2] = pl->theta_m;
   c->th_e = pl->p.machine.pole_pairs * pl->theta_m;
-  const double id = (pl->lambda_d - pl->p.machine.lambda_m) * pl->aux.inv_ld;
-  const double iq = pl->lambda_q * pl->aux.inv_lq;
+  double id, iq;
+  plant_mag_current(&pl->aux.mag, pl->lambda_d, pl->lambda_q, &id, &iq);
   const double ia = id * co - iq * si, ib = id * si + iq * co;
   c->c = co;
   c->s = si;
@@ -57,17 +58,22 @@ void plant_machine_cur_compute(const plant_t *pl, plant_cur_cache_t *c) {
   plant_machine_cur_fill(pl, c, cos(th_e), sin(th_e));
 }
 
-/* Projects the flux state so that phase `leg`'s current is exactly zero,
- * moving lambda_dq along the gradient of that current (smallest change).
- * Used when a free-wheeling diode blocks: i_x = k . (lambda - lambda_m e_d)
- * with k = diag(1/Ld, 1/Lq) R(-theta_e) c_x. */
+/* Projects the flux state so that phase `leg`'s current is zero, moving
+ * lambda_dq along the gradient of that current (smallest change), a Newton
+ * step: exact for the linear model. Used when a free-wheeling diode blocks:
+ * i_x = p . i_dq(lambda) with p = R(-theta_e) c_x, gradient k = G^T p,
+ * G = d i / d lambda (plant_magnetics.h). */
 void plant_machine_zero_phase_current(const plant_t *pl, double *x, int leg) {
   static const double cx[3][2] = {{1.0, 0.0}, {-0.5, PLANT_SQRT3_2}, {-0.5, -PLANT_SQRT3_2}};
   const double th = pl->p.machine.pole_pairs * x[X_TH];
   const double c = cos(th), s = sin(th);
-  const double k1 = (cx[leg][0] * c + cx[leg][1] * s) * pl->aux.inv_ld;
-  const double k2 = (-cx[leg][0] * s + cx[leg][1] * c) * pl->aux.inv_lq;
-  const double ix = k1 * (x[X_LD] - pl->p.machine.lambda_m) + k2 * x[X_LQ];
+  const double p1 = cx[leg][0] * c + cx[leg][1] * s;
+  const double p2 = -cx[leg][0] * s + cx[leg][1] * c;
+  double id, iq, G[2][2];
+  plant_mag_current(&pl->aux.mag, x[X_LD], x[X_LQ], &id, &iq);
+  plant_mag_jacobian(&pl->aux.mag, x[X_LD], x[X_LQ], G);
+  const double k1 = G[0][0] * p1 + G[1][0] * p2, k2 = G[0][1] * p1 + G[1][1] * p2;
+  const double ix = p1 * id + p2 * iq;
   const double n2 = k1 * k1 + k2 * k2;
   x[X_LD] -= ix * k1 / n2;
   x[X_LQ] -= ix * k2 / n2;

@@ -1,19 +1,11 @@
 /*
  * isr_record.c - ISR input/output recorder (see isr_record.h).
  *
- * What the observer cannot see directly is derived exactly from the drive:
- *  - the staged commands: drive_t.cmd after the slow loop. The slow loop
- *    changes cmd only in ways that replaying the changed values reproduces
- *    (enable forced off in fault, the mode fixed up for DFVC laws), except
- *    clear_fault, which it consumes: a clear is recorded when the drive left
- *    the fault state or lost a fault bit (bits only ever accumulate
- *    otherwise);
- *  - the hardware trip input: the drive latches DRIVE_FAULT_HW_OVERCURRENT
- *    in the ISR that reads hal_fault_hw_tripped() true, and the HAL latch
- *    and that bit are cleared together (drive_slow_loop), so the input of
- *    ISR k equals that bit after ISR k;
- *  - faults raised from outside the ISR (drive_raise_fault: the command
- *    timeout, the one cause the ISR never detects) appear as new bits.
+ * Everything the ISR reads is recorded as it found it: the HAL sample set
+ * (the runner filled it before the ISR), the break input (sil_step_t
+ * .hw_tripped), the command block drive_t.req (only the main loop writes it,
+ * between ISRs: after ISR k it still holds what ISR k read) and the drive's
+ * applied-voltage memory before the ISR (drive_t.v_applied after ISR k-1).
  */
 #include "isr_record.h"
 
@@ -30,7 +22,8 @@ static void write_header(isr_record_t *r, uint32_t count) {
   isr_stream_header_t h = {ISR_STREAM_MAGIC,
                            ISR_STREAM_VERSION,
                            sizeof(isr_stream_header_t),
-                           sizeof(drive_config_t),
+                           4u * ISR_STREAM_CONFIG_WORDS,
+                           4u * ISR_STREAM_CAPS_WORDS,
                            sizeof(isr_stream_in_t),
                            sizeof(isr_stream_out_t),
                            count,
@@ -38,43 +31,8 @@ static void write_header(isr_record_t *r, uint32_t count) {
   write_block(r, &h, sizeof h);
 }
 
-/* True when ISR_STREAM_CONFIG_FIELDS covers drive_config_t: no gap of a
- * 32-bit field or more between the listed fields (padding is shorter). */
-static bool config_fields_complete(void) {
-  struct {
-    size_t off, size;
-  } f[ISR_STREAM_CONFIG_WORDS];
-  unsigned n = 0;
-#define REC_FLT(m)    f[n].off = offsetof(drive_config_t, m), f[n++].size = sizeof(float);
-#define REC_INT(m, t) f[n].off = offsetof(drive_config_t, m), f[n++].size = sizeof(t);
-  ISR_STREAM_CONFIG_FIELDS(REC_FLT, REC_INT)
-#undef REC_FLT
-#undef REC_INT
-  for (unsigned i = 1; i < n; ++i) { /* sort by offset */
-    for (unsigned j = i; j > 0 && f[j - 1].off > f[j].off; --j) {
-      size_t o = f[j].off, z = f[j].size;
-      f[j] = f[j - 1];
-      f[j - 1].off = o;
-      f[j - 1].size = z;
-    }
-  }
-  size_t pos = 0;
-  for (unsigned i = 0; i < n; ++i) {
-    if (f[i].off < pos || f[i].off - pos >= 4u) {
-      return false;
-    }
-    pos = f[i].off + f[i].size;
-  }
-  return sizeof(drive_config_t) - pos < 4u;
-}
-
 int isr_record_open(isr_record_t *r, const char *path) {
   memset(r, 0, sizeof *r);
-  if (!config_fields_complete()) {
-    fprintf(stderr, "isr_record: drive_config_t has fields that ISR_STREAM_CONFIG_FIELDS "
-                    "(sil/runner/isr_stream.h) does not list\n");
-    return -1;
-  }
   r->f = fopen(path, "wb");
   return r->f != NULL ? 0 : -1;
 }
@@ -88,9 +46,20 @@ void isr_record_observer(void *user, const sil_step_t *st) {
     uint32_t w[ISR_STREAM_CONFIG_WORDS];
     isr_stream_config_put(&drv->cfg, w);
     write_block(r, w, sizeof w);
-    r->prev_faults = 0u;
-    r->prev_state = DRIVE_STATE_IDLE; /* after drive_init */
+    uint32_t cw[ISR_STREAM_CAPS_WORDS];
+    isr_stream_caps_put(drv->caps, st->timer_counts, cw);
+    write_block(r, cw, sizeof cw);
   }
+  /* not replayable: a parameter request, a watchdog reset (drive_init
+   * again) or a stalled ISR */
+  if (drv->creq.seq != 0u || drv->isr_count != r->isr_count + 1u) {
+    if (r->failed == 0) {
+      fprintf(stderr, "isr_record: the run has parameter requests, a watchdog reset or a "
+                      "stalled ISR: not recordable for the PIL replay\n");
+    }
+    r->failed = 1;
+  }
+  r->isr_count = drv->isr_count;
   if (r->pending) {
     memcpy(r->out.duty, st->duty_active, sizeof r->out.duty);
     write_block(r, &r->in, sizeof r->in);
@@ -100,40 +69,29 @@ void isr_record_observer(void *user, const sil_step_t *st) {
 
   isr_stream_in_t *in = &r->in;
   memset(in, 0, sizeof *in);
-  const uint32_t faults = drv->faults;
-  if (st->k % drv->cfg.slow_div == 0u) {
-    in->flags |= ISR_IN_SLOW;
-    in->flags |= drv->cmd.enable ? ISR_IN_CMD_ENABLE : 0u;
-    const bool cleared = r->prev_state == DRIVE_STATE_FAULT &&
-                         (drv->state != DRIVE_STATE_FAULT || (r->prev_faults & ~faults) != 0u);
-    in->flags |= cleared ? ISR_IN_CMD_CLEAR : 0u;
-    in->cmd_law = (uint32_t)drv->cmd.law;
-    in->cmd_mode = (uint32_t)drv->cmd.mode;
-    in->cmd_torque = drv->cmd.torque;
-    in->cmd_speed = drv->cmd.speed;
-    in->cmd_id = drv->cmd.id;
-    in->cmd_iq = drv->cmd.iq;
-    in->cmd_flux = drv->cmd.flux;
-  }
-  in->flags |= st->adc->enc_valid ? ISR_IN_ENC_VALID : 0u;
-  in->flags |= (faults & DRIVE_FAULT_HW_OVERCURRENT) != 0u ? ISR_IN_HW_TRIPPED : 0u;
+  const hal_sample_t *s = st->adc;
+  in->flags = (s->enc_valid ? ISR_IN_ENC_VALID : 0u) | (s->valid ? ISR_IN_VALID : 0u) |
+              (st->hw_tripped ? ISR_IN_HW_TRIPPED : 0u);
   in->time_us = (uint32_t)(uint64_t)(st->t * 1e6);
-  memcpy(in->i_abc, st->adc->i_abc, sizeof in->i_abc);
-  in->v_dc = st->adc->v_dc;
-  in->v_star = st->adc->v_star;
-  in->enc_angle = st->adc->enc_angle;
-  in->raise_fault = faults & ~r->prev_faults & DRIVE_FAULT_CMD_TIMEOUT;
+  memcpy(in->i_abc, s->i_abc, sizeof in->i_abc);
+  in->v_dc = s->v_dc;
+  in->t_i = s->t_i;
+  memcpy(in->v_star, s->v_star, sizeof in->v_star);
+  memcpy(in->t_star, s->t_star, sizeof in->t_star);
+  in->n_star = s->n_star;
+  in->test_vector = s->test_vector;
+  in->enc_angle = s->enc_angle;
+  in->t_enc = s->t_enc;
+  isr_stream_cmd_put(drv->req.seq, &drv->req.cmd, in);
   in->v_applied[0] = r->prev_v_applied[0];
   in->v_applied[1] = r->prev_v_applied[1];
-  r->prev_v_applied[0] = drv->ctrl.v_applied.alpha;
-  r->prev_v_applied[1] = drv->ctrl.v_applied.beta;
+  r->prev_v_applied[0] = drv->v_applied.alpha;
+  r->prev_v_applied[1] = drv->v_applied.beta;
 
   r->out.flags = st->gates_on ? ISR_OUT_GATES_ON : 0u;
-  r->out.faults = faults;
+  r->out.faults = drv->faults;
   r->out.state = (uint32_t)drv->state;
   r->pending = true;
-  r->prev_faults = faults;
-  r->prev_state = drv->state;
 
   if (r->next != NULL) {
     r->next(r->next_user, st);

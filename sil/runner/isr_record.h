@@ -1,13 +1,15 @@
 /*
- * isr_record.h - records, per ISR, the drive's inputs (HAL sample, staged
- * commands at each slow loop, hardware trip) and its outputs (duties, gate
- * state, faults) into an isr_stream file (isr_stream.h, docs/pil.md), for
- * the processor-in-the-loop replay on QEMU (pil/, `fluxdrive pil`).
+ * isr_record.h - records, per ISR, the drive's inputs (HAL sample set, the
+ * break input, the main loop's command block as the ISR finds it) and its
+ * outputs (pattern duties, gate state, faults, state) into an isr_stream
+ * file (isr_stream.h, docs/pil.md), for the processor-in-the-loop replay on
+ * QEMU (pil/, `fluxdrive pil`).
  *
  * It is a sil_run observer; it can chain to another observer (the log).
- * The outputs of ISR k are completed at period k+1 (the duties the HAL
- * holds after ISR k are those acting over [t_k+1, t_k+2)), so the last ISR
- * of a run is not recorded.
+ * The outputs of ISR k are completed at period k+1 (the pattern the HAL
+ * holds after ISR k acts over [t_k+1, t_k+2)), so the last ISR of a run is
+ * not recorded. Runs with parameter requests (CAN parameter writes) or
+ * watchdog resets are not recordable (the recorder stops with an error).
  */
 #ifndef FD_SIL_ISR_RECORD_H
 #define FD_SIL_ISR_RECORD_H
@@ -23,13 +25,12 @@ typedef struct {
   FILE *f;
   uint32_t count;
   int failed;
-  bool started; /* header and config written */
+  bool started; /* header, config and caps written */
   bool pending; /* rec holds ISR k-1, waiting for its duties */
   isr_stream_in_t in;
   isr_stream_out_t out;
-  uint32_t prev_faults;
-  drive_state_t prev_state;
-  float prev_v_applied[2]; /* drive_t.ctrl.v_applied after the last ISR */
+  float prev_v_applied[2]; /* drive_t.v_applied after the last ISR */
+  uint32_t isr_count;      /* drive_t.isr_count after the last ISR */
   sil_observer_fn next;    /* chained observer (may be NULL) */
   void *next_user;
 } isr_record_t;

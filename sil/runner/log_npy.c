@@ -8,16 +8,16 @@
 
 /* Signal names, in column order. Units in docs/log-format.md. */
 static const char *const signals[] = {
-    "t",           "speed", "speed_est", "speed_ref", "torque",     "torque_ref", "torque_est",
-    "load_torque", "i_a",   "i_b",       "i_c",       "i_a_meas",   "i_b_meas",   "i_c_meas",
-    "i_d",         "i_q",   "i_ds",      "i_qs",      "i_qs_ref",   "flux",       "flux_ref",
-    "flux_est",    "delta", "delta_est", "v_dc",      "duty_a",     "duty_b",     "duty_c",
-    "gates",       "state", "faults",    "theta_e",   "theta_e_est"};
+    "t",           "speed", "speed_est", "speed_ref", "torque",      "torque_ref", "torque_est",
+    "load_torque", "i_a",   "i_b",       "i_c",       "i_a_meas",    "i_b_meas",   "i_c_meas",
+    "i_d",         "i_q",   "i_ds",      "i_qs",      "i_qs_ref",    "flux",       "flux_ref",
+    "flux_est",    "delta", "delta_est", "v_dc",      "duty_a",      "duty_b",     "duty_c",
+    "gates",       "state", "faults",    "theta_e",   "theta_e_est", "lc_cause"};
 enum { NSIG = sizeof signals / sizeof signals[0], HEADER_LEN = 2048 };
 
 static void fill_row(const sil_step_t *st, double *r) {
   const plant_state_t *p = st->plant;
-  const drive_telemetry_t *tm = drive_telemetry(st->drive);
+  const drive_telemetry_t *tm = &st->drive->tm; /* lock-step: the ISR's own telemetry */
   double ld = p->lambda_dq[0], lq = p->lambda_dq[1];
   double flux = hypot(ld, lq);
   /* True stator-flux frame currents: projection of i on lambda_s and its
@@ -56,7 +56,8 @@ static void fill_row(const sil_step_t *st, double *r) {
                     (double)tm->state,
                     (double)tm->faults,
                     p->theta_e,
-                    tm->theta_e};
+                    tm->theta_e,
+                    (double)tm->lc_cause};
   memcpy(r, v, sizeof v);
 }
 

@@ -5,6 +5,8 @@
  *                 [--decimate N] [--bench] [--print-config]
  *
  * --print-config prints the resolved parameters (JSON) and exits.
+ * --print-params prints the parameter table and the drive's named values
+ * (JSON; no scenario needed) and exits.
  * --record-isr PATH.bin records every ISR's inputs and outputs for the PIL
  * replay (sil/runner/isr_record.h, docs/pil.md).
  * --can socketcand:PORT | socketcan:IFACE [--node N] [--can-timeout MS]:
@@ -33,11 +35,12 @@
 #include "summary.h"
 
 static int usage(void) {
-  fprintf(stderr, "usage: fluxdrive-sil SCENARIO.json [--log PATH.npy] [--summary PATH.json]\n"
-                  "                     [--decimate N] [--bench] [--print-config]\n"
-                  "                     [--record-isr PATH.bin] [--realtime]\n"
-                  "                     [--can socketcand:PORT | --can socketcan:IFACE]\n"
-                  "                     [--node N] [--can-timeout MS]\n");
+  fprintf(stderr,
+          "usage: fluxdrive-sil SCENARIO.json [--log PATH.npy] [--summary PATH.json]\n"
+          "                     [--decimate N] [--bench] [--print-config] [--print-params]\n"
+          "                     [--record-isr PATH.bin] [--realtime]\n"
+          "                     [--can socketcand:PORT | --can socketcan:IFACE]\n"
+          "                     [--node N] [--can-timeout MS]\n");
   return 2;
 }
 
@@ -81,7 +84,7 @@ static int parse_long(const char *opt, const char *s, long lo, long hi, long *ou
 
 int main(int argc, char **argv) {
   const char *scenario = NULL, *log_path = NULL, *summary_path = NULL, *record_path = NULL;
-  int decimate = 0, bench = 0, print_config = 0, realtime = 0;
+  int decimate = 0, bench = 0, print_config = 0, print_params = 0, realtime = 0;
   const char *can = NULL;
   long node = -1, can_timeout = -1;
   for (int i = 1; i < argc; ++i) {
@@ -115,11 +118,22 @@ int main(int argc, char **argv) {
       }
     } else if (strcmp(argv[i], "--print-config") == 0) {
       print_config = 1;
+    } else if (strcmp(argv[i], "--print-params") == 0) {
+      print_params = 1;
     } else if (argv[i][0] == '-' || scenario != NULL) {
       return usage();
     } else {
       scenario = argv[i];
     }
+  }
+  if (print_params) {
+    char *js = params_json();
+    if (js == NULL) {
+      return 1;
+    }
+    printf("%s\n", js);
+    free(js);
+    return 0;
   }
   if (scenario == NULL) {
     return usage();

@@ -15,6 +15,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "board_presets.h"
+#include "drive.h"
 #include "presets.h"
 
 #define PI 3.14159265358979323846
@@ -87,14 +89,6 @@ static int get_num(ctx_t *c, const cJSON *obj, const char *path, const char *key
   return 0;
 }
 
-static int get_float(ctx_t *c, const cJSON *obj, const char *path, const char *key, double lo,
-                     double hi, float *out) {
-  double v = (double)*out;
-  int r = get_num(c, obj, path, key, lo, hi, &v);
-  *out = (float)v;
-  return r;
-}
-
 static int get_int(ctx_t *c, const cJSON *obj, const char *path, const char *key, int lo, int hi,
                    int *out) {
   double v = (double)*out;
@@ -108,6 +102,15 @@ static int get_int(ctx_t *c, const cJSON *obj, const char *path, const char *key
   }
   *out = (int)v;
   return 0;
+}
+
+/* Optional number for a key that also sets drive parameter `param`: its
+ * range is the parameter's (drive_param_table.h), one range for plant and
+ * drive. */
+static int get_param_num(ctx_t *c, const cJSON *obj, const char *path, const char *key,
+                         const char *param, double *out) {
+  const drive_param_t *p = drive_params_by_name(param);
+  return get_num(c, obj, path, key, (double)p->min, (double)p->max, out);
 }
 
 /* Optional string from a list; returns its index in *out. */
@@ -246,15 +249,18 @@ static int parse_machine(ctx_t *c, const cJSON *m, scenario_t *sc) {
     preset_apply(p, &sc->plant, &sc->drive);
   }
   plant_machine_t *pm = &sc->plant.machine;
-  double ls = -1.0;
-  if (get_int(c, m, "machine", "pole_pairs", 1, 100, &pm->pole_pairs) ||
-      get_num(c, m, "machine", "rs", 1e-6, 1e4, &pm->rs) ||
-      get_num(c, m, "machine", "ls", 1e-9, 100.0, &ls) ||
-      get_num(c, m, "machine", "ld", 1e-9, 100.0, &pm->ld) ||
-      get_num(c, m, "machine", "lq", 1e-9, 100.0, &pm->lq) ||
-      get_num(c, m, "machine", "lambda_m", 0.0, 100.0, &pm->lambda_m)) {
+  double ls = -1.0, pp = pm->pole_pairs;
+  const char *M = "machine";
+  if (get_param_num(c, m, M, "pole_pairs", "pole_pairs", &pp) ||
+      get_param_num(c, m, M, "rs", "rs", &pm->rs) || get_param_num(c, m, M, "ls", "ld", &ls) ||
+      get_param_num(c, m, M, "ld", "ld", &pm->ld) || get_param_num(c, m, M, "lq", "lq", &pm->lq) ||
+      get_param_num(c, m, M, "lambda_m", "lambda_m", &pm->lambda_m)) {
     return -1;
   }
+  if (floor(pp) != pp) {
+    return fail(c, "machine.pole_pairs", "must be an integer (got %g)", pp);
+  }
+  pm->pole_pairs = (int)pp;
   if (ls > 0.0) {
     if (cJSON_GetObjectItemCaseSensitive(m, "ld") || cJSON_GetObjectItemCaseSensitive(m, "lq")) {
       return fail(c, "machine.ls", "give either ls (SPM) or ld and lq, not both");
@@ -278,10 +284,12 @@ static int parse_inverter(ctx_t *c, const cJSON *o, scenario_t *sc) {
   }
   int model = (int)sc->plant.inverter.model;
   double f = 1.0 / sc->plant.ts;
+  const drive_param_t *pts = drive_params_by_name("ts");
   if (get_enum(c, o, "inverter", "model", models, &model) ||
-      get_num(c, o, "inverter", "dead_time", 0.0, 1e-4, &sc->plant.inverter.dead_time) ||
+      get_param_num(c, o, "inverter", "dead_time", "dead_time", &sc->plant.inverter.dead_time) ||
       get_int(c, o, "inverter", "substeps", 1, 64, &sc->plant.inverter.substeps) ||
-      get_num(c, o, "inverter", "pwm_frequency", 1e3, 1e5, &f) ||
+      get_num(c, o, "inverter", "pwm_frequency", 1.0 / (double)pts->max, 1.0 / (double)pts->min,
+              &f) ||
       get_num(c, o, "inverter", "hw_trip", 0.0, 1e5, &sc->hw_trip)) {
     return -1;
   }
@@ -319,7 +327,7 @@ static int parse_mechanics(ctx_t *c, const cJSON *o, scenario_t *sc) {
   plant_mech_t *m = &sc->plant.mech;
   int mode = (int)m->mode;
   if (get_enum(c, o, "mechanics", "mode", modes, &mode) ||
-      get_num(c, o, "mechanics", "j", 1e-9, 1e4, &m->j) ||
+      get_param_num(c, o, "mechanics", "j", "inertia", &m->j) ||
       get_num(c, o, "mechanics", "b", 0.0, 1e4, &m->b) ||
       get_profile(c, o, "mechanics", "load_torque", &m->load_torque) ||
       get_profile(c, o, "mechanics", "speed", &m->speed) ||
@@ -349,11 +357,13 @@ static int parse_sensors(ctx_t *c, const cJSON *o, scenario_t *sc) {
       get_num(c, o, "sensors", "v_full_scale", 1e-3, 1e5, &s->v_full_scale) ||
       get_num(c, o, "sensors", "i_noise", 0.0, 1e3, &s->i_noise) ||
       get_num(c, o, "sensors", "v_noise", 0.0, 1e3, &s->v_noise) ||
-      get_int(c, o, "sensors", "encoder_cpr", 0, 1 << 24, &s->encoder_cpr) ||
+      get_int(c, o, "sensors", "encoder_cpr", 0, (int)drive_params_by_name("enc_cpr")->max,
+              &s->encoder_cpr) ||
       get_int(c, o, "sensors", "seed", 0, 0x7fffffff, &seed)) {
     return -1;
   }
   s->seed = (uint32_t)seed;
+  sc->drive.enc_cpr = (uint32_t)s->encoder_cpr;
   const char *arrays[2] = {"gain_error", "offset_error"};
   double *dst[2] = {s->gain_error, s->offset_error};
   for (int a = 0; a < 2; ++a) {
@@ -377,51 +387,70 @@ static int parse_sensors(ctx_t *c, const cJSON *o, scenario_t *sc) {
   return 0;
 }
 
+/* The keys of the "controller" section: every parameter whose scenario key
+ * is "controller.<name>" (drive_param_table.h), and "estimates". */
+static int controller_keys(const char **keys, unsigned max) {
+  unsigned n, k = 0;
+  const drive_param_t *t = drive_params_table(&n);
+  for (unsigned i = 0; i < n && k + 2u < max; ++i) {
+    if (strncmp(t[i].scenario, "controller.", 11) == 0) {
+      keys[k++] = t[i].scenario + 11;
+    }
+  }
+  keys[k++] = "estimates";
+  keys[k] = NULL;
+  return 0;
+}
+
+/* One controller parameter, by its type: a number in the table's range,
+ * or the name of a law, mode or position source. */
+static int get_param(ctx_t *c, const cJSON *o, const drive_param_t *p, drive_config_t *d) {
+  const char *key = p->scenario + 11;
+  const cJSON *it = cJSON_GetObjectItemCaseSensitive(o, key);
+  if (it == NULL) {
+    return 0;
+  }
+  int idx = -1;
+  if (p->type == DRIVE_PARAM_LAW || p->type == DRIVE_PARAM_MODE || p->type == DRIVE_PARAM_POS) {
+    const char *names[8];
+    unsigned n = 0;
+    for (unsigned v = 0; v <= (unsigned)p->max && n + 1u < 8u; ++v) {
+      names[n++] = p->type == DRIVE_PARAM_LAW    ? drive_law_name(v)
+                   : p->type == DRIVE_PARAM_MODE ? drive_mode_name(v)
+                                                 : drive_pos_source_name(v);
+    }
+    names[n] = NULL;
+    if (get_enum(c, o, "controller", key, names, &idx) != 0) {
+      return -1;
+    }
+    drive_param_set(d, p, (float)idx);
+    return 0;
+  }
+  double v = (double)drive_param_get(d, p);
+  if (get_num(c, o, "controller", key, (double)p->min, (double)p->max, &v) != 0) {
+    return -1;
+  }
+  if (p->type != DRIVE_PARAM_F32 && floor(v) != v) {
+    return fail(c, p->scenario, "must be an integer (got %g)", v);
+  }
+  drive_param_set(d, p, (float)v);
+  return 0;
+}
+
 static int parse_controller(ctx_t *c, const cJSON *o, scenario_t *sc) {
-  static const char *const keys[] = {
-      "law",         "mode",       "current_bw", "speed_bw",   "accel_max",      "i_max",
-      "i_trip",      "torque_max", "speed_max",  "speed_trip", "v_dc_max",       "v_dc_min",
-      "v_margin",    "pll_bw",     "enc_offset", "slow_div",   "offset_samples", "offset_max",
-      "flux_obs_wc", "delta_max",  "vsd_max",    "flux_min",   "dfvc_flux_bw",   "dfvc_iqs_bw",
-      "estimates",   NULL};
-  static const char *const laws[] = {"foc", "pi_dfvc", "db_dfvc", NULL};
-  static const char *const modes[] = {"torque", "speed", "current", NULL};
+  const char *keys[DRIVE_PARAM_COUNT + 2];
+  controller_keys(keys, DRIVE_PARAM_COUNT + 2);
   if (check_keys(c, o, "controller", keys) != 0) {
     return -1;
   }
   drive_config_t *d = &sc->drive;
-  int law = (int)d->law, mode = (int)d->mode;
-  int slow_div = d->slow_div, offset_samples = d->offset_samples;
-  const char *P = "controller";
-  if (get_enum(c, o, P, "law", laws, &law) || get_enum(c, o, P, "mode", modes, &mode) ||
-      get_float(c, o, P, "current_bw", 0.0, 1e6, &d->current_bw) ||
-      get_float(c, o, P, "speed_bw", 0.0, 1e5, &d->speed_bw) ||
-      get_float(c, o, P, "accel_max", 0.0, 1e8, &d->accel_max) ||
-      get_float(c, o, P, "i_max", 0.0, 1e5, &d->i_max) ||
-      get_float(c, o, P, "i_trip", 0.0, 1e5, &d->i_trip) ||
-      get_float(c, o, P, "torque_max", 0.0, 1e6, &d->torque_max) ||
-      get_float(c, o, P, "speed_max", 0.0, 1e5, &d->speed_max) ||
-      get_float(c, o, P, "speed_trip", 0.0, 1e5, &d->speed_trip) ||
-      get_float(c, o, P, "v_dc_max", 0.0, 1e5, &d->v_dc_max) ||
-      get_float(c, o, P, "v_dc_min", 0.0, 1e5, &d->v_dc_min) ||
-      get_float(c, o, P, "v_margin", 0.0, 1.0, &d->v_margin) ||
-      get_float(c, o, P, "pll_bw", 0.0, 1e6, &d->pll_bw) ||
-      get_float(c, o, P, "enc_offset", -7.0, 7.0, &d->enc_offset) ||
-      get_int(c, o, P, "slow_div", 1, 1000, &slow_div) ||
-      get_int(c, o, P, "offset_samples", 1, 60000, &offset_samples) ||
-      get_float(c, o, P, "offset_max", 0.0, 1e3, &d->offset_max) ||
-      get_float(c, o, P, "flux_obs_wc", 0.0, 1e5, &d->flux_obs_wc) ||
-      get_float(c, o, P, "delta_max", 0.0, 2.0, &d->delta_max) ||
-      get_float(c, o, P, "vsd_max", 0.0, 1e5, &d->vsd_max) ||
-      get_float(c, o, P, "flux_min", 0.0, 100.0, &d->flux_min) ||
-      get_float(c, o, P, "dfvc_flux_bw", 0.0, 1e6, &d->dfvc_flux_bw) ||
-      get_float(c, o, P, "dfvc_iqs_bw", 0.0, 1e6, &d->dfvc_iqs_bw)) {
-    return -1;
+  unsigned n;
+  const drive_param_t *t = drive_params_table(&n);
+  for (unsigned i = 0; i < n; ++i) {
+    if (strncmp(t[i].scenario, "controller.", 11) == 0 && get_param(c, o, &t[i], d) != 0) {
+      return -1;
+    }
   }
-  d->law = (drive_law_t)law;
-  d->mode = (drive_mode_t)mode;
-  d->slow_div = (uint16_t)slow_div;
-  d->offset_samples = (uint16_t)offset_samples;
 
   /* Detuning: the controller's machine estimates as factors of the plant's. */
   const cJSON *e = cJSON_GetObjectItemCaseSensitive(o, "estimates");
@@ -460,11 +489,56 @@ static int parse_references(ctx_t *c, const cJSON *o, scenario_t *sc) {
 }
 
 static int parse_inject(ctx_t *c, const cJSON *o, scenario_t *sc) {
-  static const char *const keys[] = {"encoder_error", NULL};
-  if (check_keys(c, o, "inject", keys) != 0) {
+  static const char *const keys[] = {"encoder_error", "encoder_invalid", "main_stall", "isr_stall",
+                                     NULL};
+  const char *P = "inject";
+  if (check_keys(c, o, P, keys) || get_profile(c, o, P, "encoder_error", &sc->encoder_error) ||
+      get_profile(c, o, P, "encoder_invalid", &sc->encoder_invalid) ||
+      get_profile(c, o, P, "main_stall", &sc->main_stall) ||
+      get_profile(c, o, P, "isr_stall", &sc->isr_stall)) {
     return -1;
   }
-  return get_profile(c, o, "inject", "encoder_error", &sc->encoder_error);
+  return 0;
+}
+
+/* The board the SIL HAL models: a preset (its board header's numbers) and
+ * overrides. Parsed after the inverter (period and dead time). */
+#define DEFAULT_BOARD "g474_nucleo"
+static int parse_board(ctx_t *c, const cJSON *o, scenario_t *sc) {
+  static const char *const keys[] = {"preset",      "duty_min",   "duty_max", "timer_counts",
+                                     "watchdog_ms", "asym_edges", NULL};
+  const char *P = "board";
+  if (check_keys(c, o, P, keys) != 0) {
+    return -1;
+  }
+  const cJSON *pre = cJSON_GetObjectItemCaseSensitive(o, "preset");
+  const sil_board_preset_t *bp =
+      pre == NULL ? sil_board_find(DEFAULT_BOARD)
+                  : (cJSON_IsString(pre) ? sil_board_find(pre->valuestring) : NULL);
+  if (bp == NULL) {
+    return fail(c, "board.preset", "unknown board (known: %s)", sil_board_names());
+  }
+  hal_sil_board_t *b = &sc->board;
+  sil_board_apply(bp, sc->plant.ts, sc->plant.inverter.dead_time, b);
+  double dmin = b->duty_min, dmax = b->duty_max, counts = b->timer_counts, wd = b->watchdog_ms;
+  int asym = b->asym_edges ? 1 : 0;
+  if (get_num(c, o, P, "duty_min", 0.0, 0.5, &dmin) ||
+      get_num(c, o, P, "duty_max", 0.5, 1.0, &dmax) ||
+      get_num(c, o, P, "timer_counts", 0.0, 1e6, &counts) ||
+      get_num(c, o, P, "watchdog_ms", 0.0, 60000.0, &wd) ||
+      get_int(c, o, P, "asym_edges", 0, 1, &asym)) {
+    return -1;
+  }
+  if (floor(counts) != counts || floor(wd) != wd) {
+    return fail(c, floor(counts) != counts ? "board.timer_counts" : "board.watchdog_ms",
+                "must be an integer");
+  }
+  b->duty_min = (float)dmin;
+  b->duty_max = (float)dmax;
+  b->timer_counts = (uint32_t)counts;
+  b->watchdog_ms = (uint32_t)wd;
+  b->asym_edges = asym != 0;
+  return 0;
 }
 
 static int parse_log(ctx_t *c, const cJSON *o, scenario_t *sc) {
@@ -510,7 +584,7 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
   }
   static const char *const keys[] = {
       "name",    "description", "duration",   "machine", "inverter", "dc_link", "mechanics",
-      "sensors", "controller",  "references", "inject",  "log",      NULL};
+      "sensors", "controller",  "references", "inject",  "log",      "board",   NULL};
   int r = check_keys(&c, root, "", keys);
   const cJSON *name = cJSON_GetObjectItemCaseSensitive(root, "name");
   if (r == 0 && name != NULL) {
@@ -537,12 +611,17 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
                   {"controller", parse_controller},
                   {"references", parse_references},
                   {"inject", parse_inject},
-                  {"log", parse_log}};
+                  {"log", parse_log},
+                  {"board", parse_board}};
   for (size_t i = 0; r == 0 && i < sizeof sections / sizeof sections[0]; ++i) {
     const cJSON *o = cJSON_GetObjectItemCaseSensitive(root, sections[i].key);
     if (o != NULL) {
       r = sections[i].fn(&c, o, sc);
     }
+  }
+  if (r == 0 && cJSON_GetObjectItemCaseSensitive(root, "board") == NULL) {
+    sil_board_apply(sil_board_find(DEFAULT_BOARD), sc->plant.ts, sc->plant.inverter.dead_time,
+                    &sc->board);
   }
   cJSON_Delete(root);
   if (r != 0) {
@@ -557,12 +636,18 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
   if (plant_check(&sc->plant, &field) != 0) {
     return fail(&c, field, "invalid plant parameter (see docs/scenarios.md)");
   }
-  if (drive_config_check(&sc->drive, &field) != 0) {
-    char p[96];
-    snprintf(p, sizeof p, "controller.%s", field);
-    return fail(&c, p,
-                "invalid controller parameter (out of range or inconsistent, see "
-                "docs/scenarios.md)");
+  /* the set as a whole, reported under the scenario key that sets the
+   * field (drive_param_table.h) */
+  drive_config_err_t e;
+  machine_t m;
+  if (drive_config_usable(&sc->drive, sc->drive.law, &m, &e) != 0) {
+    const drive_param_t *p = drive_params_by_name(e.field);
+    const char *key = p != NULL ? p->scenario : e.field;
+    if (p != NULL && strcmp(e.reason, "outside its range") == 0) {
+      return fail(&c, key, "must be in [%g, %g] (got %g)", (double)p->min, (double)p->max,
+                  (double)drive_param_get(&sc->drive, p));
+    }
+    return fail(&c, key, "%s", e.reason);
   }
   return 0;
 }

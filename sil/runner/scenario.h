@@ -9,6 +9,7 @@
 #include <stddef.h>
 
 #include "drive_config.h"
+#include "hal_sil.h"
 #include "plant.h"
 #include "profile.h"
 
@@ -16,10 +17,11 @@ typedef struct {
   char name[96];
   double duration; /* simulated time [s] */
   plant_params_t plant;
-  drive_config_t drive; /* the controller's parameters (estimates) */
-  double hw_trip;       /* hardware overcurrent comparator level [A], 0 = none */
-  double enable_at;     /* enable command time [s] */
-  double disable_at;    /* disable command time [s], <= enable_at = never */
+  drive_config_t drive;  /* the controller's parameters (estimates) */
+  hal_sil_board_t board; /* the board the SIL HAL models */
+  double hw_trip;        /* hardware overcurrent comparator level [A], 0 = none */
+  double enable_at;      /* enable command time [s] */
+  double disable_at;     /* disable command time [s], <= enable_at = never */
   struct {
     profile_t torque; /* [N m] */
     profile_t speed;  /* mechanical [rad/s] */
@@ -28,7 +30,11 @@ typedef struct {
   } ref;
   profile_t v_source;      /* DC source voltage [V] */
   profile_t encoder_error; /* added to the encoder reading [rad mech] */
-  int log_decimation;      /* log every n-th sample */
+  /* injected failures, each active while its profile is > 0.5 */
+  profile_t encoder_invalid; /* the encoder reports an error */
+  profile_t main_stall;      /* the main loop does not run (hung) */
+  profile_t isr_stall;       /* the PWM-period interrupt does not run */
+  int log_decimation;        /* log every n-th sample */
 } scenario_t;
 
 /* Loads a scenario from JSON text; `origin` prefixes error messages (the

@@ -17,21 +17,28 @@ static double wall_now(void) {
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static void to_hal_sample(const plant_adc_t *a, double enc_error, hal_adc_sample_t *s) {
+/* The plant's sensors at the valley as the board's sample set. */
+static void to_hal_sample(const plant_adc_t *a, double enc_error, bool enc_ok, hal_sample_t *s) {
   for (int x = 0; x < 3; ++x) {
     s->i_abc[x] = (float)a->i_abc[x];
   }
   s->v_dc = (float)a->v_dc;
-  s->v_star = (float)a->v_star;
+  s->t_i = 0.0f;
+  s->n_star = 1u;
+  s->v_star[0] = (float)a->v_star;
+  s->t_star[0] = 0.0f;
+  s->test_vector = 0u;
   double th = a->enc_angle + enc_error;
   if (!(th >= 0.0 && th < 2.0 * SIL_PI)) { /* fmod is the identity on [0, 2 pi) */
     th = fmod(th, 2.0 * SIL_PI);
   }
   s->enc_angle = (float)(th < 0.0 ? th + 2.0 * SIL_PI : th);
-  s->enc_valid = true;
+  s->t_enc = 0.0f;
+  s->enc_valid = enc_ok;
+  s->valid = true;
 }
 
-static void command_references(drive_t *drv, const scenario_t *sc, double t) {
+void sil_command_references(drive_t *drv, const scenario_t *sc, double t) {
   bool on = t >= sc->enable_at && !(sc->disable_at > sc->enable_at && t >= sc->disable_at);
   drive_cmd_enable(drv, on);
   drive_cmd_torque(drv, (float)profile_eval(&sc->ref.torque, t));
@@ -50,33 +57,96 @@ static void sleep_s(double s) {
   nanosleep(&ts, NULL);
 }
 
+/* A profile used as an on/off injection: active while > 0.5. */
+static bool injected(const profile_t *p, double t) {
+  return p->n > 0 && profile_eval(p, t) > 0.5;
+}
+
 int sil_run(const scenario_t *sc, sil_observer_fn obs, void *user, sil_result_t *res, char *err,
             size_t errlen) {
   return sil_run_ex(sc, NULL, obs, user, res, err, errlen);
+}
+
+/* The MCU restarts after a watchdog reset: gates off at once (the timer's
+ * outputs go idle), the firmware starts again from drive_init. */
+static int sil_reset_mcu(sil_ctx_t *x, const scenario_t *sc, char *err, size_t errlen) {
+  x->hal.gates_on = false;
+  x->hal.reset_by_watchdog = true;
+  x->hal.watchdog_last_us = x->hal.time_us;
+  drive_config_err_t e;
+  if (drive_init(&x->drv, &sc->drive, &e) != 0) {
+    snprintf(err, errlen, "controller: %s: %s", e.field, e.reason);
+    return -1;
+  }
+  return 0;
+}
+
+int sil_setup(sil_ctx_t *x, const scenario_t *sc, char *err, size_t errlen) {
+  const char *field = "";
+  if (plant_init(&x->plant, &sc->plant, &field) != 0) {
+    snprintf(err, errlen, "plant: invalid parameter %s", field);
+    return -1;
+  }
+  hal_sil_init(&x->hal, &sc->board);
+  hal_sil_bind(&x->hal);
+  drive_config_err_t e;
+  if (drive_init(&x->drv, &sc->drive, &e) != 0) {
+    snprintf(err, errlen, "controller: %s: %s", e.field, e.reason);
+    return -1;
+  }
+  memset(x->pwm_on, 0, sizeof x->pwm_on);
+  for (int j = 0; j < 3; ++j) {
+    x->pwm_on[j] = 0.25;
+    x->pwm_off[j] = 0.75;
+  }
+  x->enc_err = 0.0;
+  x->enc_err_end = -INFINITY;
+  x->v_src = 0.0;
+  x->v_src_end = -INFINITY;
+  return 0;
+}
+
+void sil_sample(sil_ctx_t *x, const scenario_t *sc, double t) {
+  plant_adc_t adc;
+  plant_sample(&x->plant, &adc);
+  if (!(t < x->enc_err_end)) {
+    x->enc_err = profile_eval_span(&sc->encoder_error, t, &x->enc_err_end);
+  }
+  to_hal_sample(&adc, x->enc_err, !injected(&sc->encoder_invalid, t), &x->hal.sample);
+}
+
+void sil_advance(sil_ctx_t *x, const scenario_t *sc, double t) {
+  if (!(t < x->v_src_end)) {
+    x->v_src = profile_eval_span(&sc->v_source, t, &x->v_src_end);
+  }
+  x->plant.p.dclink.v_source = x->v_src;
+  /* the pattern preloaded by the previous ISR acts over this period */
+  plant_step_pattern(&x->plant, x->pwm_on, x->pwm_off, x->hal.gates_on);
+  for (int j = 0; j < 3; ++j) {
+    x->pwm_on[j] = x->hal.pwm.on[j];
+    x->pwm_off[j] = x->hal.pwm.off[j];
+  }
+  /* hardware comparator: gates off in hardware, latched */
+  if (sc->hw_trip > 0.0 && x->hal.gates_on) {
+    plant_brief_t br;
+    plant_get_brief(&x->plant, &br);
+    if (fabs(br.i_abc[0]) > sc->hw_trip || fabs(br.i_abc[1]) > sc->hw_trip ||
+        fabs(br.i_abc[2]) > sc->hw_trip) {
+      x->hal.hw_tripped = true;
+      x->hal.gates_on = false;
+    }
+  }
 }
 
 int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs, void *user,
                sil_result_t *res, char *err, size_t errlen) {
   static const sil_opts_t no_opts = {0};
   static can_proto_t proto;
-  static plant_t plant; /* large: keep off the stack; one run at a time */
-  static drive_t drv;
-  static hal_sil_t hal;
-  const char *field = "";
+  static sil_ctx_t x; /* large: keep off the stack; one run at a time */
   memset(res, 0, sizeof *res);
-
-  if (plant_init(&plant, &sc->plant, &field) != 0) {
-    snprintf(err, errlen, "plant: invalid parameter %s", field);
+  if (sil_setup(&x, sc, err, errlen) != 0) {
     return -1;
   }
-  hal_sil_init(&hal);
-  hal_sil_bind(&hal);
-  if (drive_init(&drv, &sc->drive, &field) != 0) {
-    snprintf(err, errlen, "controller: invalid parameter %s", field);
-    return -1;
-  }
-  drive_cmd_set_law(&drv, sc->drive.law);
-  drive_cmd_set_mode(&drv, sc->drive.mode);
   if (opts == NULL) {
     opts = &no_opts;
   }
@@ -88,7 +158,7 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
   if (can && opts->can_ready != NULL) {
     while (!opts->can_ready(opts->can_user) && !(opts->stop != NULL && *opts->stop)) {
       if (opts->can_io != NULL) {
-        opts->can_io(opts->can_user, &hal, 0.0);
+        opts->can_io(opts->can_user, &x.hal, 0.0);
       }
       sleep_s(0.01);
     }
@@ -97,58 +167,67 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
   const double ts = sc->plant.ts;
   uint64_t n = (uint64_t)llround(sc->duration / ts);
   const uint64_t tail = n - n / 20;
-  float duty_active[3] = {0.5f, 0.5f, 0.5f};
   double torque_tail = 0.0;
   res->v_dc_min = INFINITY;
   res->v_dc_max = -INFINITY;
   res->max_speed = -INFINITY;
   res->min_speed = INFINITY;
   res->first_fault_t = -1.0;
+  res->first_watchdog_t = -1.0;
 
-  plant_adc_t adc;
   plant_state_t st;
   plant_brief_t br; /* what the metrics need: cheaper than plant_state_t */
-  /* encoder error and source voltage profiles, each constant until *_end */
-  double enc_err = 0.0, enc_err_end = -INFINITY, v_src = 0.0, v_src_end = -INFINITY;
   const double t_start = wall_now();
   uint64_t k = 0;
   for (; k < n; ++k) {
     const double t = (double)k * ts;
-    hal.time_us = (uint32_t)(uint64_t)(t * 1e6);
+    x.hal.time_us = (uint32_t)(uint64_t)(t * 1e6);
     if (k % sc->drive.slow_div == 0) {
       if (opts->stop != NULL && *opts->stop) {
         res->stopped = true;
         break;
       }
-      if (can) {
-        if (opts->can_io != NULL) {
-          opts->can_io(opts->can_user, &hal, t);
+      /* the main loop: commands (scenario or CAN), then the background
+       * service (telemetry copy, watchdog) - unless it is hung */
+      if (!injected(&sc->main_stall, t)) {
+        if (can) {
+          if (opts->can_io != NULL) {
+            opts->can_io(opts->can_user, &x.hal, t);
+          }
+          drive_background(&x.drv); /* fresh telemetry for the protocol */
+          can_proto_poll(&proto, &x.drv, x.hal.time_us);
+          if (opts->can_io != NULL) {
+            opts->can_io(opts->can_user, &x.hal, t);
+          }
+        } else {
+          sil_command_references(&x.drv, sc, t);
+          drive_background(&x.drv);
         }
-        can_proto_poll(&proto, &drv, hal.time_us);
-        drive_slow_loop(&drv);
-        if (opts->can_io != NULL) {
-          opts->can_io(opts->can_user, &hal, t);
-        }
-      } else {
-        command_references(&drv, sc, t);
-        drive_slow_loop(&drv);
       }
       if (opts->realtime) {
         sleep_s(t - (wall_now() - t_start));
       }
     }
     /* 1. sample */
-    plant_sample(&plant, &adc);
-    if (!(t < enc_err_end)) {
-      enc_err = profile_eval_span(&sc->encoder_error, t, &enc_err_end);
+    sil_sample(&x, sc, t);
+    /* 2. ISR (unless the interrupt is stuck) */
+    const bool hw_in = x.hal.hw_tripped;
+    if (!injected(&sc->isr_stall, t)) {
+      drive_isr(&x.drv);
     }
-    to_hal_sample(&adc, enc_err, &hal.sample); /* in place: no copy of a just-written struct */
-    /* 2. ISR */
-    drive_isr(&drv);
+    if (hal_sil_watchdog_expired(&x.hal, x.hal.time_us)) {
+      res->watchdog_resets++;
+      if (res->first_watchdog_t < 0.0) {
+        res->first_watchdog_t = t;
+      }
+      if (sil_reset_mcu(&x, sc, err, errlen) != 0) {
+        return -1;
+      }
+    }
     /* 3. observe */
-    plant_get_brief(&plant, &br);
-    for (int x = 0; x < 3; ++x) {
-      double a = fabs(br.i_abc[x]);
+    plant_get_brief(&x.plant, &br);
+    for (int j = 0; j < 3; ++j) {
+      double a = fabs(br.i_abc[j]);
       if (a > res->max_phase_current) {
         res->max_phase_current = a;
         res->max_phase_current_t = t;
@@ -162,35 +241,27 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
     if (k >= tail) {
       torque_tail += br.torque;
     }
-    res->faults_seen |= drv.faults;
-    if (drv.faults != 0u && res->first_fault_t < 0.0) {
+    res->faults_seen |= x.drv.faults;
+    if (x.drv.faults != 0u && res->first_fault_t < 0.0) {
       res->first_fault_t = t;
     }
     if (obs != NULL) {
-      plant_get_state(&plant, &st);
-      sil_step_t s = {k, t, &st, &hal.sample, &drv, sc, duty_active, hal.gates_on};
+      plant_get_state(&x.plant, &st);
+      const float duty_active[3] = {(float)(x.pwm_off[0] - x.pwm_on[0]),
+                                    (float)(x.pwm_off[1] - x.pwm_on[1]),
+                                    (float)(x.pwm_off[2] - x.pwm_on[2])};
+      sil_step_t s = {k,           t,
+                      &st,         &x.hal.sample,
+                      &x.drv,      sc,
+                      duty_active, x.hal.gates_on,
+                      hw_in,       x.hal.timer_counts};
       obs(user, &s);
     }
     /* 4. plant over [t_k, t_k+1) */
-    if (!(t < v_src_end)) {
-      v_src = profile_eval_span(&sc->v_source, t, &v_src_end);
-    }
-    plant.p.dclink.v_source = v_src;
-    const double d[3] = {duty_active[0], duty_active[1], duty_active[2]};
-    plant_step(&plant, d, hal.gates_on);
-    memcpy(duty_active, hal.duty, sizeof duty_active);
-    /* hardware comparator: gates off in hardware, latched */
-    if (sc->hw_trip > 0.0 && hal.gates_on) {
-      plant_get_brief(&plant, &br);
-      if (fabs(br.i_abc[0]) > sc->hw_trip || fabs(br.i_abc[1]) > sc->hw_trip ||
-          fabs(br.i_abc[2]) > sc->hw_trip) {
-        hal.hw_tripped = true;
-        hal.gates_on = false;
-      }
-    }
+    sil_advance(&x, sc, t);
   }
   res->wall_time = wall_now() - t_start;
-  plant_get_state(&plant, &st);
+  plant_get_state(&x.plant, &st);
   if (k < n) { /* stopped early */
     n = k;
   }
@@ -203,8 +274,8 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
   res->final_speed = st.omega_m;
   res->final_speed_ref = profile_eval(&sc->ref.speed, res->sim_time);
   res->final_torque = n > tail ? torque_tail / (double)(n - tail) : st.torque;
-  res->faults = drv.faults;
-  res->final_state = drv.state;
-  res->watchdog_kicks = hal.watchdog_kicks;
+  res->faults = x.drv.faults;
+  res->final_state = x.drv.state;
+  res->watchdog_kicks = x.hal.watchdog_kicks;
   return 0;
 }

@@ -2,19 +2,25 @@
  * sil_run.h - advances the plant and the drive ISR in lock-step.
  *
  * Per PWM period k (t_k = k Ts):
+ *   0. every slow_div periods, the main loop: the scenario's references are
+ *      commanded (drive_cmd_*, taken by the next ISR) and
+ *      drive_background() runs (telemetry copy, watchdog refresh);
  *   1. the plant's sensors are sampled at t_k (carrier valley) -> HAL;
- *   2. drive_isr() runs: its duties are preloaded and act from t_{k+1};
- *      a gate disable acts at once (like clearing TIM1 MOE);
+ *   2. drive_isr() runs: its pattern is preloaded and acts from t_{k+1};
+ *      a gate disable acts at once (like clearing TIM1 MOE); then the
+ *      watchdog is checked (an expiry resets the MCU: gates off,
+ *      drive_init, DRIVE_FAULT_WATCHDOG latched);
  *   3. observers see the true plant state at t_k with the ISR's outputs;
- *   4. the plant advances over [t_k, t_{k+1}) with the duties preloaded by
- *      ISR k-1 (the one-period command delay of the timing model);
- *   5. every slow_div periods, the scenario's references are commanded and
- *      drive_slow_loop() runs (commands take effect there).
+ *   4. the plant advances over [t_k, t_{k+1}) with the pattern preloaded by
+ *      ISR k-1 (the one-period command delay of the timing model).
+ * Injected failures (scenario "inject"): main_stall skips step 0,
+ * isr_stall skips step 2, encoder_invalid marks the encoder sample invalid.
  *
- * With CAN (sil_opts_t.can, fluxdrive-sil --can): at step 5 the transport
+ * With CAN (sil_opts_t.can, fluxdrive-sil --can): at step 0 the transport
  * moves frames from the bus into the HAL queue, can_proto_poll() handles
- * them (commands staged for this slow loop), drive_slow_loop() runs and the
- * transport sends what the drive queued, stamped with t_k. The scenario's
+ * them after drive_background() (telemetry copy, watchdog), commands are
+ * posted for the next ISR, and the transport sends what the drive queued,
+ * stamped with t_k. The scenario's
  * references and enable/disable times are not applied: the CAN client
  * commands. With sil_opts_t.realtime the loop sleeps at each slow period
  * until the wall clock has caught up with the simulated time.
@@ -34,12 +40,14 @@
 typedef struct {
   uint64_t k;
   double t;
-  const plant_state_t *plant;  /* true state at t_k */
-  const hal_adc_sample_t *adc; /* what the ISR read */
-  const drive_t *drive;        /* after ISR k */
+  const plant_state_t *plant; /* true state at t_k */
+  const hal_sample_t *adc;    /* what the ISR read */
+  const drive_t *drive;       /* after ISR k */
   const scenario_t *scenario;
   const float *duty_active; /* duties acting over [t_k, t_{k+1}) */
   bool gates_on;            /* gate state over [t_k, t_{k+1}) */
+  bool hw_tripped;          /* the break input as ISR k found it */
+  uint32_t timer_counts;    /* the SIL board's compare steps per period */
 } sil_step_t;
 
 typedef void (*sil_observer_fn)(void *user, const sil_step_t *st);
@@ -61,8 +69,10 @@ typedef struct {
   uint32_t faults_seen; /* union over the run */
   drive_state_t final_state;
   uint32_t watchdog_kicks;
-  can_proto_stats_t can; /* CAN runs only */
-  bool stopped;          /* ended early on request (sil_opts_t.stop) */
+  uint32_t watchdog_resets; /* MCU resets by the watchdog */
+  double first_watchdog_t;  /* -1 if none */
+  can_proto_stats_t can;    /* CAN runs only */
+  bool stopped;             /* ended early on request (sil_opts_t.stop) */
 } sil_result_t;
 
 /* Moves frames between a bus and the HAL queues; t is the simulated time. */
@@ -77,6 +87,25 @@ typedef struct {
   void *can_user;
   volatile int *stop; /* non-NULL: the run ends when *stop != 0 */
 } sil_opts_t;
+
+/* The pieces of the loop, shared with the preempting mode (sil_preempt.h). */
+typedef struct {
+  plant_t plant;
+  drive_t drv;
+  hal_sil_t hal;
+  double pwm_on[3], pwm_off[3]; /* the pattern acting over the present period */
+  double enc_err, enc_err_end;  /* encoder error profile, constant until _end */
+  double v_src, v_src_end;      /* DC source profile, constant until _end */
+} sil_ctx_t;
+
+/* Plant, HAL and drive from the scenario; 0 or -1 with the message. */
+int sil_setup(sil_ctx_t *x, const scenario_t *sc, char *err, size_t errlen);
+/* Step 1: the plant's sensors at t into the HAL's sample set. */
+void sil_sample(sil_ctx_t *x, const scenario_t *sc, double t);
+/* Step 4: the plant over [t, t + Ts) with the preloaded pattern. */
+void sil_advance(sil_ctx_t *x, const scenario_t *sc, double t);
+/* The scenario's references at t, posted through drive_cmd_*. */
+void sil_command_references(drive_t *drv, const scenario_t *sc, double t);
 
 /* Runs the scenario. obs (may be NULL) is called every period. Returns 0,
  * or -1 with a message in err (plant or drive rejected the parameters). */

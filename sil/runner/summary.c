@@ -4,9 +4,10 @@
 #include "summary.h"
 
 #include <cjson/cJSON.h>
+#include <stddef.h>
 
-static const char *const law_names[] = {"foc", "pi_dfvc", "db_dfvc"};
-static const char *const mode_names[] = {"torque", "speed", "current"};
+#include "can_codec.h"
+#include "can_proto.h"
 
 static cJSON *fault_list(uint32_t bits) {
   cJSON *a = cJSON_CreateArray();
@@ -21,8 +22,8 @@ static cJSON *fault_list(uint32_t bits) {
 char *summary_json(const scenario_t *sc, const sil_result_t *r) {
   cJSON *o = cJSON_CreateObject();
   cJSON_AddStringToObject(o, "scenario", sc->name);
-  cJSON_AddStringToObject(o, "law", law_names[sc->drive.law]);
-  cJSON_AddStringToObject(o, "mode", mode_names[sc->drive.mode]);
+  cJSON_AddStringToObject(o, "law", drive_law_name((unsigned)sc->drive.law));
+  cJSON_AddStringToObject(o, "mode", drive_mode_name((unsigned)sc->drive.mode));
   cJSON_AddStringToObject(o, "inverter",
                           sc->plant.inverter.model == PLANT_INV_AVERAGE ? "average" : "switching");
   cJSON_AddNumberToObject(o, "sim_time", r->sim_time);
@@ -42,9 +43,30 @@ char *summary_json(const scenario_t *sc, const sil_result_t *r) {
   cJSON_AddItemToObject(o, "faults", fault_list(r->faults));
   cJSON_AddItemToObject(o, "faults_seen", fault_list(r->faults_seen));
   cJSON_AddNumberToObject(o, "first_fault_t", r->first_fault_t);
+  cJSON_AddNumberToObject(o, "watchdog_resets", (double)r->watchdog_resets);
+  cJSON_AddNumberToObject(o, "first_watchdog_t", r->first_watchdog_t);
   char *s = cJSON_Print(o);
   cJSON_Delete(o);
   return s;
+}
+
+/* One parameter as JSON: a number, or the name of a law, mode, source. */
+static void add_param(cJSON *o, const drive_config_t *d, const drive_param_t *p) {
+  const float v = drive_param_get(d, p);
+  switch ((drive_param_type_t)p->type) {
+  case DRIVE_PARAM_LAW:
+    cJSON_AddStringToObject(o, p->name, drive_law_name((unsigned)v));
+    break;
+  case DRIVE_PARAM_MODE:
+    cJSON_AddStringToObject(o, p->name, drive_mode_name((unsigned)v));
+    break;
+  case DRIVE_PARAM_POS:
+    cJSON_AddStringToObject(o, p->name, drive_pos_source_name((unsigned)v));
+    break;
+  default:
+    cJSON_AddNumberToObject(o, p->name, (double)v);
+    break;
+  }
 }
 
 char *config_json(const scenario_t *sc) {
@@ -62,19 +84,79 @@ char *config_json(const scenario_t *sc) {
   cJSON_AddNumberToObject(o, "v_dc", sc->plant.dclink.v_source);
   cJSON_AddNumberToObject(o, "ts", sc->plant.ts);
   cJSON_AddNumberToObject(o, "dead_time", sc->plant.inverter.dead_time);
+  cJSON *b = cJSON_AddObjectToObject(o, "board");
+  cJSON_AddNumberToObject(b, "duty_min", sc->board.duty_min);
+  cJSON_AddNumberToObject(b, "duty_max", sc->board.duty_max);
+  cJSON_AddNumberToObject(b, "timer_counts", sc->board.timer_counts);
+  cJSON_AddNumberToObject(b, "watchdog_ms", sc->board.watchdog_ms);
+  /* the controller: every row of the parameter table */
   cJSON *c = cJSON_AddObjectToObject(o, "controller");
-  cJSON_AddStringToObject(c, "law", law_names[d->law]);
-  cJSON_AddNumberToObject(c, "rs", d->rs);
-  cJSON_AddNumberToObject(c, "ld", d->ld);
-  cJSON_AddNumberToObject(c, "lq", d->lq);
-  cJSON_AddNumberToObject(c, "lambda_m", d->lambda_m);
-  cJSON_AddNumberToObject(c, "i_max", d->i_max);
-  cJSON_AddNumberToObject(c, "torque_max", d->torque_max);
-  cJSON_AddNumberToObject(c, "speed_max", d->speed_max);
-  cJSON_AddNumberToObject(c, "v_margin", d->v_margin);
-  cJSON_AddNumberToObject(c, "delta_max", d->delta_max);
-  cJSON_AddNumberToObject(c, "vsd_max", d->vsd_max);
-  cJSON_AddNumberToObject(c, "flux_min", d->flux_min);
+  unsigned n;
+  const drive_param_t *t = drive_params_table(&n);
+  for (unsigned i = 0; i < n; ++i) {
+    add_param(c, d, &t[i]);
+  }
+  char *s = cJSON_Print(o);
+  cJSON_Delete(o);
+  return s;
+}
+
+/* The parameter table and the drive's named values (fluxdrive params). */
+char *params_json(void) {
+  cJSON *o = cJSON_CreateObject();
+  cJSON *arr = cJSON_AddArrayToObject(o, "params");
+  unsigned n;
+  const drive_param_t *t = drive_params_table(&n);
+  static const char *const types[] = {"f32", "u16", "u32", "law", "mode", "pos_source"};
+  static const char *const access[] = {"ro", "idle", "live"};
+  for (unsigned i = 0; i < n; ++i) {
+    cJSON *p = cJSON_CreateObject();
+    cJSON_AddNumberToObject(p, "id", t[i].id);
+    cJSON_AddStringToObject(p, "name", t[i].name);
+    cJSON_AddStringToObject(p, "type", types[t[i].type]);
+    cJSON_AddStringToObject(p, "unit", t[i].unit);
+    cJSON_AddNumberToObject(p, "default", (double)t[i].def);
+    cJSON_AddNumberToObject(p, "min", (double)t[i].min);
+    cJSON_AddNumberToObject(p, "max", (double)t[i].max);
+    cJSON_AddStringToObject(p, "access", access[t[i].access]);
+    cJSON_AddStringToObject(p, "scenario", t[i].scenario);
+    cJSON_AddStringToObject(p, "doc", t[i].doc);
+    cJSON_AddItemToArray(arr, p);
+  }
+  cJSON *pp = cJSON_AddArrayToObject(o, "can_params");
+  for (unsigned id = 0; id < 256u; ++id) {
+    const char *name = can_proto_param_name((uint8_t)id);
+    if (name != NULL) {
+      cJSON *p = cJSON_CreateObject();
+      cJSON_AddNumberToObject(p, "id", id);
+      cJSON_AddStringToObject(p, "name", name);
+      cJSON_AddStringToObject(p, "access", id == CAN_PROTO_PARAM_FIRST ? "ro" : "live");
+      cJSON_AddItemToArray(pp, p);
+    }
+  }
+  struct {
+    const char *key;
+    const char *(*name)(unsigned);
+    unsigned count;
+  } lists[] = {{"laws", drive_law_name, DRIVE_LAW_COUNT},
+               {"modes", drive_mode_name, DRIVE_MODE_COUNT},
+               {"states", drive_state_name, DRIVE_STATE_COUNT},
+               {"pos_sources", drive_pos_source_name, POS_SOURCE_COUNT}};
+  for (size_t l = 0; l < sizeof lists / sizeof lists[0]; ++l) {
+    cJSON *a = cJSON_AddArrayToObject(o, lists[l].key);
+    for (unsigned v = 0; v < lists[l].count; ++v) {
+      cJSON_AddItemToArray(a, cJSON_CreateString(lists[l].name(v)));
+    }
+  }
+  cJSON *f = cJSON_AddArrayToObject(o, "faults");
+  for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {
+    cJSON_AddItemToArray(f, cJSON_CreateString(drive_fault_name(1u << b)));
+  }
+  cJSON *res = cJSON_AddArrayToObject(o, "can_results");
+  for (unsigned r = 0; r < CAN_RESULT_COUNT; ++r) {
+    cJSON_AddItemToArray(res, cJSON_CreateString(can_codec_result_name(r)));
+  }
+  cJSON_AddNumberToObject(o, "can_keep", CAN_KEEP);
   char *s = cJSON_Print(o);
   cJSON_Delete(o);
   return s;

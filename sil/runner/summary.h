@@ -14,4 +14,11 @@ char *summary_json(const scenario_t *sc, const sil_result_t *res);
  * what offline tools (tools/: capability curves) compute from. Caller frees. */
 char *config_json(const scenario_t *sc);
 
+/* The parameter table (every row), the CAN protocol's parameters and the
+ * drive's named values (laws, modes, states, position sources, faults, CAN
+ * results), as JSON: `fluxdrive-sil --print-params`, from which `fluxdrive
+ * params` generates the DBC value tables, the tools' table and the docs.
+ * Caller frees. */
+char *params_json(void);
+
 #endif

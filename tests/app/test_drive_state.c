@@ -1,9 +1,15 @@
 /*
- * The drive state machine against the SIL HAL with hand-made samples:
- * idle -> offset calibration -> run; offsets measured; commands clamped;
- * faults disable the gates at once, latch, and clear only on command;
- * a law change waits for the gates to be off; bad configs are named.
+ * The drive state machine and its concurrency contract against the SIL HAL
+ * with hand-made samples: idle -> offset calibration -> [align] -> run;
+ * offsets measured; commands clamped and taken by the next ISR; faults
+ * disable the gates at once, latch, and clear only on request; fault
+ * requests and clears keep their order; a law change waits for the gates
+ * to be off; a law the machine cannot run is refused with its reason;
+ * parameter requests are applied by the ISR (LIVE ones while running, the
+ * rest when the gates are off); the watchdog is refreshed only while the
+ * ISR runs; the position source must be valid; bad configs are named.
  */
+#include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -13,22 +19,34 @@
 #include <cmocka.h>
 
 #include "drive.h"
+#include "drive_params.h"
 #include "hal_sil.h"
 
 static hal_sil_t hal;
 static drive_t drv;
 
 static void sample(float ia, float ib, float ic, float vdc) {
-  hal.sample = (hal_adc_sample_t){{ia, ib, ic}, vdc, 0.0f, 0.0f, true};
+  memset(&hal.sample, 0, sizeof hal.sample);
+  hal.sample.i_abc[0] = ia;
+  hal.sample.i_abc[1] = ib;
+  hal.sample.i_abc[2] = ic;
+  hal.sample.v_dc = vdc;
+  hal.sample.enc_valid = true;
+  hal.sample.valid = true;
+}
+
+static void setup_with(const drive_config_t *cfg) {
+  const hal_sil_board_t board = {0.0f, 1.0f, 0u, 1e-6f, 62.5e-6f, 50u, false};
+  hal_sil_init(&hal, &board);
+  hal_sil_bind(&hal);
+  drive_config_err_t err;
+  assert_int_equal(drive_init(&drv, cfg, &err), 0);
 }
 
 static void setup_drive(void) {
-  hal_sil_init(&hal);
-  hal_sil_bind(&hal);
   drive_config_t cfg;
   drive_config_default(&cfg);
-  const char *field = NULL;
-  assert_int_equal(drive_init(&drv, &cfg, &field), 0);
+  setup_with(&cfg);
 }
 
 static void run_isrs(int n) {
@@ -42,9 +60,12 @@ static void start_running(void) {
   setup_drive();
   sample(0.0f, 0.0f, 0.0f, 310.0f);
   drive_cmd_enable(&drv, true);
-  drive_slow_loop(&drv);
   run_isrs(drv.cfg.offset_samples + 2);
   assert_int_equal(drv.state, DRIVE_STATE_RUN);
+}
+
+static float duty(int x) {
+  return hal.pwm.off[x] - hal.pwm.on[x];
 }
 
 static void calibrates_offsets_then_runs(void **state) {
@@ -55,7 +76,7 @@ static void calibrates_offsets_then_runs(void **state) {
   assert_int_equal(drv.state, DRIVE_STATE_IDLE);
   assert_false(hal.gates_on);
   drive_cmd_enable(&drv, true);
-  drive_slow_loop(&drv);
+  assert_int_equal(drv.state, DRIVE_STATE_IDLE); /* posted: the next ISR takes it */
   drive_isr(&drv);
   assert_int_equal(drv.state, DRIVE_STATE_OFFSET_CAL);
   run_isrs(drv.cfg.offset_samples - 1);
@@ -69,10 +90,9 @@ static void calibrates_offsets_then_runs(void **state) {
   assert_float_equal(drv.offset[2], 0.02f, 1e-5);
   /* zero current after offset removal -> duties stay near 50 % at zero ref */
   drive_isr(&drv);
-  assert_float_equal(hal.duty[0], 0.5f, 0.01f);
+  assert_float_equal(duty(0), 0.5f, 0.02f);
   /* disable: gates off in the next ISR, back to idle */
   drive_cmd_enable(&drv, false);
-  drive_slow_loop(&drv);
   drive_isr(&drv);
   assert_int_equal(drv.state, DRIVE_STATE_IDLE);
   assert_false(hal.gates_on);
@@ -83,7 +103,6 @@ static void offset_out_of_range_faults(void **state) {
   setup_drive();
   sample(0.9f, 0.0f, 0.0f, 310.0f); /* offset_max is 0.5 A */
   drive_cmd_enable(&drv, true);
-  drive_slow_loop(&drv);
   run_isrs(drv.cfg.offset_samples + 2);
   assert_int_equal(drv.state, DRIVE_STATE_FAULT);
   assert_int_equal(drv.faults, DRIVE_FAULT_OFFSET);
@@ -102,24 +121,71 @@ static void fault_latches_until_cleared(void **state) {
   assert_string_equal(drive_fault_name(drv.faults), "overcurrent");
   /* the cause is gone: still latched, enable is refused */
   sample(0.0f, 0.0f, 0.0f, 310.0f);
-  drive_slow_loop(&drv);
+  run_isrs(100);
+  assert_int_equal(drv.state, DRIVE_STATE_FAULT);
+  drive_cmd_enable(&drv, true);
   run_isrs(100);
   assert_int_equal(drv.state, DRIVE_STATE_FAULT);
   assert_false(hal.gates_on);
-  drive_cmd_enable(&drv, true);
-  drive_slow_loop(&drv);
-  run_isrs(100);
-  assert_int_equal(drv.state, DRIVE_STATE_FAULT);
-  /* clear: back to idle, needs a fresh enable */
+  /* clear: back to idle, and the enable in force before it does not count */
   drive_cmd_clear_fault(&drv);
-  drive_slow_loop(&drv);
   drive_isr(&drv);
   assert_int_equal(drv.state, DRIVE_STATE_IDLE);
   assert_int_equal(drv.faults, 0);
+  run_isrs(10);
+  assert_int_equal(drv.state, DRIVE_STATE_IDLE);
   drive_cmd_enable(&drv, true);
-  drive_slow_loop(&drv);
   run_isrs(drv.cfg.offset_samples + 2);
   assert_int_equal(drv.state, DRIVE_STATE_RUN);
+}
+
+/* A clear that meets a new trip in the same ISR: the clear takes the old
+ * faults, the new one latches again (never idle with faults latched, never
+ * re-enabled by the old enable). */
+static void clear_racing_a_trip_stays_safe(void **state) {
+  (void)state;
+  start_running();
+  sample(drv.cfg.i_trip + 1.0f, 0.0f, -(drv.cfg.i_trip + 1.0f), 310.0f);
+  drive_isr(&drv);
+  assert_int_equal(drv.faults, DRIVE_FAULT_OVERCURRENT);
+  drive_cmd_clear_fault(&drv); /* the cause persists */
+  drive_isr(&drv);
+  assert_int_equal(drv.state, DRIVE_STATE_FAULT);
+  assert_int_equal(drv.faults, DRIVE_FAULT_OVERCURRENT);
+  assert_false(hal.gates_on);
+  sample(0.0f, 0.0f, 0.0f, 310.0f);
+  drive_cmd_enable(&drv, true); /* the operator re-arms, cause gone, but no clear */
+  run_isrs(50);
+  assert_int_equal(drv.state, DRIVE_STATE_FAULT);
+}
+
+/* Fault requests of the main loop and clears keep their order. */
+static void fault_requests_and_clears_keep_order(void **state) {
+  (void)state;
+  setup_drive();
+  sample(0.0f, 0.0f, 0.0f, 310.0f);
+  /* request, then clear, before the ISR: the clear takes it */
+  drive_request_fault(&drv, DRIVE_FAULT_CMD_TIMEOUT);
+  drive_cmd_clear_fault(&drv);
+  drive_isr(&drv);
+  assert_int_equal(drv.faults, 0);
+  assert_int_equal(drv.state, DRIVE_STATE_IDLE);
+  /* clear, then request: the request stands */
+  drive_cmd_clear_fault(&drv);
+  drive_request_fault(&drv, DRIVE_FAULT_CMD_TIMEOUT);
+  drive_isr(&drv);
+  assert_int_equal(drv.faults, DRIVE_FAULT_CMD_TIMEOUT);
+  /* two requests between ISRs: one fault, none lost, none applied twice */
+  drive_cmd_clear_fault(&drv);
+  drive_isr(&drv);
+  assert_int_equal(drv.faults, 0);
+  drive_request_fault(&drv, DRIVE_FAULT_CMD_TIMEOUT);
+  drive_request_fault(&drv, DRIVE_FAULT_CMD_TIMEOUT);
+  run_isrs(3);
+  assert_int_equal(drv.faults, DRIVE_FAULT_CMD_TIMEOUT);
+  drive_cmd_clear_fault(&drv);
+  run_isrs(3);
+  assert_int_equal(drv.faults, 0);
 }
 
 static void hw_break_cannot_be_overridden(void **state) {
@@ -133,73 +199,218 @@ static void hw_break_cannot_be_overridden(void **state) {
   assert_false(hal.gates_on);
 }
 
-static void non_finite_sample_faults(void **state) {
+static void bad_samples_fault(void **state) {
   (void)state;
   setup_drive();
   sample(0.0f, 0.0f, 0.0f, 310.0f);
-  hal.sample.i_abc[1] = 0.0f / 0.0f;
+  hal.sample.i_abc[1] = NAN;
+  drive_isr(&drv);
+  assert_int_equal(drv.faults, DRIVE_FAULT_SAMPLE);
+  /* an incomplete sample set (the board's ADC timeout) */
+  setup_drive();
+  sample(0.0f, 0.0f, 0.0f, 310.0f);
+  hal.sample.valid = false;
   drive_isr(&drv);
   assert_int_equal(drv.faults, DRIVE_FAULT_SAMPLE);
 }
 
-static void commands_are_clamped_and_staged(void **state) {
+/* A board without a usable encoder: the drive refuses to turn the gates on
+ * (position fault), and an encoder that fails while running trips. */
+static void invalid_position_faults(void **state) {
   (void)state;
   setup_drive();
+  sample(0.0f, 0.0f, 0.0f, 310.0f);
+  hal.sample.enc_valid = false;
+  run_isrs(10);
+  assert_int_equal(drv.state, DRIVE_STATE_IDLE); /* idle: no fault yet */
+  drive_cmd_enable(&drv, true);
+  run_isrs(2);
+  assert_int_equal(drv.state, DRIVE_STATE_FAULT);
+  assert_int_equal(drv.faults, DRIVE_FAULT_POSITION);
+  assert_false(hal.gates_on);
+
+  start_running();
+  hal.sample.enc_valid = false;
+  drive_isr(&drv);
+  assert_int_equal(drv.faults, DRIVE_FAULT_POSITION);
+  assert_false(hal.gates_on);
+  /* implausible: a jump of the encoder by half a turn electrical */
+  start_running();
+  hal.sample.enc_angle = 3.14159f / drv.cfg.pole_pairs;
+  drive_isr(&drv);
+  assert_int_equal(drv.faults, DRIVE_FAULT_POSITION);
+}
+
+static void commands_are_clamped_and_posted(void **state) {
+  (void)state;
+  setup_drive();
+  sample(0.0f, 0.0f, 0.0f, 310.0f);
   drive_cmd_torque(&drv, 1e9f);
-  assert_float_equal(drv.ref.torque, 0.0f, 0.0f); /* staged, not yet in force */
-  drive_slow_loop(&drv);
-  assert_float_equal(drv.ref.torque, drv.cfg.torque_max, 0.0f);
+  assert_float_equal(drv.cmd.torque, 0.0f, 0.0f); /* posted, not yet in force */
+  drive_isr(&drv);
+  assert_float_equal(drv.cmd.torque, drv.cfg.torque_max, 0.0f);
   drive_cmd_speed(&drv, -1e9f);
   drive_cmd_current(&drv, 100.0f, 100.0f);
-  drive_cmd_torque(&drv, 0.0f / 0.0f);
-  drive_slow_loop(&drv);
-  assert_float_equal(drv.ref.speed, -drv.cfg.speed_max, 0.0f);
-  assert_float_equal(drv.ref.id * drv.ref.id + drv.ref.iq * drv.ref.iq,
+  drive_cmd_torque(&drv, NAN);
+  drive_isr(&drv);
+  assert_float_equal(drv.cmd.speed, -drv.cfg.speed_max, 0.0f);
+  assert_float_equal(drv.cmd.id * drv.cmd.id + drv.cmd.iq * drv.cmd.iq,
                      drv.cfg.i_max * drv.cfg.i_max, 1e-3f);
-  assert_float_equal(drv.ref.torque, 0.0f, 0.0f);
-  assert_false(drive_cmd_set_law(&drv, (drive_law_t)7));
-  assert_false(drive_cmd_set_mode(&drv, (drive_mode_t)-1));
+  assert_float_equal(drv.cmd.torque, 0.0f, 0.0f);
+  assert_non_null(drive_cmd_set_law(&drv, (drive_law_t)7));
+  assert_non_null(drive_cmd_set_mode(&drv, (drive_mode_t)-1));
+  /* current mode only with a law that has it */
+  assert_null(drive_cmd_set_law(&drv, DRIVE_LAW_DB_DFVC));
+  assert_non_null(drive_cmd_set_mode(&drv, DRIVE_MODE_CURRENT));
 }
 
 static void law_change_waits_for_gates_off(void **state) {
   (void)state;
   start_running();
-  assert_true(drive_cmd_set_law(&drv, DRIVE_LAW_PI_DFVC));
-  drive_slow_loop(&drv);
-  assert_int_equal(drv.ref.law, DRIVE_LAW_FOC);
+  assert_null(drive_cmd_set_law(&drv, DRIVE_LAW_PI_DFVC));
+  run_isrs(5);
+  assert_int_equal(drv.ctrl.law, DRIVE_LAW_FOC);
   drive_cmd_enable(&drv, false);
-  drive_slow_loop(&drv);
+  run_isrs(2);
+  assert_int_equal(drv.ctrl.law, DRIVE_LAW_PI_DFVC);
+}
+
+/* A reluctance machine (no magnet, Lq > Ld): FOC runs it, the SPM laws
+ * are unavailable with their reason instead of failing the whole drive. */
+static void syr_machine_runs_foc_only(void **state) {
+  (void)state;
+  drive_config_t cfg;
+  drive_config_default(&cfg);
+  cfg.pole_pairs = 2.0f;
+  cfg.rs = 6.8f;
+  cfg.ld = 0.05f;
+  cfg.lq = 0.25f;
+  cfg.lambda_m = 0.0f;
+  cfg.flux_min = 0.0f;
+  cfg.law = DRIVE_LAW_FOC;
+  setup_with(&cfg);
+  const char *why = drive_cmd_set_law(&drv, DRIVE_LAW_DB_DFVC);
+  assert_non_null(why);
+  assert_non_null(strstr(why, "lambda_m"));
+  assert_non_null(ctrl_unavailable(&drv.ctrl, DRIVE_LAW_PI_DFVC));
+  assert_null(ctrl_unavailable(&drv.ctrl, DRIVE_LAW_FOC));
+  /* and the start-up law must be available: named with the reason */
+  cfg.law = DRIVE_LAW_DB_DFVC;
+  drive_config_err_t err;
+  assert_int_not_equal(drive_init(&drv, &cfg, &err), 0);
+  assert_string_equal(err.field, "law");
+  assert_non_null(strstr(err.reason, "PM machine"));
+}
+
+/* Parameter requests: applied by the ISR; an IDLE parameter is refused
+ * while running, a LIVE one applied at the next ISR. */
+static void parameter_requests_are_applied_by_the_isr(void **state) {
+  (void)state;
+  start_running();
+  const drive_param_t *itrip = drive_params_by_name("i_trip");
+  const drive_param_t *rs = drive_params_by_name("rs");
+  assert_int_equal(drive_params_set(&drv, itrip->id, 6.0f, NULL), DRIVE_PARAM_OK);
+  assert_float_equal(drv.cfg.i_trip, 7.0710678f, 1e-6f); /* not yet */
   drive_isr(&drv);
-  drive_slow_loop(&drv);
-  assert_int_equal(drv.ref.law, DRIVE_LAW_PI_DFVC);
+  assert_float_equal(drv.cfg.i_trip, 6.0f, 0.0f);
+  assert_int_equal(drive_params_set(&drv, rs->id, 8.0f, NULL), DRIVE_PARAM_RUNNING);
+  drive_config_err_t err;
+  assert_int_equal(drive_params_set(&drv, itrip->id, 1.0f, &err), DRIVE_PARAM_INCONSISTENT);
+  assert_string_equal(err.field, "i_trip"); /* below i_max */
+  float v;
+  assert_int_equal(drive_params_get(&drv, itrip->id, &v), DRIVE_PARAM_OK);
+  assert_float_equal(v, 6.0f, 0.0f);
+  /* with the gates off the whole set, and the law re-initialised */
+  drive_cmd_enable(&drv, false);
+  drive_isr(&drv);
+  assert_int_equal(drive_params_set(&drv, rs->id, 8.0f, NULL), DRIVE_PARAM_OK);
+  drive_isr(&drv);
+  assert_float_equal(drv.cfg.rs, 8.0f, 0.0f);
+  assert_float_equal(drv.machine.rs, 8.0f, 0.0f);
+}
+
+/* The watchdog is refreshed by the main loop's background service, and only
+ * when the ISR has run since the last refresh. */
+static void watchdog_needs_both_contexts(void **state) {
+  (void)state;
+  setup_drive();
+  sample(0.0f, 0.0f, 0.0f, 310.0f);
+  const uint32_t k0 = hal.watchdog_kicks;
+  run_isrs(16); /* the ISR alone never refreshes it */
+  assert_int_equal(hal.watchdog_kicks, k0);
+  drive_background(&drv);
+  assert_int_equal(hal.watchdog_kicks, k0 + 1u);
+  drive_background(&drv); /* no ISR since: no refresh */
+  assert_int_equal(hal.watchdog_kicks, k0 + 1u);
+  drive_isr(&drv);
+  drive_background(&drv);
+  assert_int_equal(hal.watchdog_kicks, k0 + 2u);
+  /* after a watchdog reset the drive starts in fault, cause latched */
+  hal.reset_by_watchdog = true;
+  drive_config_t cfg;
+  drive_config_default(&cfg);
+  assert_int_equal(drive_init(&drv, &cfg, NULL), 0);
+  assert_int_equal(drv.state, DRIVE_STATE_FAULT);
+  assert_int_equal(drv.faults, DRIVE_FAULT_WATCHDOG);
+  hal.reset_by_watchdog = false;
+}
+
+/* Alignment: gates on with d current along theta = 0 for align_time, then
+ * the encoder's offset is what it reads there. */
+static void alignment_sets_the_encoder_offset(void **state) {
+  (void)state;
+  drive_config_t cfg;
+  drive_config_default(&cfg);
+  cfg.align_time = 0.01f;
+  cfg.align_current = 1.0f;
+  setup_with(&cfg);
+  sample(0.0f, 0.0f, 0.0f, 310.0f);
+  hal.sample.enc_angle = 0.5f; /* the rotor's d axis sits here */
+  drive_cmd_enable(&drv, true);
+  run_isrs(drv.cfg.offset_samples + 1);
+  assert_int_equal(drv.state, DRIVE_STATE_ALIGN);
+  assert_true(hal.gates_on);
+  run_isrs((int)(0.01f / drv.cfg.ts) + 1);
+  assert_int_equal(drv.state, DRIVE_STATE_RUN);
+  const float half = 3.14159265f / (float)drv.cfg.enc_cpr;
+  const float want = remainderf(drv.cfg.pole_pairs * (0.5f + half), 6.2831853f);
+  assert_float_equal(drv.pos_st.enc.offset, want, 1e-4f);
 }
 
 static void bad_config_is_named(void **state) {
   (void)state;
   drive_config_t cfg;
   drive_config_default(&cfg);
-  const char *field = NULL;
+  drive_config_err_t err;
   cfg.lq = -1.0f;
-  assert_int_not_equal(drive_init(&drv, &cfg, &field), 0);
-  assert_string_equal(field, "lq");
+  assert_int_not_equal(drive_init(&drv, &cfg, &err), 0);
+  assert_string_equal(err.field, "lq");
+  assert_string_equal(err.reason, "outside its range");
   drive_config_default(&cfg);
   cfg.pole_pairs = 2.5f;
-  assert_int_not_equal(drive_config_check(&cfg, &field), 0);
-  assert_string_equal(field, "pole_pairs");
+  assert_int_not_equal(drive_config_check(&cfg, &err), 0);
+  assert_string_equal(err.field, "pole_pairs");
   drive_config_default(&cfg);
   cfg.v_dc_min = cfg.v_dc_max + 1.0f;
-  assert_int_not_equal(drive_config_check(&cfg, &field), 0);
-  assert_string_equal(field, "v_dc_min");
+  assert_int_not_equal(drive_config_check(&cfg, &err), 0);
+  assert_string_equal(err.field, "v_dc_min");
 }
 
 int main(void) {
   const struct CMUnitTest tests[] = {cmocka_unit_test(calibrates_offsets_then_runs),
                                      cmocka_unit_test(offset_out_of_range_faults),
                                      cmocka_unit_test(fault_latches_until_cleared),
+                                     cmocka_unit_test(clear_racing_a_trip_stays_safe),
+                                     cmocka_unit_test(fault_requests_and_clears_keep_order),
                                      cmocka_unit_test(hw_break_cannot_be_overridden),
-                                     cmocka_unit_test(non_finite_sample_faults),
-                                     cmocka_unit_test(commands_are_clamped_and_staged),
+                                     cmocka_unit_test(bad_samples_fault),
+                                     cmocka_unit_test(invalid_position_faults),
+                                     cmocka_unit_test(commands_are_clamped_and_posted),
                                      cmocka_unit_test(law_change_waits_for_gates_off),
+                                     cmocka_unit_test(syr_machine_runs_foc_only),
+                                     cmocka_unit_test(parameter_requests_are_applied_by_the_isr),
+                                     cmocka_unit_test(watchdog_needs_both_contexts),
+                                     cmocka_unit_test(alignment_sets_the_encoder_offset),
                                      cmocka_unit_test(bad_config_is_named)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

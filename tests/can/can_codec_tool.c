@@ -48,7 +48,7 @@ static void describe(void) {
              (long long)d->raw_min, (long long)d->raw_max, (int)s + 1);
     }
   }
-  for (unsigned r = 0; r < 8u; ++r) {
+  for (unsigned r = 0; r < CAN_RESULT_COUNT; ++r) {
     printf("RESULT %u %s\n", r, can_codec_result_name(r));
   }
   unsigned n;

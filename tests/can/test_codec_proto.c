@@ -32,7 +32,8 @@ static rig_t rig; /* large: off the stack */
 
 static void rig_init(void) {
   memset(&rig, 0, sizeof rig);
-  hal_sil_init(&rig.hal);
+  const hal_sil_board_t board = {0.0f, 1.0f, 0u, 1e-6f, 62.5e-6f, 0u, false};
+  hal_sil_init(&rig.hal, &board);
   hal_sil_bind(&rig.hal);
   drive_config_t cfg;
   drive_config_default(&cfg);
@@ -43,13 +44,14 @@ static void rig_init(void) {
   assert_int_equal(can_proto_init(&rig.p, &rig.pc), 0);
   rig.hal.sample.v_dc = 310.0f;
   rig.hal.sample.enc_valid = true;
+  rig.hal.sample.valid = true;
 }
 
-/* One slow period: protocol + slow loop, then slow_div ISRs. */
+/* One slow period: protocol + background service, then slow_div ISRs. */
 static void slow_tick(void) {
   rig.hal.time_us = (uint32_t)(rig.k * 1000000ull / 16000ull);
+  drive_background(&rig.drv);
   can_proto_poll(&rig.p, &rig.drv, rig.hal.time_us);
-  drive_slow_loop(&rig.drv);
   for (unsigned i = 0; i < rig.drv.cfg.slow_div; ++i) {
     drive_isr(&rig.drv);
     rig.k++;
@@ -173,7 +175,7 @@ static void test_out_of_range_names_signal(void **state) {
   uint8_t d[8] = {0};
   can_codec_set_raw(CAN_SIG_CMD_SPEED_RPM, d, (uint32_t)(int32_t)-20000001); /* beyond the DBC */
   push(CAN_MSG_CMD_SPEED, 4, d);
-  push_state(1, 0, 7, 3); /* mode 7: outside the DBC range 0..3 */
+  push_state(1, 0, 7, CAN_KEEP); /* mode 7: no such mode */
   memset(d, 0, sizeof d);
   can_codec_set(CAN_SIG_CMD_TORQUE, d, 25.0f); /* above torque_max (20 N m) */
   push(CAN_MSG_CMD_TORQUE, 4, d);
@@ -241,7 +243,7 @@ static void run_until_state(drive_state_t st, unsigned max_ticks) {
 static void test_idle_only_params_refused_while_running(void **state) {
   (void)state;
   rig_init();
-  push_state(1, 0, 3, 3);
+  push_state(1, 0, CAN_KEEP, CAN_KEEP);
   run_until_state(DRIVE_STATE_RUN, 100);
   reply_t r[64];
   pop_replies(r, 64, NULL);
@@ -304,7 +306,7 @@ static void test_command_timeout(void **state) {
   rig_init();
   rig.p.cfg.timeout_ms = 300;
   rig.p.cfg.ramp_ms = 100;
-  push_state(1, 0, 0, 3); /* enable, torque mode */
+  push_state(1, 0, 0, CAN_KEEP); /* enable, torque mode */
   uint8_t d[8] = {0};
   can_codec_set(CAN_SIG_CMD_TORQUE, d, 4.0f);
   push(CAN_MSG_CMD_TORQUE, 4, d);
@@ -344,7 +346,7 @@ static void test_command_timeout(void **state) {
   pop_replies(r, 256, &status_n);
   assert_true(status_n >= 2);
   /* clear + enable restarts from rest in the previous mode */
-  push_state(2, 1, 3, 3);
+  push_state(CAN_KEEP, 1, CAN_KEEP, CAN_KEEP);
   slow_tick();
   assert_int_equal(rig.drv.state, DRIVE_STATE_IDLE);
   assert_true(rig.drv.cmd.torque == 0.0f);
@@ -361,7 +363,7 @@ static void test_no_timeout_when_idle_or_off(void **state) {
   assert_int_equal(rig.p.stats.timeouts, 0);
   rig_init();
   rig.p.cfg.timeout_ms = 0;
-  push_state(1, 0, 3, 3);
+  push_state(1, 0, CAN_KEEP, CAN_KEEP);
   for (unsigned i = 0; i < 2000; ++i) {
     slow_tick();
   }
@@ -389,6 +391,38 @@ static void test_telemetry_rates(void **state) {
   assert_int_equal(n_hb, 2); /* 500 ms */
 }
 
+/* CMD_STATE: the keep value is outside every law and mode; a law the
+ * machine cannot run is "unavailable" and nothing of the frame applies. */
+static void test_keep_and_unavailable_law(void **state) {
+  (void)state;
+  rig_init();
+  push_state(CAN_KEEP, 0, CAN_KEEP, 1);               /* pi_dfvc: available on the SPM default */
+  push_state(CAN_KEEP, 0, CAN_KEEP, DRIVE_LAW_COUNT); /* no such law */
+  push_param(1, 4, 0.1f); /* lq = 0.1 H with a DFVC law commanded: refused */
+  slow_tick();
+  reply_t r[8];
+  assert_int_equal(pop_replies(r, 8, NULL), 3);
+  assert_int_equal(r[0].result, CAN_RESULT_OK);
+  assert_int_equal(rig.drv.ctrl.law, DRIVE_LAW_PI_DFVC);
+  assert_int_equal(r[1].result, CAN_RESULT_OUT_OF_RANGE);
+  assert_int_equal(r[1].signal, CAN_SIG_LAW + 1);
+  assert_int_equal(r[2].result, CAN_RESULT_INCONSISTENT);
+  /* back to FOC, then the saliency is accepted and the DFVC laws are not */
+  push_state(CAN_KEEP, 0, CAN_KEEP, 0);
+  push_param(1, 4, 0.1f);
+  push_state(1, 0, CAN_KEEP, 2); /* enable with db_dfvc: unavailable, not enabled */
+  slow_tick();
+  assert_int_equal(pop_replies(r, 8, NULL), 3);
+  assert_int_equal(r[0].result, CAN_RESULT_OK);
+  assert_int_equal(r[1].result, CAN_RESULT_OK);
+  assert_int_equal(r[2].result, CAN_RESULT_UNAVAILABLE);
+  assert_int_equal(r[2].signal, CAN_SIG_LAW + 1);
+  assert_int_equal(rig.drv.ctrl.law, DRIVE_LAW_FOC);
+  assert_int_equal(rig.drv.cmd.enable, 0);
+  assert_int_equal(rig.drv.state, DRIVE_STATE_IDLE);
+  assert_float_equal(rig.drv.cfg.lq, 0.1f, 0.0f);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_unknown_and_other_nodes_ignored),
@@ -401,6 +435,7 @@ int main(void) {
       cmocka_unit_test(test_command_timeout),
       cmocka_unit_test(test_no_timeout_when_idle_or_off),
       cmocka_unit_test(test_telemetry_rates),
+      cmocka_unit_test(test_keep_and_unavailable_law),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -113,8 +113,13 @@ static void plant_step(plant_t *p, dq_t v_cmd) {
   p->vq = v_cmd.q;
 }
 
+/* The regulators hold a pointer to their machine: static, not on a stack. */
+static machine_t machine_nominal, machine_mismatch;
+
 static current_ctrl_t make_cc(void) {
-  const current_ctrl_cfg_t cfg = {(float)RS, (float)LD, (float)LQ, (float)LM, (float)WC, (float)TS};
+  assert_int_equal(
+      machine_init_linear(&machine_nominal, 4.0f, (float)RS, (float)LD, (float)LQ, (float)LM), 0);
+  const current_ctrl_cfg_t cfg = {&machine_nominal, (float)WC, (float)TS};
   current_ctrl_t cc;
   current_ctrl_init(&cc, &cfg);
   return cc;
@@ -183,8 +188,10 @@ static void test_step_response(void **state) {
  * R 50 % higher than the regulator's): still no steady-state error. */
 static void test_mismatch_zero_error(void **state) {
   (void)state;
-  const current_ctrl_cfg_t cfg = {(float)(RS / 1.5), (float)(LD * 1.2), (float)(LQ * 1.2),
-                                  (float)LM,         (float)WC,         (float)TS};
+  assert_int_equal(machine_init_linear(&machine_mismatch, 4.0f, (float)(RS / 1.5),
+                                       (float)(LD * 1.2), (float)(LQ * 1.2), (float)LM),
+                   0);
+  const current_ctrl_cfg_t cfg = {&machine_mismatch, (float)WC, (float)TS};
   current_ctrl_t cc;
   current_ctrl_init(&cc, &cfg);
   plant_t p = plant_make(0.0);

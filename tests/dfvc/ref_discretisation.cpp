@@ -75,8 +75,11 @@ void test_discretisation(void **) {
 /* MPE: x = [i; v; lambda_m_ab], di/dt = -f i + (v - w J lambda_m)/L, dv/dt = 0,
  * d lambda_m/dt = w J lambda_m (exact) or 0 (printed (21)). */
 void check_predictor(current_predictor_mode_t mode) {
+  static machine_t machine; /* the predictor holds a pointer to it */
+  assert_int_equal(
+      machine_init_linear(&machine, 21.0f, (float)kRs, (float)kLs, (float)kLs, (float)kLm), 0);
   current_predictor_t p;
-  const current_predictor_cfg_t cfg = {(float)kRs, (float)kLs, (float)kLm, (float)kTs, mode};
+  const current_predictor_cfg_t cfg = {&machine, (float)kTs, mode};
   assert_int_equal(current_predictor_init(&p, &cfg), 0);
   Eigen::Matrix2d J;
   J << 0.0, -1.0, 1.0, 0.0;

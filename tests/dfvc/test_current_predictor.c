@@ -25,9 +25,13 @@ static double rpm_to_we(double rpm) {
 }
 
 /* worst error of the predictor over a set of states and voltages */
+static machine_t machine; /* the predictor holds a pointer to it */
+
 static double worst_error(current_predictor_mode_t mode, double we) {
   current_predictor_t p;
-  const current_predictor_cfg_t cfg = {(float)RS, (float)LS, (float)LM, (float)TS, mode};
+  assert_int_equal(
+      machine_init_linear(&machine, (float)P, (float)RS, (float)LS, (float)LS, (float)LM), 0);
+  const current_predictor_cfg_t cfg = {&machine, (float)TS, mode};
   assert_int_equal(current_predictor_init(&p, &cfg), 0);
   double worst = 0.0;
   for (int n = 0; n < 64; ++n) {
@@ -79,9 +83,13 @@ static void test_eq21_error_bound(void **state) {
 static void test_init_rejects_bad(void **state) {
   (void)state;
   current_predictor_t p;
-  current_predictor_cfg_t cfg = {7.1f, 0.057f, -0.1f, 62.5e-6f, CURRENT_PREDICTOR_EXACT};
+  current_predictor_cfg_t cfg = {NULL, 62.5e-6f, CURRENT_PREDICTOR_EXACT};
+  assert_int_equal(current_predictor_init(&p, &cfg), -1); /* no machine */
+  assert_int_equal(machine_init_linear(&machine, 21.0f, 7.1f, 0.057f, 0.057f, 0.19f), 0);
+  cfg.machine = &machine;
+  cfg.ts = 0.0f;
   assert_int_equal(current_predictor_init(&p, &cfg), -1);
-  cfg.lambda_m = 0.19f;
+  cfg.ts = 62.5e-6f;
   cfg.mode = (current_predictor_mode_t)7;
   assert_int_equal(current_predictor_init(&p, &cfg), -1);
   cfg.mode = CURRENT_PREDICTOR_EQ21;

@@ -17,6 +17,13 @@
 #include "control/dfvc.h"
 #include "spm_plant_ref.h"
 
+/* Rubino 2020, Table I; the law holds a pointer to it. */
+static const machine_t *table1(void) {
+  static machine_t m;
+  assert_int_equal(machine_init_linear(&m, 21.0f, 7.1f, 0.057f, 0.057f, 0.19f), 0);
+  return &m;
+}
+
 typedef struct {
   spm_plant_t m;
   dfvc_t c;
@@ -27,8 +34,9 @@ typedef struct {
 
 static void loop_init(loop_t *l, const dfvc_cfg_t *cfg, double rpm, dfvc_law_t law) {
   l->vdc = 310.0;
-  spm_plant_init(&l->m, cfg->rs, cfg->ls, cfg->lambda_m, cfg->pole_pairs, cfg->ts,
-                 rpm / 60.0 * 6.283185307179586 * cfg->pole_pairs);
+  const machine_t *m = cfg->machine;
+  spm_plant_init(&l->m, m->rs, machine_ls(m), m->lambda_m, m->pole_pairs, cfg->ts,
+                 rpm / 60.0 * 6.283185307179586 * m->pole_pairs);
   l->m.theta = 0.4;
   assert_int_equal(dfvc_init(&l->c, cfg), 0);
   l->v_prev = (ab_t){0.0f, 0.0f};
@@ -44,7 +52,7 @@ static void loop_step(loop_t *l, double torque, dfvc_out_t *out) {
   in.v_ab_applied = l->v_prev;
   in.theta_r = (float)l->m.theta;
   in.omega_r = (float)l->m.w;
-  in.v_dc = (float)l->vdc;
+  in.v_lin = (float)(l->vdc / sqrt(3.0));
   in.torque_ref = (float)torque;
   in.lambda_ref = 0.0f;
   dfvc_step(&l->c, &in, out);
@@ -129,7 +137,7 @@ static step_result_t run_step(const dfvc_cfg_t *cfg, dfvc_law_t law, double rpm,
 static void test_step_db_vs_pi(void **state) {
   (void)state;
   dfvc_cfg_t cfg;
-  dfvc_cfg_defaults(&cfg);
+  dfvc_cfg_defaults(&cfg, table1());
   const step_result_t db = run_step(&cfg, DFVC_LAW_DEADBEAT, 100.0, 310.0, 10.0, 11.0, 1);
   const step_result_t pi = run_step(&cfg, DFVC_LAW_PI, 100.0, 310.0, 10.0, 11.0, 1);
   printf("  DB: i_qs %.4f -> %.4f A; within 2 %% of final after %d samples, 2 %% of step after "
@@ -171,7 +179,7 @@ static void test_step_db_vs_pi(void **state) {
 static void test_reversal(void **state) {
   (void)state;
   dfvc_cfg_t cfg;
-  dfvc_cfg_defaults(&cfg);
+  dfvc_cfg_defaults(&cfg, table1());
   const step_result_t db = run_step(&cfg, DFVC_LAW_DEADBEAT, 100.0, 310.0, -20.0, 20.0, 0);
   const step_result_t pi = run_step(&cfg, DFVC_LAW_PI, 100.0, 310.0, -20.0, 20.0, 0);
   printf("  DB reversal: i_qs %.3f -> %.3f A, 2 %% of final after %d samples, overshoot %.2f %% "
@@ -206,14 +214,14 @@ static void run_fw(const dfvc_cfg_t *cfg, double *flux_err, double *delta, doubl
   printf("  1200 rpm, T* = 20 N m, rot_advance %.1f: lambda %.4f Vs (ref %.4f, err %.3f %%), "
          "delta %.2f deg, T %.3f N m (%.0f W), i_qs %.3f (ref %.3f), T_max %.3f, |v| max %.1f V\n",
          cfg->rot_advance, cabs(lam), out.lambda_ref, 100.0 * *flux_err, *delta * 57.29578, *torque,
-         *torque * l.m.w / cfg->pole_pairs, spm_plant_iqs(&l.m), out.i_qs_ref, out.torque_max,
-         *vmag);
+         *torque * l.m.w / cfg->machine->pole_pairs, spm_plant_iqs(&l.m), out.i_qs_ref,
+         out.torque_max, *vmag);
 }
 
 static void test_flux_weakening_1200rpm(void **state) {
   (void)state;
   dfvc_cfg_t cfg;
-  dfvc_cfg_defaults(&cfg);
+  dfvc_cfg_defaults(&cfg, table1());
   double fe, de, tq, vm;
   uint32_t lim;
   run_fw(&cfg, &fe, &de, &tq, &vm, &lim);
@@ -235,14 +243,14 @@ static void test_flux_weakening_1200rpm(void **state) {
 static void test_faults_and_switch(void **state) {
   (void)state;
   dfvc_cfg_t cfg;
-  dfvc_cfg_defaults(&cfg);
+  dfvc_cfg_defaults(&cfg, table1());
   loop_t l;
   loop_init(&l, &cfg, 100.0, DFVC_LAW_DEADBEAT);
   dfvc_out_t out;
   for (int k = 0; k < 400; ++k) {
     loop_step(&l, 10.0, &out);
   }
-  dfvc_in_t in = {DFVC_LAW_DEADBEAT, {0.1f, 0.2f}, {0.0f, 0.0f}, 0.0f, 0.0f, 310.0f, 10.0f, 0.0f};
+  dfvc_in_t in = {DFVC_LAW_DEADBEAT, {0.1f, 0.2f}, {0.0f, 0.0f}, 0.0f, 0.0f, 179.0f, 10.0f, 0.0f};
   in.i_ab.alpha = NAN;
   const dfvc_t before = l.c;
   dfvc_step(&l.c, &in, &out);
@@ -281,7 +289,7 @@ static void test_faults_and_switch(void **state) {
   c2.rot_advance = 2.0f;
   assert_int_equal(dfvc_init(&d, &c2), -1);
   c2 = cfg;
-  c2.ls = 0.0f;
+  c2.machine = NULL;
   assert_int_equal(dfvc_init(&d, &c2), -1);
 }
 

@@ -12,9 +12,12 @@
 
 #include "control/dfvc_deadbeat.h"
 
+static machine_t machine; /* Rubino 2020, Table I; the law holds a pointer to it */
+
 static dfvc_deadbeat_t make(void) {
   dfvc_deadbeat_t db;
-  const dfvc_deadbeat_cfg_t cfg = {7.1f, 0.057f, 0.19f, 62.5e-6f, 60.0f};
+  assert_int_equal(machine_init_linear(&machine, 21.0f, 7.1f, 0.057f, 0.057f, 0.19f), 0);
+  const dfvc_deadbeat_cfg_t cfg = {&machine, 62.5e-6f, 60.0f};
   assert_int_equal(dfvc_deadbeat_init(&db, &cfg), 0);
   return db;
 }

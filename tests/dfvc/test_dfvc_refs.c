@@ -20,10 +20,13 @@
 #define IMAX 3.5355339
 #define DMAX (80.0 * 0.017453292519943295)
 
+static machine_t machine; /* the references hold a pointer to it */
+
 static dfvc_refs_t make(void) {
   dfvc_refs_t r;
-  const dfvc_refs_cfg_t cfg = {(float)RS,   (float)LS,   (float)LM,         (float)P,
-                               (float)IMAX, (float)DMAX, (float)(0.2 * LM), 0.95f};
+  assert_int_equal(
+      machine_init_linear(&machine, (float)P, (float)RS, (float)LS, (float)LS, (float)LM), 0);
+  const dfvc_refs_cfg_t cfg = {&machine, (float)IMAX, (float)DMAX, (float)(0.2 * LM), 0.95f};
   assert_int_equal(dfvc_refs_init(&r, &cfg), 0);
   return r;
 }
@@ -64,11 +67,12 @@ static void test_voltage_limit(void **state) {
     /* eq. (23) with omega_r */
     const double want =
         (sqrt(vmax * vmax - RS * ids * RS * ids) - RS * iqs * (w < 0 ? -1 : 1)) / fabs(w);
-    near_rel(dfvc_refs_lambda_vlim(&r, 310.0f, (float)w, (float)ids, (float)iqs), want, 2e-6);
+    near_rel(dfvc_refs_lambda_vlim(&r, 310.0f / sqrtf(3.0f), (float)w, (float)ids, (float)iqs),
+             want, 2e-6);
   }
   /* reference = min(MTPA, voltage) >= lambda_min */
   dfvc_refs_out_t o;
-  dfvc_refs_in_t in = {20.0f, 0.0f, (float)w_of_rpm(100.0), 310.0f, 0.5f, 2.0f};
+  dfvc_refs_in_t in = {20.0f, 0.0f, (float)w_of_rpm(100.0), 310.0f / sqrtf(3.0f), 0.5f, 2.0f};
   dfvc_refs_update(&r, &in, &o);
   near_rel(o.lambda_ref, 0.26903750507749286, 1e-6); /* 100 rpm: MTPA */
   assert_int_equal(o.limits & (DFVC_REFS_FLUX_VLIM | DFVC_REFS_FLUX_MIN), 0);
@@ -78,12 +82,12 @@ static void test_voltage_limit(void **state) {
   near_rel(o.lambda_ref, o.lambda_vlim, 1e-7);
   near_rel(o.lambda_ref, (sqrt(vmax * vmax - RS * 0.5 * RS * 0.5) - RS * 2.0) / w_of_rpm(1200.0),
            2e-6);
-  in.v_dc = 40.0f; /* deep: lambda_min */
+  in.v_lin = 40.0f / sqrtf(3.0f); /* deep: lambda_min */
   dfvc_refs_update(&r, &in, &o);
   assert_true(o.limits & DFVC_REFS_FLUX_MIN);
   near_rel(o.lambda_ref, 0.2 * LM, 1e-6);
   /* override replaces MTPA, still voltage-limited */
-  in.v_dc = 310.0f;
+  in.v_lin = 310.0f / sqrtf(3.0f);
   in.lambda_override = 0.15f;
   in.omega_r = (float)w_of_rpm(100.0);
   dfvc_refs_update(&r, &in, &o);
@@ -95,7 +99,7 @@ static void test_iqs_limits(void **state) {
   const dfvc_refs_t r = make();
   dfvc_refs_out_t o;
   /* 10 N m at 100 rpm: eq. (24), no limit */
-  dfvc_refs_in_t in = {10.0f, 0.0f, (float)w_of_rpm(100.0), 310.0f, 0.7f, 1.5f};
+  dfvc_refs_in_t in = {10.0f, 0.0f, (float)w_of_rpm(100.0), 310.0f / sqrtf(3.0f), 0.7f, 1.5f};
   dfvc_refs_update(&r, &in, &o);
   near_rel(o.iqs_ref, 10.0 / (1.5 * P * 0.21253304398276637), 2e-6);
   assert_int_equal(o.limits, 0);
@@ -126,7 +130,8 @@ static void test_iqs_limits(void **state) {
 static void test_init_rejects_bad(void **state) {
   (void)state;
   dfvc_refs_t r;
-  dfvc_refs_cfg_t cfg = {7.1f, 0.057f, 0.19f, 21.0f, 3.5f, 1.7f, 0.04f, 0.95f};
+  assert_int_equal(machine_init_linear(&machine, 21.0f, 7.1f, 0.057f, 0.057f, 0.19f), 0);
+  dfvc_refs_cfg_t cfg = {&machine, 3.5f, 1.7f, 0.04f, 0.95f};
   assert_int_equal(dfvc_refs_init(&r, &cfg), -1); /* delta_max > pi/2 */
   cfg.delta_max = 1.3f;
   cfg.v_margin = 1.2f;

@@ -27,10 +27,13 @@
 #define P  21.0
 #define WC 125.0
 
+static machine_t machine; /* the model of the observer, which holds a pointer to it */
+
 static flux_observer_t make_obs(double lm_model) {
   flux_observer_t o;
-  const flux_observer_cfg_t cfg = {(float)RS, (float)LS, (float)lm_model, (float)P,
-                                   (float)TS, (float)WC, 1000.0f};
+  assert_int_equal(
+      machine_init_linear(&machine, (float)P, (float)RS, (float)LS, (float)LS, (float)lm_model), 0);
+  const flux_observer_cfg_t cfg = {&machine, (float)TS, (float)WC, 1000.0f};
   assert_int_equal(flux_observer_init(&o, &cfg), 0);
   return o;
 }
@@ -157,7 +160,8 @@ static void test_prediction_and_frame(void **state) {
 static void test_init_and_reset(void **state) {
   (void)state;
   flux_observer_t o;
-  flux_observer_cfg_t cfg = {7.1f, 0.057f, 0.19f, 21.0f, 62.5e-6f, 125.0f, 0.0f};
+  assert_int_equal(machine_init_linear(&machine, 21.0f, 7.1f, 0.057f, 0.057f, 0.19f), 0);
+  flux_observer_cfg_t cfg = {&machine, 62.5e-6f, 125.0f, 0.0f};
   assert_int_equal(flux_observer_init(&o, &cfg), -1);
   cfg.omega_s_bw = 1000.0f;
   assert_int_equal(flux_observer_init(&o, &cfg), 0);

@@ -7,6 +7,12 @@ if(FD_PYTHON)
            WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   set_tests_properties(python/pytest PROPERTIES LABELS python TIMEOUT 900
     ENVIRONMENT "FLUXDRIVE_SIL=$<TARGET_FILE:fluxdrive-sil>")
+  # the parameter table of the firmware against the DBC, the tools' table
+  # and docs/parameters.md (fluxdrive params --check)
+  add_test(NAME params/agreement
+           COMMAND ${FD_PYTHON} -m fluxdrive params --check --sil $<TARGET_FILE:fluxdrive-sil>
+           WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  set_tests_properties(params/agreement PROPERTIES LABELS python TIMEOUT 120)
 else()
   message(STATUS "FD_PYTHON not set: pytest not registered (scripts/test.sh sets it)")
 endif()

@@ -33,8 +33,9 @@ static inline void trace_observer(void *user, const sil_step_t *st) {
   tr->torque[k] = p->torque;
   tr->v_dc[k] = p->v_dc;
   tr->imax_abs[k] = fmax(fabs(p->i_abc[0]), fmax(fabs(p->i_abc[1]), fabs(p->i_abc[2])));
-  tr->speed_ref[k] = drive_telemetry(st->drive)->speed_ref;
-  const drive_telemetry_t *tm = drive_telemetry(st->drive);
+  /* lock-step: the ISR's own telemetry (not the main loop's copy) */
+  const drive_telemetry_t *tm = &st->drive->tm;
+  tr->speed_ref[k] = tm->speed_ref;
   tr->v_dc_meas[k] = st->adc->v_dc;
   tr->imax_meas[k] = fmax(fabs(tm->i_abc[0]), fmax(fabs(tm->i_abc[1]), fabs(tm->i_abc[2])));
   tr->speed_est[k] = tm->omega_m;

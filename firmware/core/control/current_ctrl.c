@@ -17,8 +17,12 @@
 void current_ctrl_init(current_ctrl_t *cc, const current_ctrl_cfg_t *cfg) {
   cc->cfg = *cfg;
   const float wc = cfg->bandwidth;
-  pi_ctrl_init(&cc->pi_d, wc * cfg->ld, wc * cfg->rs, cfg->ts, -INFINITY, INFINITY);
-  pi_ctrl_init(&cc->pi_q, wc * cfg->lq, wc * cfg->rs, cfg->ts, -INFINITY, INFINITY);
+  const machine_t *m = cfg->machine;
+  /* gains from the incremental inductances at zero current (constant for
+   * the linear machine) */
+  const machine_ldq_t l = machine_inductance(m, (dq_t){0.0f, 0.0f});
+  pi_ctrl_init(&cc->pi_d, wc * l.dd, wc * m->rs, cfg->ts, -INFINITY, INFINITY);
+  pi_ctrl_init(&cc->pi_q, wc * l.qq, wc * m->rs, cfg->ts, -INFINITY, INFINITY);
   cc->limited = 0;
 }
 
@@ -37,10 +41,10 @@ dq_t current_ctrl_update(current_ctrl_t *cc, dq_t i_ref, dq_t i, float we, float
   if (!fd_isfinite(we)) {
     we = 0.0f;
   }
-  const current_ctrl_cfg_t *c = &cc->cfg;
-  /* decoupling feed-forward: v = Rs i + L di/dt + we J lambda */
-  const float ff_d = -we * c->lq * i.q;
-  const float ff_q = we * (c->ld * i.d + c->lambda_m);
+  /* decoupling feed-forward: v = Rs i + L di/dt + we J lambda(i) */
+  const dq_t flux = machine_flux(cc->cfg.machine, i);
+  const float ff_d = -we * flux.q;
+  const float ff_q = we * flux.d;
 
   pi_ctrl_set_limits(&cc->pi_d, -v_max, v_max);
   v.d = pi_ctrl_update(&cc->pi_d, i_ref.d - i.d, ff_d);

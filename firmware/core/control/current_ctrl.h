@@ -10,13 +10,12 @@
 
 #include "math/frames.h"
 #include "math/pi_ctrl.h"
+#include "model/machine.h"
 
 typedef struct {
-  float rs;        /* stator resistance [Ohm] */
-  float ld, lq;    /* inductances [H] */
-  float lambda_m;  /* PM flux linkage [Vs] */
-  float bandwidth; /* closed-loop bandwidth wc [rad/s] */
-  float ts;        /* sampling period [s] */
+  const machine_t *machine; /* Rs, Ld, Lq, lambda_m (linear) */
+  float bandwidth;          /* closed-loop bandwidth wc [rad/s] */
+  float ts;                 /* sampling period [s] */
 } current_ctrl_cfg_t;
 
 typedef struct {

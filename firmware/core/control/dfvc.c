@@ -8,18 +8,13 @@
 
 #include "math/fd_math.h"
 
-#define DFVC_INV_SQRT3 0.577350269189626f
-#define DFVC_2PI       6.28318530717959f
-#define DFVC_DEG       0.0174532925199433f
+#define DFVC_2PI 6.28318530717959f
+#define DFVC_DEG 0.0174532925199433f
 
-void dfvc_cfg_defaults(dfvc_cfg_t *cfg) {
+void dfvc_cfg_defaults(dfvc_cfg_t *cfg, const machine_t *machine) {
   memset(cfg, 0, sizeof(*cfg));
-  /* Rubino 2020, Table I */
-  cfg->rs = 7.1f;
-  cfg->ls = 0.057f;
-  cfg->lambda_m = 0.19f;
-  cfg->pole_pairs = 21.0f;
-  cfg->ts = 62.5e-6f;
+  cfg->machine = machine;
+  cfg->ts = 62.5e-6f; /* Rubino 2020, section IV: 16 kHz */
   /* section III.B, IV */
   cfg->omega_c = 125.0f;
   cfg->delta_max = 80.0f * DFVC_DEG;
@@ -29,7 +24,7 @@ void dfvc_cfg_defaults(dfvc_cfg_t *cfg) {
   /* open in the paper: see dfvc.h */
   cfg->omega_s_bw = 1000.0f;
   cfg->i_max = 2.5f * 1.41421356f;
-  cfg->lambda_min = 0.2f * cfg->lambda_m;
+  cfg->lambda_min = 0.2f * machine->lambda_m;
   cfg->lambda_collapse = 0.5f * cfg->lambda_min;
   cfg->v_margin = 0.95f;
   cfg->mpe_mode = CURRENT_PREDICTOR_EXACT;
@@ -47,13 +42,12 @@ int dfvc_init(dfvc_t *c, const dfvc_cfg_t *cfg) {
          k->omega_delta_mode == DFVC_OMEGA_DELTA_OBSERVED))) {
     return -1;
   }
-  const flux_observer_cfg_t oc = {k->rs, k->ls,      k->lambda_m,  k->pole_pairs,
-                                  k->ts, k->omega_c, k->omega_s_bw};
-  const current_predictor_cfg_t pc = {k->rs, k->ls, k->lambda_m, k->ts, k->mpe_mode};
-  const dfvc_refs_cfg_t rc = {k->rs,    k->ls,        k->lambda_m,   k->pole_pairs,
-                              k->i_max, k->delta_max, k->lambda_min, k->v_margin};
-  const dfvc_deadbeat_cfg_t dc = {k->rs, k->ls, k->lambda_m, k->ts, k->v_sd_max};
-  const dfvc_pi_cfg_t ic = {k->rs, k->ls, k->ts, k->pi_bw_flux, k->pi_bw_iqs, k->v_sd_max};
+  const machine_t *m = k->machine;
+  const flux_observer_cfg_t oc = {m, k->ts, k->omega_c, k->omega_s_bw};
+  const current_predictor_cfg_t pc = {m, k->ts, k->mpe_mode};
+  const dfvc_refs_cfg_t rc = {m, k->i_max, k->delta_max, k->lambda_min, k->v_margin};
+  const dfvc_deadbeat_cfg_t dc = {m, k->ts, k->v_sd_max};
+  const dfvc_pi_cfg_t ic = {m, k->ts, k->pi_bw_flux, k->pi_bw_iqs, k->v_sd_max};
   if (flux_observer_init(&c->obs, &oc) != 0 || current_predictor_init(&c->mpe, &pc) != 0 ||
       dfvc_refs_init(&c->refs, &rc) != 0 || dfvc_deadbeat_init(&c->db, &dc) != 0 ||
       dfvc_pi_init(&c->pi, &ic) != 0) {
@@ -80,7 +74,7 @@ static inline float dfvc_zero_if_finite_ab(ab_t x) {
 static int dfvc_inputs_ok(const dfvc_in_t *in) {
   const float z = dfvc_zero_if_finite_ab(in->i_ab) + dfvc_zero_if_finite_ab(in->v_ab_applied) +
                   fd_zero_if_finite(in->theta_r) + fd_zero_if_finite(in->omega_r) +
-                  fd_zero_if_finite(in->v_dc) + fd_zero_if_finite(in->torque_ref) +
+                  fd_zero_if_finite(in->v_lin) + fd_zero_if_finite(in->torque_ref) +
                   fd_zero_if_finite(in->lambda_ref);
   return (in->law == DFVC_LAW_DEADBEAT || in->law == DFVC_LAW_PI) && fd_isfinite(z);
 }
@@ -116,12 +110,12 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
 
   /* references, Fig. 5, eqs. (22)-(26), from the quantities at tau */
   const dfvc_refs_in_t ri = {in->torque_ref, in->lambda_ref, in->omega_r,
-                             in->v_dc,       o.i_dqs.d,      o.i_dqs.q};
+                             in->v_lin,      o.i_dqs.d,      o.i_dqs.q};
   dfvc_refs_out_t r;
   dfvc_refs_update(&c->refs, &ri, &r);
 
-  /* the linear range of the min-max modulator */
-  const float v_max = fd_maxf(in->v_dc, 0.0f) * DFVC_INV_SQRT3;
+  /* the linear range of the modulator */
+  const float v_max = fd_maxf(in->v_lin, 0.0f);
   dq_t v_dqs;
   uint32_t lim = r.limits;
   if (in->law == DFVC_LAW_DEADBEAT) {
@@ -201,8 +195,12 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
   out->i_qs_pred = i1_dqs.q;
   out->i_dq_r = frames_park(in->i_ab, scr);
   out->torque = o.torque;
+  {
+    const float ea = o.lambda.alpha - o.lambda_cm.alpha, eb = o.lambda.beta - o.lambda_cm.beta;
+    out->obs_err = sqrtf(ea * ea + eb * eb);
+  }
   /* torque at tau+1, eq. (16) */
-  out->torque_pred = 1.5f * k->pole_pairs * o.lambda_s_next * i1_dqs.q;
+  out->torque_pred = 1.5f * k->machine->pole_pairs * o.lambda_s_next * i1_dqs.q;
   out->torque_min = r.torque_min;
   out->torque_max = r.torque_max;
   out->v_dqs = v_dqs;

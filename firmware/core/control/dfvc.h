@@ -23,7 +23,7 @@
  * Typical use per ISR:
  *   in.i_ab = measured; in.v_ab_applied = mod.v_applied (from last period);
  *   dfvc_step(&c, &in, &out);
- *   mod = modulation_minmax(out.v_ab_ref, v_dc);
+ *   mod = modulation_minmax(out.v_ab_ref, v_dc, duty_min, duty_max);
  *   deadtime_comp_apply(&dt, mod.duty, frames_clarke_inv(out.i_ab_mid), duty);
  *   if (out.fault) -> app decides (gates off, latch)
  *
@@ -33,8 +33,9 @@
  *  - lambda_min = 0.2 lambda_m (paper: below the flux needed at top speed
  *    and minimum DC link; Table I: 0.038 Vs < 0.052 Vs at 1200 rpm, 250 V).
  *  - lambda_collapse = 0.5 lambda_min: observed flux below it is a fault.
- *  - v_margin = 0.95 of v_dc/sqrt(3) in the flux-weakening law (23); the
- *    output voltage may use the whole linear range v_dc/sqrt(3).
+ *  - v_margin = 0.95 of the modulator's linear range v_lin (v_dc/sqrt(3)
+ *    for duties over [0, 1]) in the flux-weakening law (23); the output
+ *    voltage may use the whole linear range.
  *  - i_max = 2.5 sqrt(2) A (Table I rated rms current, as amplitude).
  *  - MPE form: exact back-EMF term (current_predictor.h) instead of the
  *    back-EMF held at tau; CURRENT_PREDICTOR_EQ21 gives the printed (21).
@@ -73,12 +74,10 @@ typedef enum {
 } dfvc_omega_delta_t;
 
 typedef struct {
-  /* machine (Table I: 7.1 Ohm, 57 mH, 0.19 Vs, 21 pole pairs) */
-  float rs;         /* stator resistance [Ohm] */
-  float ls;         /* stator inductance [H] */
-  float lambda_m;   /* PM flux linkage [Vs] */
-  float pole_pairs; /* p */
-  float ts;         /* sampling = PWM period [s] (62.5 us) */
+  /* the machine: an isotropic PM machine (Table I: 7.1 Ohm, 57 mH,
+   * 0.19 Vs, 21 pole pairs); every block below references it */
+  const machine_t *machine;
+  float ts; /* sampling = PWM period [s] (62.5 us) */
   /* observer */
   float omega_c;    /* crossover current model / back-EMF [rad/s] (125) */
   float omega_s_bw; /* omega_s derivative filter [rad/s] (1000) */
@@ -88,7 +87,7 @@ typedef struct {
   float v_sd_max;        /* d_s voltage limit [V] (60) */
   float lambda_min;      /* minimum flux reference [Vs] */
   float lambda_collapse; /* observed flux below this is a fault [Vs] */
-  float v_margin;        /* fraction of v_dc/sqrt(3) used by the flux-weakening law (0.95) */
+  float v_margin;        /* fraction of v_lin used by the flux-weakening law (0.95) */
   /* PI-DFVC */
   float pi_bw_flux; /* [rad/s] (2 pi 1000) */
   float pi_bw_iqs;  /* [rad/s] (2 pi 1000) */
@@ -104,7 +103,7 @@ typedef struct {
   ab_t v_ab_applied; /* voltage applied over [tau, tau+1) [V] */
   float theta_r;     /* electrical rotor angle at tau [rad] */
   float omega_r;     /* electrical rotor speed at tau [rad/s] */
-  float v_dc;        /* DC-link voltage [V] */
+  float v_lin;       /* linear voltage range of the modulator now (v_dc/sqrt(3)) [V] */
   float torque_ref;  /* T* [N m] */
   float lambda_ref;  /* flux reference override [Vs]; 0 = automatic (MTPA/FW) */
 } dfvc_in_t;
@@ -123,23 +122,24 @@ enum {
 };
 
 typedef struct {
-  ab_t v_ab_ref;   /* voltage to apply over [tau+1, tau+2) [V], |v| <= v_dc/sqrt(3) */
+  ab_t v_ab_ref;   /* voltage to apply over [tau+1, tau+2) [V], |v| <= v_lin */
   ab_t i_ab_pred;  /* predicted current at tau+1 (MPE) [A] */
   ab_t i_ab_pred2; /* predicted current at tau+2 with v_ab_ref [A] */
   ab_t i_ab_mid;   /* (pred + pred2)/2: mean over [tau+1, tau+2), for dead-time comp [A] */
   /* telemetry at tau unless stated */
-  float lambda_s;               /* observed flux amplitude [Vs] */
-  float lambda_s_pred;          /* predicted at tau+1 [Vs] */
-  float lambda_ref;             /* lambda* [Vs] */
-  float theta_s;                /* flux angle [rad] */
-  float omega_s;                /* flux-frame speed (filtered) [rad/s] */
-  float delta;                  /* load angle [rad] */
-  float i_ds, i_qs;             /* stator-flux frame currents [A] */
-  float i_qs_ref;               /* limited i_qs* [A] */
-  float i_qs_pred;              /* predicted at tau+1 [A] */
-  dq_t i_dq_r;                  /* rotor-frame currents at tau (telemetry) [A] */
-  float torque;                 /* 3/2 p lambda_s i_qs [N m] */
-  float torque_pred;            /* predicted at tau+1 [N m] */
+  float lambda_s;      /* observed flux amplitude [Vs] */
+  float lambda_s_pred; /* predicted at tau+1 [Vs] */
+  float lambda_ref;    /* lambda* [Vs] */
+  float theta_s;       /* flux angle [rad] */
+  float omega_s;       /* flux-frame speed (filtered) [rad/s] */
+  float delta;         /* load angle [rad] */
+  float i_ds, i_qs;    /* stator-flux frame currents [A] */
+  float i_qs_ref;      /* limited i_qs* [A] */
+  float i_qs_pred;     /* predicted at tau+1 [A] */
+  dq_t i_dq_r;         /* rotor-frame currents at tau (telemetry) [A] */
+  float torque;        /* 3/2 p lambda_s i_qs [N m] */
+  float obs_err;       /* |lambda_hat - lambda_cm| at tau: observer vs current model [Vs] */
+  float torque_pred;   /* predicted at tau+1 [N m] */
   float torque_min, torque_max; /* deliverable now [N m] (dfvc_refs.h) */
   dq_t v_dqs;                   /* (ds, qs) voltage reference [V] */
   uint32_t limits;              /* DFVC_REFS_* | DFVC_LIMIT_* */
@@ -156,8 +156,8 @@ typedef struct {
   dfvc_law_t last_law;
 } dfvc_t;
 
-/* Paper constants and the Table I machine (overwrite the machine fields). */
-void dfvc_cfg_defaults(dfvc_cfg_t *cfg);
+/* Paper constants for the given machine (lambda_min from its PM flux). */
+void dfvc_cfg_defaults(dfvc_cfg_t *cfg, const machine_t *machine);
 /* Returns 0, or -1 if a parameter is invalid (the state is then unusable). */
 int dfvc_init(dfvc_t *c, const dfvc_cfg_t *cfg);
 /* Observer restarts from the current model, PI integrals cleared. */

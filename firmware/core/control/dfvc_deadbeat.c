@@ -16,8 +16,7 @@ static int dfvc_deadbeat_pos(float x) {
 int dfvc_deadbeat_init(dfvc_deadbeat_t *db, const dfvc_deadbeat_cfg_t *cfg) {
   memset(db, 0, sizeof(*db));
   const dfvc_deadbeat_cfg_t *c = cfg;
-  if (!(fd_isfinite(c->rs) && c->rs >= 0.0f && dfvc_deadbeat_pos(c->ls) &&
-        dfvc_deadbeat_pos(c->lambda_m) && dfvc_deadbeat_pos(c->ts) &&
+  if (!(c->machine != NULL && dfvc_deadbeat_pos(c->machine->lambda_m) && dfvc_deadbeat_pos(c->ts) &&
         dfvc_deadbeat_pos(c->v_sd_max))) {
     return -1;
   }
@@ -28,7 +27,7 @@ int dfvc_deadbeat_init(dfvc_deadbeat_t *db, const dfvc_deadbeat_cfg_t *cfg) {
 
 void dfvc_deadbeat_reset(dfvc_deadbeat_t *db) {
   db->inv_ts = 1.0f / db->cfg.ts;
-  db->ls_ts = db->cfg.ls / db->cfg.ts;
+  db->ls_ts = machine_ls(db->cfg.machine) / db->cfg.ts;
 }
 
 float dfvc_deadbeat_omega_delta_target(const dfvc_deadbeat_t *db, float iqs_ref, float iqs_next,
@@ -45,7 +44,9 @@ float dfvc_deadbeat_omega_delta_target_sc(const dfvc_deadbeat_t *db, float iqs_r
    * asin(Ls i_qs* / lambda_m); with detuned ones the error scales the step
    * only and vanishes in steady state (no bias on v_qs). */
   const float sd = sc_delta.s;
-  const float s = fd_clampf(sd + db->cfg.ls * (iqs_ref - iqs_next) / db->cfg.lambda_m, -1.0f, 1.0f);
+  const float s =
+      fd_clampf(sd + machine_ls(db->cfg.machine) * (iqs_ref - iqs_next) / db->cfg.machine->lambda_m,
+                -1.0f, 1.0f);
   if (!(sc_delta.c >= 0.0f)) {
     /* |delta(t+1)| > pi/2, beyond the principal branch of asin */
     return frames_wrap_pi(fd_asinf(s) - delta_next) * db->inv_ts;
@@ -61,12 +62,13 @@ float dfvc_deadbeat_omega_delta_target_sc(const dfvc_deadbeat_t *db, float iqs_r
 void dfvc_deadbeat_step(const dfvc_deadbeat_t *db, const dfvc_deadbeat_in_t *in,
                         dfvc_deadbeat_out_t *out) {
   const dfvc_deadbeat_cfg_t *c = &db->cfg;
+  const machine_t *m = c->machine;
   unsigned sat = 0u;
 
   /* Rubino 2020, eq. (29) */
-  const float vd = c->rs * in->i_dqs_next.d + (in->lambda_ref - in->lambda_s_next) * db->inv_ts;
+  const float vd = m->rs * in->i_dqs_next.d + (in->lambda_ref - in->lambda_s_next) * db->inv_ts;
   /* Rubino 2020, eq. (33) */
-  const float vq = c->rs * in->i_dqs_next.q + in->omega_delta * c->ls * in->i_dqs_next.d +
+  const float vq = m->rs * in->i_dqs_next.q + in->omega_delta * machine_ls(m) * in->i_dqs_next.d +
                    in->omega_r * in->lambda_s_next + db->ls_ts * (in->iqs_ref - in->i_dqs_next.q);
   out->v_dqs_raw.d = vd;
   out->v_dqs_raw.q = vq;

@@ -30,11 +30,12 @@
 #define FD_CONTROL_DFVC_DEADBEAT_H
 
 #include "math/frames.h"
+#include "model/machine.h"
 
 typedef struct {
-  float rs, ls, lambda_m; /* [Ohm], [H], [Vs] */
-  float ts;               /* [s] */
-  float v_sd_max;         /* d_s voltage limit [V]; paper: 60 V */
+  const machine_t *machine; /* SPM: Rs, Ls = machine_ls(), lambda_m > 0 */
+  float ts;                 /* [s] */
+  float v_sd_max;           /* d_s voltage limit [V]; paper: 60 V */
 } dfvc_deadbeat_cfg_t;
 
 typedef struct {

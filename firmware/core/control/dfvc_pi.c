@@ -40,8 +40,8 @@ static float dfvc_pi_axis(float *integ, float kp, float ki, float ts, float err,
 int dfvc_pi_init(dfvc_pi_t *c, const dfvc_pi_cfg_t *cfg) {
   memset(c, 0, sizeof(*c));
   const dfvc_pi_cfg_t *k = cfg;
-  if (!(fd_isfinite(k->rs) && k->rs >= 0.0f && dfvc_pi_pos(k->ls) && dfvc_pi_pos(k->ts) &&
-        dfvc_pi_pos(k->bw_flux) && dfvc_pi_pos(k->bw_iqs) && dfvc_pi_pos(k->v_sd_max))) {
+  if (!(k->machine != NULL && dfvc_pi_pos(k->ts) && dfvc_pi_pos(k->bw_flux) &&
+        dfvc_pi_pos(k->bw_iqs) && dfvc_pi_pos(k->v_sd_max))) {
     return -1;
   }
   c->cfg = *cfg;
@@ -49,8 +49,8 @@ int dfvc_pi_init(dfvc_pi_t *c, const dfvc_pi_cfg_t *cfg) {
   c->kp_flux = k->bw_flux;
   c->ki_flux = 0.1f * k->bw_flux * k->bw_flux;
   /* i_qs: plant 1/(Ls s + Rs), pole-zero cancellation */
-  c->kp_iqs = k->bw_iqs * k->ls;
-  c->ki_iqs = k->bw_iqs * k->rs;
+  c->kp_iqs = k->bw_iqs * machine_ls(k->machine);
+  c->ki_iqs = k->bw_iqs * k->machine->rs;
   dfvc_pi_reset(c);
   return 0;
 }
@@ -68,15 +68,16 @@ void dfvc_pi_step(dfvc_pi_t *c, const dfvc_pi_in_t *in, dfvc_pi_out_t *out) {
 
   /* flux loop on the d_s equation of Rubino 2020, eq. (16) */
   const float vd_max = fd_minf(k->v_sd_max, vmax);
-  const float ff_d = k->rs * in->i_dqs.d;
+  const machine_t *m = k->machine;
+  const float ff_d = m->rs * in->i_dqs.d;
   const float vd = dfvc_pi_axis(&c->integ_d, c->kp_flux, c->ki_flux, k->ts,
                                 in->lambda_ref - in->lambda_s, ff_d, vd_max, 0.0f, &sd);
 
   /* i_qs loop on Rubino 2020, eq. (32) */
   const float vq_max = sqrtf(fd_maxf(vmax * vmax - vd * vd, 0.0f));
-  const float ff_q = in->omega_r * in->lambda_s + in->omega_delta * k->ls * in->i_dqs.d;
+  const float ff_q = in->omega_r * in->lambda_s + in->omega_delta * machine_ls(m) * in->i_dqs.d;
   const float vq = dfvc_pi_axis(&c->integ_q, c->kp_iqs, c->ki_iqs, k->ts, in->iqs_ref - in->i_dqs.q,
-                                ff_q, vq_max, k->rs * in->i_dqs.q, &sq);
+                                ff_q, vq_max, m->rs * in->i_dqs.q, &sq);
 
   out->v_dqs.d = vd;
   out->v_dqs.q = vq;

@@ -38,13 +38,14 @@
 #define FD_CONTROL_DFVC_PI_H
 
 #include "math/frames.h"
+#include "model/machine.h"
 
 typedef struct {
-  float rs, ls;   /* [Ohm], [H] */
-  float ts;       /* [s] */
-  float bw_flux;  /* flux loop bandwidth [rad/s] */
-  float bw_iqs;   /* i_qs loop bandwidth [rad/s] */
-  float v_sd_max; /* d_s voltage limit [V] */
+  const machine_t *machine; /* SPM: Rs, Ls = machine_ls() */
+  float ts;                 /* [s] */
+  float bw_flux;            /* flux loop bandwidth [rad/s] */
+  float bw_iqs;             /* i_qs loop bandwidth [rad/s] */
+  float v_sd_max;           /* d_s voltage limit [V] */
 } dfvc_pi_cfg_t;
 
 typedef struct {

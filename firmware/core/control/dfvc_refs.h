@@ -4,7 +4,8 @@
  *
  *   lambda_MTPA = lambda_m sqrt(1 + 4/9 (Ls T* / (p lambda_m^2))^2)       (22)
  *   lambda_vlim = (sqrt(v_max^2 - (Rs i_ds)^2) - Rs i_qs sgn(w_r)) / |w_r| (23)
- *                 v_max = v_dc / sqrt(3) * v_margin, omega_s replaced by omega_r
+ *                 v_max = v_lin v_margin (v_lin: the modulator's linear range,
+ *                 v_dc/sqrt(3) over duties [0, 1]), omega_s replaced by omega_r
  *                 as the paper does
  *   lambda*     = max(min(lambda_MTPA, lambda_vlim), lambda_min)
  *   i_qs*       = T* / (1.5 p lambda*)                                    (24)
@@ -27,13 +28,14 @@
 #ifndef FD_CONTROL_DFVC_REFS_H
 #define FD_CONTROL_DFVC_REFS_H
 
+#include "model/machine.h"
+
 typedef struct {
-  float rs, ls, lambda_m; /* [Ohm], [H], [Vs] */
-  float pole_pairs;
-  float i_max;      /* phase current amplitude limit [A] */
-  float delta_max;  /* load-angle limit [rad], (0, pi/2] */
-  float lambda_min; /* lower flux limit [Vs] */
-  float v_margin;   /* fraction of v_dc/sqrt(3) used in (23), (0, 1] */
+  const machine_t *machine; /* SPM: Rs, Ls = machine_ls(), lambda_m > 0, p */
+  float i_max;              /* phase current amplitude limit [A] */
+  float delta_max;          /* load-angle limit [rad], (0, pi/2] */
+  float lambda_min;         /* lower flux limit [Vs] */
+  float v_margin;           /* fraction of the linear range v_lin used in (23), (0, 1] */
 } dfvc_refs_cfg_t;
 
 typedef struct {
@@ -46,7 +48,7 @@ typedef struct {
   float torque_ref;      /* T* [N m] */
   float lambda_override; /* > 0: replaces lambda_MTPA [Vs]; 0 = automatic */
   float omega_r;         /* electrical rotor speed [rad/s] */
-  float v_dc;            /* [V] */
+  float v_lin;           /* linear voltage range of the modulator [V] */
   float i_ds, i_qs;      /* stator-flux frame currents at tau [A] */
 } dfvc_refs_in_t;
 
@@ -76,7 +78,7 @@ int dfvc_refs_init(dfvc_refs_t *r, const dfvc_refs_cfg_t *cfg);
 void dfvc_refs_reset(dfvc_refs_t *r);
 /* Eqs. (22)-(23) only (useful to callers and tests). */
 float dfvc_refs_lambda_mtpa(const dfvc_refs_t *r, float torque_ref);
-float dfvc_refs_lambda_vlim(const dfvc_refs_t *r, float v_dc, float omega_r, float i_ds,
+float dfvc_refs_lambda_vlim(const dfvc_refs_t *r, float v_lin, float omega_r, float i_ds,
                             float i_qs);
 void dfvc_refs_update(const dfvc_refs_t *r, const dfvc_refs_in_t *in, dfvc_refs_out_t *out);
 

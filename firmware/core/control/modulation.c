@@ -1,12 +1,14 @@
 /*
  * modulation.c - min-max zero-sequence injection (equivalent to centred
- * SVPWM) normalised by the measured DC-link voltage.
+ * SVPWM) normalised by the measured DC-link voltage, inside the duty range
+ * [d_min, d_max] the board publishes (hal_caps_t).
  *
- * v0 = -(max + min)/2, duty_x = 1/2 + (v_x + v0) / v_dc. The linear range is
- * the circle inscribed in the hexagon, |v| <= v_dc/sqrt(3); beyond it the
- * request is scaled onto that circle keeping its angle. The applied vector
- * is reconstructed from the duties (Clarke of duty*v_dc; the common mode
- * drops out), so rounding and clamping are reported honestly.
+ * v0 = -(max + min)/2, duty_x = (d_min + d_max)/2 + (v_x + v0) / v_dc. The
+ * linear range is the circle inscribed in the hexagon the duty range
+ * allows, |v| <= (d_max - d_min) v_dc/sqrt(3); beyond it the request is
+ * scaled onto that circle keeping its angle. The applied vector is
+ * reconstructed from the duties (Clarke of duty*v_dc; the common mode drops
+ * out), so rounding and clamping are reported honestly.
  */
 #include "control/modulation.h"
 
@@ -16,12 +18,13 @@
 
 #define MOD_INV_SQRT3 0.577350269189626f
 
-float modulation_v_max(float v_dc) {
-  return (v_dc > 0.0f && fd_isfinite(v_dc)) ? v_dc * MOD_INV_SQRT3 : 0.0f;
+float modulation_v_max(float v_dc, float d_min, float d_max) {
+  const float span = d_max - d_min;
+  return (v_dc > 0.0f && fd_isfinite(v_dc) && span > 0.0f) ? span * v_dc * MOD_INV_SQRT3 : 0.0f;
 }
 
-static float mod_clamp01(float x) {
-  return (x > 1.0f) ? 1.0f : ((x < 0.0f) ? 0.0f : x);
+static float mod_clamp(float x, float lo, float hi) {
+  return (x > hi) ? hi : ((x < lo) ? lo : x);
 }
 
 static float mod_max3(float a, float b, float c) {
@@ -34,9 +37,10 @@ static float mod_min3(float a, float b, float c) {
   return (m < c) ? m : c;
 }
 
-modulation_out_t modulation_minmax(ab_t v_ref, float v_dc) {
-  modulation_out_t out = {{0.5f, 0.5f, 0.5f}, {0.0f, 0.0f}, 1};
-  const float v_max = modulation_v_max(v_dc);
+modulation_out_t modulation_minmax(ab_t v_ref, float v_dc, float d_min, float d_max) {
+  const float mid = 0.5f * (d_min + d_max);
+  modulation_out_t out = {{mid, mid, mid}, {0.0f, 0.0f}, 1};
+  const float v_max = modulation_v_max(v_dc, d_min, d_max);
   if (!(v_max > 0.0f) || !fd_isfinite(v_ref.alpha) || !fd_isfinite(v_ref.beta)) {
     return out; /* safe output: zero average voltage, flagged */
   }
@@ -55,9 +59,9 @@ modulation_out_t modulation_minmax(ab_t v_ref, float v_dc) {
   const abc_t v = frames_clarke_inv(v_ref);
   const float v_cm = -0.5f * (mod_max3(v.a, v.b, v.c) + mod_min3(v.a, v.b, v.c));
   const float inv_vdc = 1.0f / v_dc;
-  out.duty[0] = mod_clamp01(0.5f + (v.a + v_cm) * inv_vdc);
-  out.duty[1] = mod_clamp01(0.5f + (v.b + v_cm) * inv_vdc);
-  out.duty[2] = mod_clamp01(0.5f + (v.c + v_cm) * inv_vdc);
+  out.duty[0] = mod_clamp(mid + (v.a + v_cm) * inv_vdc, d_min, d_max);
+  out.duty[1] = mod_clamp(mid + (v.b + v_cm) * inv_vdc, d_min, d_max);
+  out.duty[2] = mod_clamp(mid + (v.c + v_cm) * inv_vdc, d_min, d_max);
   const abc_t v_pole = {out.duty[0] * v_dc, out.duty[1] * v_dc, out.duty[2] * v_dc};
   out.v_applied = frames_clarke(v_pole);
   return out;

@@ -13,15 +13,18 @@
 #include "math/frames.h"
 
 typedef struct {
-  float duty[3];  /* duty cycles of phases a, b, c in [0, 1] */
+  float duty[3];  /* duty cycles of phases a, b, c in [d_min, d_max] */
   ab_t v_applied; /* average voltage vector these duties apply [V] */
   int saturated;  /* 1 when the request was scaled to the linear limit */
 } modulation_out_t;
 
-/* Largest voltage amplitude in the linear range. */
-float modulation_v_max(float v_dc);
-/* v_ref: alpha-beta voltage reference [V]; v_dc > 0. A non-positive or
- * non-finite v_dc gives 50 % duties and v_applied = 0. */
-modulation_out_t modulation_minmax(ab_t v_ref, float v_dc);
+/* Largest voltage amplitude in the linear range of duties [d_min, d_max]:
+ * (d_max - d_min) v_dc / sqrt(3). */
+float modulation_v_max(float v_dc, float d_min, float d_max);
+/* v_ref: alpha-beta voltage reference [V]; v_dc > 0; duties stay inside
+ * [d_min, d_max] (0 <= d_min < d_max <= 1, the board's range). A
+ * non-positive or non-finite v_dc gives duties at the middle of the range
+ * and v_applied = 0. */
+modulation_out_t modulation_minmax(ab_t v_ref, float v_dc, float d_min, float d_max);
 
 #endif

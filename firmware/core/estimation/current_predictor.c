@@ -11,11 +11,11 @@
 
 int current_predictor_init(current_predictor_t *p, const current_predictor_cfg_t *cfg) {
   memset(p, 0, sizeof(*p));
-  if (!fd_isfinite(cfg->lambda_m) || cfg->lambda_m < 0.0f ||
+  if (cfg->machine == NULL ||
       (cfg->mode != CURRENT_PREDICTOR_EXACT && cfg->mode != CURRENT_PREDICTOR_EQ21)) {
     return -1;
   }
-  if (spm_discrete_init(&p->disc, cfg->rs, cfg->ls, cfg->ts) != 0) {
+  if (spm_discrete_init(&p->disc, cfg->machine->rs, machine_ls(cfg->machine), cfg->ts) != 0) {
     return -1;
   }
   p->cfg = *cfg;
@@ -40,7 +40,7 @@ ab_t current_predictor_step_sc(const current_predictor_t *p, const current_predi
   y.alpha = m->ks * i.alpha + m->b_ab * v.alpha;
   y.beta = m->ks * i.beta + m->b_ab * v.beta;
 
-  const float wl = w->omega_r * p->cfg.lambda_m;
+  const float wl = w->omega_r * p->cfg.machine->lambda_m;
   if (p->cfg.mode == CURRENT_PREDICTOR_EQ21) {
     /* - j omega_r lambda_m e^{j theta_r}, held at tau over the period, eq. (21) */
     y.alpha += m->b_ab * (wl * sc_r.s);

@@ -21,6 +21,7 @@
 #define FD_ESTIMATION_CURRENT_PREDICTOR_H
 
 #include "math/frames.h"
+#include "model/machine.h"
 #include "model/spm_discrete.h"
 
 typedef enum {
@@ -29,7 +30,8 @@ typedef enum {
 } current_predictor_mode_t;
 
 typedef struct {
-  float rs, ls, lambda_m, ts; /* [Ohm], [H], [Vs], [s] */
+  const machine_t *machine; /* SPM: Rs, Ls = machine_ls(), lambda_m */
+  float ts;                 /* [s] */
   current_predictor_mode_t mode;
 } current_predictor_cfg_t;
 
@@ -38,7 +40,7 @@ typedef struct {
   spm_discrete_t disc; /* k_s, (1 - k_s)/Rs computed once */
 } current_predictor_t;
 
-/* Returns 0, or -1 for invalid parameters (rs, ls, ts > 0, lambda_m >= 0). */
+/* Returns 0, or -1 for invalid parameters (no machine, ts <= 0). */
 int current_predictor_init(current_predictor_t *p, const current_predictor_cfg_t *cfg);
 /* No dynamic state: recomputes the discretisation constants from cfg. */
 void current_predictor_reset(current_predictor_t *p);

@@ -27,9 +27,7 @@ static float flux_observer_polar(ab_t x, sincos_t *sc) {
 int flux_observer_init(flux_observer_t *o, const flux_observer_cfg_t *cfg) {
   memset(o, 0, sizeof(*o));
   const flux_observer_cfg_t *c = cfg;
-  if (!(fd_isfinite(c->rs) && c->rs >= 0.0f && fd_isfinite(c->ls) && c->ls > 0.0f &&
-        fd_isfinite(c->lambda_m) && c->lambda_m >= 0.0f && fd_isfinite(c->pole_pairs) &&
-        c->pole_pairs > 0.0f && fd_isfinite(c->ts) && c->ts > 0.0f && fd_isfinite(c->omega_c) &&
+  if (!(c->machine != NULL && fd_isfinite(c->ts) && c->ts > 0.0f && fd_isfinite(c->omega_c) &&
         c->omega_c >= 0.0f && fd_isfinite(c->omega_s_bw) && c->omega_s_bw > 0.0f)) {
     return -1;
   }
@@ -55,11 +53,13 @@ void flux_observer_update(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, float
 void flux_observer_update_sc(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, float theta_r,
                              sincos_t scr, float omega_r, flux_observer_out_t *out) {
   const flux_observer_cfg_t *c = &o->cfg;
+  const machine_t *m = c->machine;
 
   /* current model, Rubino 2020, eq. (2) in (alpha, beta) */
+  const float ls = machine_ls(m);
   ab_t lcm;
-  lcm.alpha = c->ls * i.alpha + c->lambda_m * scr.c;
-  lcm.beta = c->ls * i.beta + c->lambda_m * scr.s;
+  lcm.alpha = ls * i.alpha + m->lambda_m * scr.c;
+  lcm.beta = ls * i.beta + m->lambda_m * scr.s;
   if (!o->started) {
     o->lambda_hat = lcm;
   }
@@ -73,7 +73,7 @@ void flux_observer_update_sc(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, fl
   /* Fig. 3: back-EMF (resistive drop averaged over the period) plus the
    * current-model correction omega_c (lambda_cm - lambda_hat), then the one-step
    * prediction, Rubino 2020, eqs. (19)-(20) */
-  const float hr = 0.5f * c->rs;
+  const float hr = 0.5f * m->rs;
   ab_t e;
   e.alpha = v.alpha - hr * (i.alpha + i_next.alpha) + c->omega_c * (lcm.alpha - lh.alpha);
   e.beta = v.beta - hr * (i.beta + i_next.beta) + c->omega_c * (lcm.beta - lh.beta);
@@ -98,7 +98,7 @@ void flux_observer_update_sc(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, fl
   out->delta = frames_wrap_pi(out->theta_s - theta_r);
   /* stator-flux frame currents and torque, eq. (16) */
   out->i_dqs = frames_park(i, out->sc_s);
-  out->torque = 1.5f * c->pole_pairs * out->lambda_s * out->i_dqs.q;
+  out->torque = 1.5f * m->pole_pairs * out->lambda_s * out->i_dqs.q;
 
   o->lambda_hat = ln;
   o->started = 1;

@@ -31,13 +31,13 @@
 #define FD_ESTIMATION_FLUX_OBSERVER_H
 
 #include "math/frames.h"
+#include "model/machine.h"
 
 typedef struct {
-  float rs, ls, lambda_m; /* [Ohm], [H], [Vs] */
-  float pole_pairs;
-  float ts;         /* [s] */
-  float omega_c;    /* crossover (observer gain) [rad/s]; paper: 125 */
-  float omega_s_bw; /* low-pass bandwidth of the omega_s derivative [rad/s] */
+  const machine_t *machine; /* SPM: Rs, Ls = machine_ls(), lambda_m, p */
+  float ts;                 /* [s] */
+  float omega_c;            /* crossover (observer gain) [rad/s]; paper: 125 */
+  float omega_s_bw;         /* low-pass bandwidth of the omega_s derivative [rad/s] */
 } flux_observer_cfg_t;
 
 typedef struct {
@@ -65,8 +65,8 @@ typedef struct {
   float torque;  /* 3/2 p lambda_s i_qs [N m] */
 } flux_observer_out_t;
 
-/* Returns 0, or -1 for invalid parameters (rs >= 0, ls > 0, lambda_m >= 0,
- * pole_pairs > 0, ts > 0, omega_c >= 0, omega_s_bw > 0, all finite). */
+/* Returns 0, or -1 for invalid parameters (no machine, ts > 0, omega_c >= 0,
+ * omega_s_bw > 0, all finite). */
 int flux_observer_init(flux_observer_t *o, const flux_observer_cfg_t *cfg);
 void flux_observer_reset(flux_observer_t *o);
 /* i: measured current at t [A]; i_next: predicted current at t+1 [A];

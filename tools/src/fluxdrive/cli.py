@@ -215,6 +215,13 @@ def build_parser() -> argparse.ArgumentParser:
                    help="do not force the applied voltage (docs/pil.md)")
     p.add_argument("--timeout", type=float, default=600.0, help="per QEMU run [s]")
     p.set_defaults(func=lambda a: __import__("fluxdrive.pil").pil.main(a))
+    p = sub.add_parser("params", help="the drive's parameter table into the DBC, the tools' "
+                       "table and docs/parameters.md")
+    p.add_argument("--sil", metavar="PATH", help=sil_help)
+    mx = p.add_mutually_exclusive_group()
+    mx.add_argument("--write", action="store_true", help="regenerate the files that differ")
+    mx.add_argument("--check", action="store_true", help="exit 1 when a file differs")
+    p.set_defaults(func=lambda a: __import__("fluxdrive.params").params.main(a))
     from fluxdrive.can.cli import add_parser as add_can_parser  # fluxdrive can ...
 
     add_can_parser(sub)

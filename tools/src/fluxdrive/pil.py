@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fluxdrive import sil
+from fluxdrive import params, sil
 from fluxdrive.errors import FluxdriveError
 
 ENV_ELF = "FLUXDRIVE_PIL_ELF"
@@ -57,17 +57,18 @@ HEADER = np.dtype(
         ("version", "<u4"),
         ("header_size", "<u4"),
         ("config_size", "<u4"),
+        ("caps_size", "<u4"),
         ("in_size", "<u4"),
         ("out_size", "<u4"),
         ("count", "<u4"),
         ("flags", "<u4"),
     ]
 )
-MAGIC, VERSION, FORCE_APPLIED = 0x52534946, 1, 1
+MAGIC, VERSION, FORCE_APPLIED = 0x52534946, 2, 1
 OUT = np.dtype(
     [("duty", "<f4", 3), ("flags", "<u4"), ("faults", "<u4"), ("state", "<u4")]
 )
-IN_SIZE = 72
+IN_SIZE = 240
 
 #: Blocks of the per-function share: the first pattern that a function name
 #: starts with (or equals) names its block.
@@ -121,7 +122,7 @@ def read_record(path: Path) -> tuple[bytes, np.ndarray, np.ndarray]:
         raise FluxdriveError(f"{path}: not an isr_stream v{VERSION} file", exit_code=1)
     if int(h["in_size"]) != IN_SIZE or int(h["out_size"]) != OUT.itemsize:
         raise FluxdriveError(f"{path}: record layout differs from this tool's", exit_code=1)
-    start = int(h["header_size"]) + int(h["config_size"])
+    start = int(h["header_size"]) + int(h["config_size"]) + int(h["caps_size"])
     n = int(h["count"])
     rec = np.dtype([("in", f"V{IN_SIZE}"), ("out", OUT)])
     body = np.frombuffer(data, rec, count=n, offset=start)
@@ -448,7 +449,7 @@ def tools_available() -> None:
         raise FluxdriveError(f"{QEMU} not found", hint="apt-get install qemu-system-arm")
 
 
-LAWS = ("foc", "pi_dfvc", "db_dfvc")
+LAWS = tuple(params.law_ids())
 
 
 def main(args) -> int:

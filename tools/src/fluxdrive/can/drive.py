@@ -29,13 +29,15 @@ from typing import Any, Callable
 
 import can
 
+from fluxdrive import params
 from fluxdrive.can.protocol import Protocol, Reply
 from fluxdrive.errors import FluxdriveError
 
-TELEMETRY = ("TM_SPEED", "TM_TORQUE", "TM_PHASE", "TM_DQ", "TM_FLUX")
-MODES = {"torque": 0, "speed": 1, "current": 2}
-LAWS = {"foc": 0, "pi_dfvc": 1, "db_dfvc": 2}
-KEEP_ENABLE, KEEP_MODE, KEEP_LAW = 2, 3, 3
+TELEMETRY = ("TM_SPEED", "TM_TORQUE", "TM_PHASE", "TM_DQ", "TM_FLUX")  # TM_CPU: 100 ms, ask for it
+# names and numbers from the firmware's tables (fluxdrive params)
+MODES = params.mode_ids()
+LAWS = params.law_ids()
+KEEP_ENABLE = KEEP_MODE = KEEP_LAW = params.keep()
 
 
 class DriveError(FluxdriveError):
@@ -191,8 +193,8 @@ class Drive:
         v = self.read_telemetry(timeout, ("STATUS",))
         st = {k: v[k] for k in ("state", "ctrl_mode", "ctrl_law", "faults", "v_dc", "timeout_ramp",
                                 "cmd_enabled", "err_count")}
-        names = {0: "idle", 1: "offset_cal", 2: "run", 3: "fault"}
-        st["state_name"] = names.get(int(st["state"]), str(st["state"]))
+        st["state_name"] = params.state_names().get(int(st["state"]), str(st["state"]))
+        st["fault_names"] = params.fault_names(int(st["faults"]))
         return st
 
     def wait_for(self, predicate: Callable[[dict[str, float]], bool], timeout: float = 5.0) -> dict[str, float]:

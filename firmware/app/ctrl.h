@@ -1,0 +1,118 @@
+/*
+ * ctrl.h - the control laws behind one table. A law is a row
+ * {name, capabilities, check, init, reset, step} (ctrl_law_t); its state
+ * lives in a union (one law runs at a time, RAM of the smallest board); the
+ * table (ctrl_laws.c) has one row per entry of DRIVE_LAW_LIST
+ * (drive_enums.h). Adding a law: its module (law_*.c with its row), one
+ * line in DRIVE_LAW_LIST and one in ctrl_laws.c (docs/architecture.md).
+ *
+ * The drive hands a law one sample (currents, angle, speed, the voltage
+ * available, references) and gets the alpha-beta voltage for the next
+ * period, the currents it expects over that period (dead-time
+ * compensation), the torque it can deliver now and telemetry.
+ */
+#ifndef FLUXDRIVE_CTRL_H
+#define FLUXDRIVE_CTRL_H
+
+#include <stdint.h>
+
+#include "control/current_ctrl.h"
+#include "control/deadtime_comp.h"
+#include "control/dfvc.h"
+#include "drive_config.h"
+#include "math/frames.h"
+#include "model/machine.h"
+
+/* Law-specific telemetry (zero where a law has no such quantity). */
+typedef struct {
+  float flux;     /* stator flux amplitude estimate [Vs] */
+  float flux_ref; /* [Vs] */
+  float delta;    /* load angle [rad] */
+  float i_ds;     /* stator-flux frame currents [A] */
+  float i_qs;
+  float i_qs_ref;
+  float torque;  /* torque estimate [N m] */
+  float obs_err; /* |observer flux - current-model flux| [Vs] (flux laws) */
+} ctrl_telemetry_t;
+
+typedef struct {
+  ab_t i_ab;      /* measured currents at the sampling instant [A] */
+  ab_t v_applied; /* voltage applied over the period ending at the sample [V] */
+  float theta_e;  /* electrical angle at the sampling instant [rad] */
+  float omega_e;  /* electrical speed [rad/s] */
+  float v_lin;    /* voltage amplitude the modulator can apply linearly now [V] */
+  drive_mode_t mode;
+  float torque_ref;     /* [N m] */
+  float id_ref, iq_ref; /* current mode [A] */
+  float flux_ref;       /* 0 = automatic [Vs] */
+} ctrl_in_t;
+
+typedef struct {
+  ab_t v_ref;                   /* voltage for the next period [V] */
+  float torque_min, torque_max; /* torque the law can deliver now [N m] */
+  uint32_t fault;               /* non-zero: the law asks for the gates to be disabled */
+  dq_t i_dq;                    /* rotor frame currents [A] */
+  ab_t i_pred;                  /* currents expected over the next period [A] */
+  ctrl_telemetry_t tm;
+} ctrl_out_t;
+
+/* What every law reads: the parameter set and the machine in force (owned
+ * by the drive, which re-initialises the law when either changes) and the
+ * output timing. */
+typedef struct {
+  const drive_config_t *cfg;
+  const machine_t *machine;
+  float t_out; /* from the current sample to the centre of the output interval [s] */
+} ctrl_setup_t;
+
+typedef union {
+  current_ctrl_t foc;
+  dfvc_t dfvc;
+} ctrl_state_t;
+
+enum {
+  CTRL_CAP_CURRENT = 1u << 0, /* runs DRIVE_MODE_CURRENT */
+  CTRL_CAP_FLUX = 1u << 1,    /* takes a flux reference, reports flux and load angle */
+};
+
+typedef struct {
+  const char *name;
+  uint32_t caps; /* CTRL_CAP_* */
+  /* NULL when the law can serve this machine and parameter set, else why not */
+  const char *(*check)(const ctrl_setup_t *su);
+  /* 0, or -1 when the law refuses the parameters (state unusable) */
+  int (*init)(ctrl_state_t *s, const ctrl_setup_t *su);
+  void (*reset)(ctrl_state_t *s); /* on enable: observers and integrators restart */
+  /* one period; writes every field of *out */
+  void (*step)(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *in, ctrl_out_t *out);
+} ctrl_law_t;
+
+typedef struct {
+  ctrl_setup_t su;
+  drive_law_t law;        /* the law whose state is initialised */
+  const ctrl_law_t *impl; /* its row */
+  ctrl_state_t st;
+  uint32_t available; /* bit per law: check() passed */
+  deadtime_comp_t dtc;
+} ctrl_t;
+
+/* The row of a law (NULL out of range). */
+const ctrl_law_t *ctrl_law(drive_law_t law);
+/* Binds cfg and machine, checks every law (ctrl_t.available) and
+ * initialises `law`. 0, or -1 with *reason when that law is unavailable or
+ * refuses the parameters. */
+int ctrl_init(ctrl_t *c, const drive_config_t *cfg, const machine_t *machine, float t_out,
+              drive_law_t law, const char **reason);
+/* Why `law` cannot run (NULL: it can). */
+const char *ctrl_unavailable(const ctrl_t *c, drive_law_t law);
+/* Switches to `law` (gates off): initialises its state. 0 or -1. */
+int ctrl_select(ctrl_t *c, drive_law_t law);
+/* Resets the law in force (on enable). */
+void ctrl_reset(ctrl_t *c);
+void ctrl_step(ctrl_t *c, const ctrl_in_t *in, ctrl_out_t *out);
+/* Predictive dead-time compensation (Rubino 2020, Fig. 8) with the
+ * currents the law expects over the period the duties act: the duty
+ * change it adds per phase. */
+void ctrl_deadtime_delta(const ctrl_t *c, const ctrl_out_t *out, float delta[3]);
+
+#endif

@@ -1,0 +1,83 @@
+/*
+ * drive_enums.h - the drive's named values, each an X-macro list that is
+ * the single source of the C enum, its names (logs, JSON, scenario keys)
+ * and, through `fluxdrive-sil --print-params`, the DBC value tables and
+ * the Python tools (tools/src/fluxdrive/params.py). Values are the list
+ * order (fault bits: 1 << order); append, never reorder.
+ */
+#ifndef FLUXDRIVE_DRIVE_ENUMS_H
+#define FLUXDRIVE_DRIVE_ENUMS_H
+
+/* clang-format off */
+/* Control laws: X(ENUM, name, doc). The law table (ctrl_laws.c) has one
+ * row per entry, in this order. */
+#define DRIVE_LAW_LIST(X)                                                                  \
+  X(FOC, foc, "rotor-frame PI current control; torque mode on the MTPA trajectory")       \
+  X(PI_DFVC, pi_dfvc, "PI direct flux vector control of SPM machines (Rubino 2020, IV.7)") \
+  X(DB_DFVC, db_dfvc, "deadbeat direct flux vector control of SPM machines (Rubino 2020)")
+
+/* Control modes: X(ENUM, name, doc). */
+#define DRIVE_MODE_LIST(X)                                                    \
+  X(TORQUE, torque, "torque reference")                                       \
+  X(SPEED, speed, "the speed loop produces the torque reference")            \
+  X(CURRENT, current, "d-q current references (laws with CTRL_CAP_CURRENT)")
+
+/* Drive states: X(ENUM, name, doc). */
+#define DRIVE_STATE_LIST(X)                                                          \
+  X(IDLE, idle, "gates off, waiting for enable")                                    \
+  X(OFFSET_CAL, offset_cal, "gates off, averaging the current-sensor offsets")      \
+  X(RUN, run, "gates on, control law active")                                       \
+  X(FAULT, fault, "gates off, causes latched until cleared")                        \
+  X(ALIGN, align, "gates on, d current along the assumed axis (position sources)")
+
+/* Fault causes, bit n = list position n: X(ENUM, name, doc). */
+#define DRIVE_FAULT_LIST(X)                                                                     \
+  X(OVERCURRENT, overcurrent, "a phase current sample above i_trip")                           \
+  X(OVERVOLTAGE, overvoltage, "DC link above v_dc_max")                                        \
+  X(UNDERVOLTAGE, undervoltage, "DC link below v_dc_min while the gates are on")               \
+  X(OVERSPEED, overspeed, "speed estimate above speed_trip")                                   \
+  X(HW_OVERCURRENT, hw_overcurrent, "the board's break input tripped (gates off in hardware)") \
+  X(OFFSET, offset, "a current-sensor offset beyond offset_max")                               \
+  X(CONTROL, control, "the control law reported a fault (non-finite state, flux collapse)")    \
+  X(CMD_TIMEOUT, cmd_timeout, "no command or heartbeat from the host in time (CAN)")           \
+  X(SAMPLE, sample, "a non-finite or incomplete ADC sample set")                               \
+  X(POSITION, position, "the position source is invalid or implausible")                       \
+  X(LOST_CONTROL, lost_control, "loss of control: current, load angle, tracking or observer")  \
+  X(WATCHDOG, watchdog, "the MCU was reset by the watchdog (latched at start-up)")             \
+  X(CONFIG, config, "the parameter set in force was refused (law unavailable)")
+
+/* Position sources: X(ENUM, name, doc). The source table (pos_sources.c)
+ * has one row per entry, in this order. */
+#define POS_SOURCE_LIST(X) \
+  X(ENCODER, encoder, "encoder (quantised, half-count corrected) and PLL")
+/* clang-format on */
+
+#define DRIVE_ENUM_LAW(E, n, d)       DRIVE_LAW_##E,
+#define DRIVE_ENUM_MODE(E, n, d)      DRIVE_MODE_##E,
+#define DRIVE_ENUM_STATE(E, n, d)     DRIVE_STATE_##E,
+#define DRIVE_ENUM_FAULT_BIT(E, n, d) DRIVE_FAULT_BIT_##E,
+#define DRIVE_ENUM_POS(E, n, d)       POS_SOURCE_##E,
+
+typedef enum { DRIVE_LAW_LIST(DRIVE_ENUM_LAW) DRIVE_LAW_COUNT } drive_law_t;
+typedef enum { DRIVE_MODE_LIST(DRIVE_ENUM_MODE) DRIVE_MODE_COUNT } drive_mode_t;
+typedef enum { DRIVE_STATE_LIST(DRIVE_ENUM_STATE) DRIVE_STATE_COUNT } drive_state_t;
+typedef enum { DRIVE_FAULT_LIST(DRIVE_ENUM_FAULT_BIT) DRIVE_FAULT_COUNT } drive_fault_bit_t;
+typedef enum { POS_SOURCE_LIST(DRIVE_ENUM_POS) POS_SOURCE_COUNT } pos_source_t;
+
+/* Fault masks: DRIVE_FAULT_OVERCURRENT = 1u << DRIVE_FAULT_BIT_OVERCURRENT ... */
+#define DRIVE_ENUM_FAULT_MASK(E, n, d) DRIVE_FAULT_##E = 1u << DRIVE_FAULT_BIT_##E,
+enum { DRIVE_FAULT_LIST(DRIVE_ENUM_FAULT_MASK) DRIVE_FAULT_ALL = (1u << DRIVE_FAULT_COUNT) - 1u };
+
+/* Names ("?" out of range). */
+const char *drive_law_name(unsigned law);
+const char *drive_mode_name(unsigned mode);
+const char *drive_state_name(unsigned state);
+const char *drive_pos_source_name(unsigned src);
+/* Name of the lowest set fault bit, "none" for 0. */
+const char *drive_fault_name(unsigned fault_bits);
+/* Index of name in a list, or -1. */
+int drive_law_index(const char *name);
+int drive_mode_index(const char *name);
+int drive_pos_source_index(const char *name);
+
+#endif

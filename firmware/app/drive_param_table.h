@@ -1,0 +1,122 @@
+/*
+ * drive_param_table.h - THE parameter table of the drive: one row per
+ * parameter, the single source of
+ *   - the struct drive_config_t and its defaults   (drive_config.h/.c)
+ *   - the range check of every field                (drive_config.c)
+ *   - access by id for CAN                          (drive_params.c)
+ *   - the ISR stream's configuration words          (sil/runner/isr_stream.h)
+ *   - the scenario keys and their ranges            (sil/runner/scenario.c)
+ *   - the DBC value table of reply_param, the Python tools' table and the
+ *     docs table: generated from `fluxdrive-sil --print-params` by
+ *     `fluxdrive params --write` (tools/src/fluxdrive/params.py); the CTest
+ *     test params/agreement fails when they differ from this file.
+ * Relations between fields (i_trip >= i_max, ...) are drive_config_check's
+ * (drive_config.c), each reported under the field it names.
+ *
+ * Columns: X(id, name, type, unit, default, min, max, access, scenario, doc)
+ *   id        CAN parameter number (PARAM_REQ.param_id), unique, < 64
+ *   type      F32 float | U16 uint16_t | U32 uint32_t | LAW drive_law_t |
+ *             MODE drive_mode_t | POS pos_source_t (enums: min 0, max count-1)
+ *   access    RO read only | IDLE written with the gates off | LIVE also
+ *             while running (applied by the ISR at its next period)
+ *   scenario  the scenario key that sets it ("section.key"); keys outside
+ *             "controller" are converted by their section (docs/scenarios.md)
+ * Adding a parameter: one row here, then use cfg->name where it acts, and
+ * run `fluxdrive params --write` (docs/architecture.md, walk-through).
+ */
+#ifndef FLUXDRIVE_DRIVE_PARAM_TABLE_H
+#define FLUXDRIVE_DRIVE_PARAM_TABLE_H
+
+/* clang-format off */
+#define DRIVE_PARAM_TABLE(X)                                                                                 \
+  /* machine: the controller's estimates (may differ from the plant) */                                  \
+  X(1,  pole_pairs,     F32,  "",       21.0f,       1.0f,    100.0f,   IDLE, "machine.pole_pairs",        \
+    "pole pairs (an integer)")                                                                              \
+  X(2,  rs,             F32,  "Ohm",    7.1f,        1e-5f,   1e3f,     IDLE, "machine.rs",                \
+    "stator phase resistance")                                                                              \
+  X(3,  ld,             F32,  "H",      0.057f,      1e-7f,   10.0f,    IDLE, "machine.ld",                \
+    "d-axis inductance (d on the PM flux)")                                                                 \
+  X(4,  lq,             F32,  "H",      0.057f,      1e-7f,   10.0f,    IDLE, "machine.lq",                \
+    "q-axis inductance")                                                                                    \
+  X(5,  lambda_m,       F32,  "Vs",     0.19f,       0.0f,    10.0f,    IDLE, "machine.lambda_m",          \
+    "PM flux linkage, peak per phase (0: reluctance machine)")                                              \
+  X(6,  inertia,        F32,  "kg m^2", 0.021f,      1e-9f,   1e3f,     IDLE, "mechanics.j",               \
+    "inertia, for the speed-loop design")                                                                   \
+  /* limits and protections */                                                                              \
+  X(10, i_max,          F32,  "A",      3.5355339f,  1e-3f,   1e4f,     IDLE, "controller.i_max",          \
+    "current amplitude limit (peak)")                                                                       \
+  X(11, torque_max,     F32,  "N m",    20.0f,       0.0f,    1e5f,     LIVE, "controller.torque_max",     \
+    "torque reference limit")                                                                               \
+  X(12, speed_max,      F32,  "rad/s",  125.66371f,  0.0f,    1e5f,     LIVE, "controller.speed_max",      \
+    "speed reference limit, mechanical")                                                                    \
+  X(13, v_margin,       F32,  "",       0.95f,       0.1f,    1.0f,     IDLE, "controller.v_margin",       \
+    "usable fraction of the modulator's linear voltage range")                                              \
+  X(14, i_trip,         F32,  "A",      7.0710678f,  1e-3f,   1e4f,     LIVE, "controller.i_trip",         \
+    "phase current trip (any sample)")                                                                      \
+  X(15, v_dc_max,       F32,  "V",      400.0f,      1.0f,    1e4f,     LIVE, "controller.v_dc_max",       \
+    "DC-link overvoltage trip")                                                                             \
+  X(16, v_dc_min,       F32,  "V",      150.0f,      0.0f,    1e4f,     LIVE, "controller.v_dc_min",       \
+    "DC-link undervoltage trip while the gates are on")                                                     \
+  X(17, speed_trip,     F32,  "rad/s",  157.07964f,  1e-3f,   1e5f,     LIVE, "controller.speed_trip",     \
+    "overspeed trip, mechanical")                                                                           \
+  X(18, offset_max,     F32,  "A",      0.5f,        0.0f,    1e3f,     LIVE, "controller.offset_max",     \
+    "largest acceptable current-sensor offset")                                                             \
+  X(19, delta_max,      F32,  "rad",    1.3962634f,  0.1f,    1.5f,     IDLE, "controller.delta_max",      \
+    "load-angle (MTPV) limit of the DFVC laws")                                                             \
+  X(20, vsd_max,        F32,  "V",      60.0f,       0.0f,    1e4f,     IDLE, "controller.vsd_max",        \
+    "flux-axis voltage limit v_sd,max of the DFVC laws")                                                    \
+  X(21, flux_min,       F32,  "Vs",     0.038f,      0.0f,    10.0f,    IDLE, "controller.flux_min",       \
+    "minimum flux reference of the DFVC laws")                                                              \
+  X(22, lc_time,        F32,  "s",      0.002f,      1e-4f,   1.0f,     LIVE, "controller.lc_time",        \
+    "loss of control: time the current or load-angle condition may persist before the trip")               \
+  X(23, lc_current,     F32,  "",       1.15f,       1.0f,    3.0f,     LIVE, "controller.lc_current",     \
+    "loss of control: current amplitude above lc_current * i_max")                                          \
+  X(24, lc_delta,       F32,  "rad",    0.17453293f, 0.0f,    1.5f,     LIVE, "controller.lc_delta",       \
+    "loss of control: load angle beyond delta_max + lc_delta (DFVC laws)")                                  \
+  X(25, lc_track,       F32,  "",       0.5f,        0.05f,   10.0f,    LIVE, "controller.lc_track",       \
+    "loss of control: torque, flux or observer error above lc_track times its scale")                      \
+  X(26, lc_track_time,  F32,  "s",      0.02f,       1e-4f,   1.0f,     LIVE, "controller.lc_track_time",  \
+    "loss of control: time a tracking condition may persist (a reversal at the voltage limit takes ms)")   \
+  /* controller */                                                                                          \
+  X(30, current_bw,     F32,  "rad/s",  2000.0f,     1.0f,    1e5f,     IDLE, "controller.current_bw",     \
+    "FOC current-loop bandwidth")                                                                           \
+  X(31, speed_bw,       F32,  "rad/s",  60.0f,       0.1f,    1e5f,     LIVE, "controller.speed_bw",       \
+    "speed-loop bandwidth")                                                                                 \
+  X(32, accel_max,      F32,  "rad/s^2", 125.66371f, 1e-3f,   1e7f,     LIVE, "controller.accel_max",      \
+    "speed reference slew limit, mechanical")                                                               \
+  X(33, pll_bw,         F32,  "rad/s",  400.0f,      1.0f,    1e5f,     IDLE, "controller.pll_bw",         \
+    "position-source PLL bandwidth")                                                                        \
+  X(34, flux_obs_wc,    F32,  "rad/s",  125.0f,      0.0f,    1e5f,     IDLE, "controller.flux_obs_wc",    \
+    "hybrid flux observer crossover omega_c (Rubino 2020)")                                                 \
+  X(35, dfvc_flux_bw,   F32,  "rad/s",  6283.1853f,  1.0f,    1e5f,     IDLE, "controller.dfvc_flux_bw",   \
+    "PI-DFVC flux-loop bandwidth")                                                                          \
+  X(36, dfvc_iqs_bw,    F32,  "rad/s",  6283.1853f,  1.0f,    1e5f,     IDLE, "controller.dfvc_iqs_bw",    \
+    "PI-DFVC i_qs-loop bandwidth")                                                                          \
+  X(37, enc_offset,     F32,  "rad",    0.0f,        -7.0f,   7.0f,     IDLE, "controller.enc_offset",     \
+    "electrical angle at encoder zero (found by the alignment when align_time > 0)")                        \
+  X(38, pos_source,     POS,  "",       0.0f,        0.0f,    0.0f,     IDLE, "controller.pos_source",     \
+    "position source")                                                                                      \
+  X(39, enc_cpr,        U32,  "",       4096.0f,     0.0f,    16777216.0f, IDLE, "sensors.encoder_cpr",    \
+    "encoder counts per mechanical revolution (0: not quantised)")                                          \
+  X(44, align_time,     F32,  "s",      0.0f,        0.0f,    10.0f,    IDLE, "controller.align_time",     \
+    "alignment before run: d current along the assumed axis for this long (0: no alignment)")               \
+  X(45, align_current,  F32,  "A",      1.0f,        0.0f,    1e4f,     IDLE, "controller.align_current",  \
+    "d current of the alignment")                                                                           \
+  X(46, pos_err_max,    F32,  "rad",    0.5f,        0.01f,   3.2f,     LIVE, "controller.pos_err_max",    \
+    "position fault: measured angle this far (electrical) from the PLL's prediction")                       \
+  /* timing and calibration */                                                                              \
+  X(40, ts,             F32,  "s",      6.25e-5f,    1e-6f,   1e-2f,    RO,   "inverter.pwm_frequency",    \
+    "PWM and ISR period")                                                                                   \
+  X(41, slow_div,       U16,  "",       16.0f,       1.0f,    1000.0f,  RO,   "controller.slow_div",       \
+    "speed loop and telemetry every slow_div ISRs")                                                         \
+  X(42, dead_time,      F32,  "s",      1e-6f,       0.0f,    1e-4f,    IDLE, "inverter.dead_time",        \
+    "inverter dead time, for the compensation")                                                             \
+  X(43, offset_samples, U16,  "",       256.0f,      1.0f,    60000.0f, IDLE, "controller.offset_samples", \
+    "ISRs averaged by the current-offset calibration")                                                      \
+  X(50, law,            LAW,  "",       0.0f,        0.0f,    0.0f,     RO,   "controller.law",            \
+    "control law at start-up (CMD_STATE changes the law in force)")                                         \
+  X(51, mode,           MODE, "",       0.0f,        0.0f,    0.0f,     RO,   "controller.mode",           \
+    "control mode at start-up (CMD_STATE changes the mode in force)")
+/* clang-format on */
+
+#endif

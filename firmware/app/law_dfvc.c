@@ -1,0 +1,104 @@
+/*
+ * law_dfvc.c - the DFVC laws of Rubino 2020 for SPM machines behind the law
+ * table: PI-DFVC (section IV.7) and DB-DFVC share one state (control/dfvc.h,
+ * observer, predictor, references) and differ in the voltage law. They
+ * serve isotropic PM machines only: L_s = L_d with L_q within 10 % of it
+ * (machine_ls()), and lambda_m > 0 (the load-angle relation (26) and the
+ * MTPA flux (22) divide by it); on any other machine the law is
+ * unavailable with that reason, and the drive runs the other laws.
+ */
+#include <stddef.h>
+
+#include "ctrl_laws.h"
+#include "math/fd_math.h"
+
+/* Largest relative difference of L_q from L_d an SPM law accepts. */
+#define DFVC_ISOTROPY_TOL 0.1f
+
+static const char *dfvc_check(const ctrl_setup_t *su) {
+  const machine_t *m = su->machine;
+  if (m->kind != MACHINE_LINEAR) {
+    return "DFVC of Rubino 2020 needs a linear machine model";
+  }
+  if (!(m->lambda_m > 0.0f)) {
+    return "DFVC of Rubino 2020 needs a PM machine (lambda_m > 0)";
+  }
+  if (!machine_is_isotropic(m, DFVC_ISOTROPY_TOL)) {
+    return "DFVC of Rubino 2020 needs an isotropic (SPM) machine: |Lq - Ld| > 10 % of Ld";
+  }
+  if (!(su->cfg->flux_min > 0.0f)) {
+    return "DFVC needs flux_min > 0";
+  }
+  return NULL;
+}
+
+static int dfvc_law_init(ctrl_state_t *s, const ctrl_setup_t *su) {
+  const drive_config_t *cfg = su->cfg;
+  dfvc_cfg_t d;
+  dfvc_cfg_defaults(&d, su->machine);
+  d.ts = cfg->ts;
+  d.omega_c = cfg->flux_obs_wc;
+  d.i_max = cfg->i_max;
+  d.delta_max = cfg->delta_max;
+  d.v_sd_max = cfg->vsd_max;
+  d.lambda_min = cfg->flux_min;
+  d.lambda_collapse = 0.5f * cfg->flux_min;
+  d.v_margin = cfg->v_margin;
+  d.pi_bw_flux = cfg->dfvc_flux_bw;
+  d.pi_bw_iqs = cfg->dfvc_iqs_bw;
+  /* the output rotation: from theta_s(tau+1) to the centre of the interval
+   * the voltage acts, t_out after the sample (dfvc.h, rot_advance) */
+  d.rot_advance = fd_clampf(su->t_out / cfg->ts - 1.0f, 0.0f, 1.0f);
+  return dfvc_init(&s->dfvc, &d);
+}
+
+static void dfvc_law_reset(ctrl_state_t *s) {
+  dfvc_reset(&s->dfvc);
+}
+
+static void dfvc_law_step(dfvc_law_t law, ctrl_state_t *s, const ctrl_setup_t *su,
+                          const ctrl_in_t *in, ctrl_out_t *out) {
+  const dfvc_in_t din = {
+      .law = law,
+      .i_ab = in->i_ab,
+      .v_ab_applied = in->v_applied,
+      .theta_r = in->theta_e,
+      .omega_r = in->omega_e,
+      .v_lin = in->v_lin,
+      .torque_ref = in->torque_ref,
+      .lambda_ref = in->flux_ref,
+  };
+  dfvc_out_t d;
+  dfvc_step(&s->dfvc, &din, &d);
+  out->v_ref = d.v_ab_ref;
+  out->i_pred = d.i_ab_mid;
+  /* rotor-frame currents: from the law's sin/cos of theta_e unless it
+   * faulted before computing them */
+  out->i_dq = ((d.fault & (DFVC_FAULT_INPUT | DFVC_FAULT_STATE)) != 0u)
+                  ? frames_park(in->i_ab, frames_sincos(in->theta_e))
+                  : d.i_dq_r;
+  out->torque_min = fd_maxf(d.torque_min, -su->cfg->torque_max);
+  out->torque_max = fd_minf(d.torque_max, su->cfg->torque_max);
+  out->fault = d.fault;
+  out->tm = (ctrl_telemetry_t){.flux = d.lambda_s,
+                               .flux_ref = d.lambda_ref,
+                               .delta = d.delta,
+                               .i_ds = d.i_ds,
+                               .i_qs = d.i_qs,
+                               .i_qs_ref = d.i_qs_ref,
+                               .torque = d.torque,
+                               .obs_err = d.obs_err};
+}
+
+static void db_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *in, ctrl_out_t *out) {
+  dfvc_law_step(DFVC_LAW_DEADBEAT, s, su, in, out);
+}
+
+static void pi_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *in, ctrl_out_t *out) {
+  dfvc_law_step(DFVC_LAW_PI, s, su, in, out);
+}
+
+const ctrl_law_t ctrl_law_pi_dfvc = {"pi_dfvc",     CTRL_CAP_FLUX,  dfvc_check,
+                                     dfvc_law_init, dfvc_law_reset, pi_step};
+const ctrl_law_t ctrl_law_db_dfvc = {"db_dfvc",     CTRL_CAP_FLUX,  dfvc_check,
+                                     dfvc_law_init, dfvc_law_reset, db_step};

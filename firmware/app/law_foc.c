@@ -1,0 +1,72 @@
+/*
+ * law_foc.c - FOC: rotor-frame PI current control with decoupling, the
+ * papers' baseline (control/current_ctrl.h). Torque mode follows the MTPA
+ * trajectory of the machine model (model/machine.h: i_d = 0 on an SPM
+ * machine, i_d < 0 on interior-PM and reluctance machines). The voltage
+ * computed from the samples acts over the next period: the inverse Park
+ * uses the angle extrapolated to the centre of that interval (t_out after
+ * the current sample, from the HAL's timestamps).
+ */
+#include <math.h>
+#include <stddef.h>
+
+#include "ctrl_laws.h"
+#include "math/fd_math.h"
+
+/* Symmetric clamp that lets NaN through, so that a non-finite reference
+ * ends in the finiteness check (a fault), never at a limit. */
+static float clamp_sym_nan(float x, float lim) {
+  return x > lim ? lim : (x < -lim ? -lim : x);
+}
+
+static const char *foc_check(const ctrl_setup_t *su) {
+  (void)su;
+  return NULL; /* any machine: current mode always, torque mode on its MTPA */
+}
+
+static int foc_init(ctrl_state_t *s, const ctrl_setup_t *su) {
+  const current_ctrl_cfg_t ccfg = {su->machine, su->cfg->current_bw, su->cfg->ts};
+  current_ctrl_init(&s->foc, &ccfg);
+  return 0;
+}
+
+static void foc_reset(ctrl_state_t *s) {
+  current_ctrl_reset(&s->foc);
+}
+
+static void foc_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *in,
+                     ctrl_out_t *out) {
+  const machine_t *m = su->machine;
+  const float i_max = su->cfg->i_max;
+  const sincos_t sc = frames_sincos(in->theta_e);
+  const dq_t i = frames_park(in->i_ab, sc);
+  const float t_lim = fd_minf(su->cfg->torque_max, machine_mtpa_torque(m, i_max));
+  dq_t i_ref;
+  if (in->mode == DRIVE_MODE_CURRENT) {
+    i_ref = (dq_t){in->id_ref, in->iq_ref};
+  } else {
+    i_ref = machine_mtpa_current(m, clamp_sym_nan(in->torque_ref, t_lim));
+  }
+  const float mag = sqrtf(i_ref.d * i_ref.d + i_ref.q * i_ref.q);
+  if (mag > i_max) {
+    i_ref.d *= i_max / mag;
+    i_ref.q *= i_max / mag;
+  }
+  const float v_max = su->cfg->v_margin * in->v_lin;
+  const dq_t v = current_ctrl_update(&s->foc, i_ref, i, in->omega_e, v_max);
+  const sincos_t sc_next = frames_sincos(in->theta_e + in->omega_e * su->t_out);
+  out->v_ref = frames_park_inv(v, sc_next);
+  out->i_dq = i;
+  /* Expected current over the next period: the reference (the loop tracks
+   * it), rotated to the centre of that period. */
+  out->i_pred = frames_park_inv(i_ref, sc_next);
+  out->torque_min = -t_lim;
+  out->torque_max = t_lim;
+  out->fault = 0u;
+  out->tm = (ctrl_telemetry_t){0};
+  out->tm.torque = machine_torque(m, i);
+  const dq_t flux = machine_flux(m, i);
+  out->tm.flux = sqrtf(flux.d * flux.d + flux.q * flux.q);
+}
+
+const ctrl_law_t ctrl_law_foc = {"foc", CTRL_CAP_CURRENT, foc_check, foc_init, foc_reset, foc_step};

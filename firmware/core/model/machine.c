@@ -1,0 +1,101 @@
+/*
+ * machine.c - the linear machine behind the machine_t interface.
+ */
+#include "model/machine.h"
+
+#include <math.h>
+
+#include "math/fd_math.h"
+
+/* Newton steps of the MTPA inversion (machine_mtpa_current): from the
+ * starting point below, 4 steps reach float resolution over the whole
+ * range (tests/core/test_machine.c checks the residual). */
+#define MACHINE_MTPA_NEWTON 4
+
+int machine_init_linear(machine_t *m, float pole_pairs, float rs, float ld, float lq,
+                        float lambda_m) {
+  const float z = fd_zero_if_finite(pole_pairs) + fd_zero_if_finite(rs) + fd_zero_if_finite(ld) +
+                  fd_zero_if_finite(lq) + fd_zero_if_finite(lambda_m);
+  if (!(fd_isfinite(z) && pole_pairs >= 1.0f && rs > 0.0f && ld > 0.0f && lq > 0.0f &&
+        lambda_m >= 0.0f)) {
+    return -1;
+  }
+  *m = (machine_t){MACHINE_LINEAR, pole_pairs, rs, ld, lq, lambda_m};
+  return 0;
+}
+
+dq_t machine_flux(const machine_t *m, dq_t i) {
+  return (dq_t){m->ld * i.d + m->lambda_m, m->lq * i.q};
+}
+
+dq_t machine_current(const machine_t *m, dq_t lambda) {
+  return (dq_t){(lambda.d - m->lambda_m) / m->ld, lambda.q / m->lq};
+}
+
+machine_ldq_t machine_inductance(const machine_t *m, dq_t i) {
+  (void)i; /* linear: independent of the operating point */
+  return (machine_ldq_t){m->ld, 0.0f, 0.0f, m->lq};
+}
+
+float machine_torque(const machine_t *m, dq_t i) {
+  const dq_t l = machine_flux(m, i);
+  return 1.5f * m->pole_pairs * (l.d * i.q - l.q * i.d);
+}
+
+float machine_pm_flux(const machine_t *m) {
+  return m->lambda_m;
+}
+
+int machine_is_isotropic(const machine_t *m, float rel_tol) {
+  return fabsf(m->lq - m->ld) <= rel_tol * m->ld;
+}
+
+/* MTPA of the linear machine at current amplitude I (d lambda_d/d i_d = Ld,
+ * dL = Lq - Ld): i_d = (lambda_m - s) / (4 dL), s = sqrt(lambda_m^2 +
+ * 8 dL^2 I^2), written without the cancellation at small dL:
+ * i_d = -2 dL I^2 / (lambda_m + s); i_q = sqrt(I^2 - i_d^2) >= 0. */
+static dq_t mtpa_at(const machine_t *m, float i_amp) {
+  const float dl = m->lq - m->ld;
+  const float s = sqrtf(m->lambda_m * m->lambda_m + 8.0f * dl * dl * i_amp * i_amp);
+  const float den = m->lambda_m + s;
+  const float id = den > 0.0f ? -2.0f * dl * i_amp * i_amp / den : 0.0f;
+  return (dq_t){id, sqrtf(fd_maxf(i_amp * i_amp - id * id, 0.0f))};
+}
+
+float machine_mtpa_torque(const machine_t *m, float i_amp) {
+  return machine_torque(m, mtpa_at(m, fd_maxf(i_amp, 0.0f)));
+}
+
+dq_t machine_mtpa_current(const machine_t *m, float t) {
+  const float k = 1.5f * m->pole_pairs;
+  const float dl = m->lq - m->ld;
+  const float ta = fabsf(t);
+  if (!fd_isfinite(t) || !(m->lambda_m > 0.0f || fabsf(dl) > 0.0f)) {
+    return (dq_t){0.0f, 0.0f};
+  }
+  /* Start from the larger of the two asymptotes of T(I): the PM torque
+   * k lambda_m I and the reluctance torque k |dL| I^2 / 2; T(I) lies above
+   * both, so Newton on the convex T(I) - |t| approaches from above. */
+  float i_amp = m->lambda_m > 0.0f ? ta / (k * m->lambda_m) : 0.0f;
+  if (fabsf(dl) > 0.0f) {
+    i_amp = fd_maxf(i_amp, sqrtf(2.0f * ta / (k * fabsf(dl))));
+  }
+  if (fabsf(dl) > 0.0f && ta > 0.0f) {
+    for (int n = 0; n < MACHINE_MTPA_NEWTON; ++n) {
+      /* dT/dI along MTPA is the partial derivative at a fixed current
+       * angle (dT/dbeta = 0 there): k (lambda_m i_q + 2 (Ld - Lq) i_d i_q) / I */
+      const dq_t i = mtpa_at(m, i_amp);
+      const float slope = k * (m->lambda_m * i.q - 2.0f * dl * i.d * i.q) / fd_maxf(i_amp, 1e-30f);
+      const float err = machine_torque(m, i) - ta;
+      i_amp = slope > 0.0f ? fd_maxf(i_amp - err / slope, 0.0f) : i_amp;
+    }
+  }
+  dq_t i = mtpa_at(m, i_amp);
+  i.q = t < 0.0f ? -i.q : i.q;
+  return i;
+}
+
+dq_t machine_voltage_ss(const machine_t *m, dq_t i, float we) {
+  const dq_t l = machine_flux(m, i);
+  return (dq_t){m->rs * i.d - we * l.q, m->rs * i.q + we * l.d};
+}

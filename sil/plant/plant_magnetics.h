@@ -1,0 +1,60 @@
+/*
+ * plant_magnetics.h - the machine's magnetic model in the plant: the one
+ * place where flux linkages (the integration state, rotor frame) and
+ * currents are related. Everything else in the plant (both inverter
+ * models, the diode logic, the current cache, the sensors) goes through
+ * these functions:
+ *   plant_mag_current   i_dq(lambda_dq)
+ *   plant_mag_jacobian  G = d i_dq / d lambda_dq (the inverse incremental
+ *                       inductance matrix) at lambda_dq
+ *   plant_mag_flux0     lambda_dq at zero current (the PM flux)
+ *   plant_mag_l_min     the smallest incremental inductance (step sizing)
+ * PLANT_MAG_LINEAR: lambda_d = Ld i_d + lambda_m, lambda_q = Lq i_q (d on
+ * the magnet). A flux map (saturation, cross-saturation) is one more kind
+ * behind the same four functions.
+ */
+#ifndef FD_PLANT_MAGNETICS_H
+#define FD_PLANT_MAGNETICS_H
+
+typedef enum { PLANT_MAG_LINEAR = 0 } plant_mag_kind_t;
+
+typedef struct {
+  plant_mag_kind_t kind;
+  double lambda_m;       /* lambda_d at zero current [Vs] */
+  double inv_ld, inv_lq; /* 1/Ld, 1/Lq [1/H] */
+} plant_mag_t;
+
+/* The model of a linear machine (ld, lq > 0). */
+static inline plant_mag_t plant_mag_linear(double ld, double lq, double lambda_m) {
+  plant_mag_t g = {PLANT_MAG_LINEAR, lambda_m, 1.0 / ld, 1.0 / lq};
+  return g;
+}
+
+static inline void plant_mag_current(const plant_mag_t *g, double lambda_d, double lambda_q,
+                                     double *i_d, double *i_q) {
+  *i_d = (lambda_d - g->lambda_m) * g->inv_ld;
+  *i_q = lambda_q * g->inv_lq;
+}
+
+/* jac[r][c] = d i_r / d lambda_c, r, c in {d, q}. */
+static inline void plant_mag_jacobian(const plant_mag_t *g, double lambda_d, double lambda_q,
+                                      double jac[2][2]) {
+  (void)lambda_d;
+  (void)lambda_q;
+  jac[0][0] = g->inv_ld;
+  jac[0][1] = 0.0;
+  jac[1][0] = 0.0;
+  jac[1][1] = g->inv_lq;
+}
+
+static inline void plant_mag_flux0(const plant_mag_t *g, double *lambda_d, double *lambda_q) {
+  *lambda_d = g->lambda_m;
+  *lambda_q = 0.0;
+}
+
+static inline double plant_mag_l_min(const plant_mag_t *g) {
+  const double gmax = g->inv_ld > g->inv_lq ? g->inv_ld : g->inv_lq;
+  return 1.0 / gmax;
+}
+
+#endif

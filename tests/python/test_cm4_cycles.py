@@ -297,6 +297,30 @@ def test_walker_loop_and_bus_waits() -> None:
     assert both.cycles(prog) == 28 + 6  # the longer alternative
 
 
+def test_walker_calls_veneer_and_single_register_pop() -> None:
+    prog = cm.parse_objdump(listing(
+        (0x500, "caller", [
+            (4, "str.w lr, [sp, #-4]!"),  # 500  1: push {lr}
+            (4, "bl 510 <__leaf_veneer>"),  # 504  3
+            (4, "ldr.w pc, [sp], #4"),  # 508  4 (2 + P): pop {pc}
+            (4, "nop"),
+        ]),
+        (0x510, "__leaf_veneer", [
+            (4, "ldr.w pc, [pc]"),  # 510  4: to 0x08000100 (flash)
+            (4, ".word 0x08000101"),
+        ]),
+        (0x08000100, "leaf", [
+            (2, "bx lr"),  # 3
+        ]),
+    ))
+    p = cm.walk(prog, 0x500, lambda i, k, n: None)
+    assert p.pcs == [0x500, 0x504, 0x510, 0x08000100, 0x508]
+    assert cm.sequence_cycles(prog, p.pcs) == 1 + 3 + 4 + 3 + 4
+    assert p.bus == 0  # ART hit
+    worst = cm.walk(prog, 0x500, lambda i, k, n: None, worst_flash=True)
+    assert worst.bus == cm.FLASH_WS  # one flash line entered
+
+
 # ------------------------------------------------------------ real images
 @pytest.mark.skipif(not PIL_ELF.is_file(), reason="PIL image not built (preset cortex-m4f)")
 def test_pil_image_fully_classified() -> None:

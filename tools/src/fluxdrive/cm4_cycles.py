@@ -782,6 +782,21 @@ class _State:
             if not isinstance(v, int):
                 raise FluxdriveError(f"walk: unknown bx target at 0x{ins.addr:08x}")
             return v & ~1
+        if ins.basereg == "sp" and ins.writeback and first and (b in _LOAD1 or b in _STORE1):
+            # single-register push/pop: str rt, [sp, #-4]! / ldr rt, [sp], #4
+            if ins.mem == "w":
+                stack.append(regs.get(first))
+                return None
+            v = stack.pop() if stack else None
+            if first == "pc":
+                if not isinstance(v, int):
+                    raise FluxdriveError(f"walk: unknown return address at 0x{ins.addr:08x}")
+                return v & ~1
+            if v is None:
+                regs.pop(first, None)
+            else:
+                regs[first] = v
+            return None
         if ins.mem == "r" and ins.base in _LOAD1 and first:
             a = self._addr(ins, regs)
             val: object = None

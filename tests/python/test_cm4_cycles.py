@@ -142,7 +142,7 @@ def test_model_constants() -> None:
         (2, 14, 3, 2, 1, 1, 12)
     assert (cm.EXC_ENTRY, cm.EXC_EXIT, cm.LAZY_FP_SAVE, cm.LAZY_FP_RESTORE) == (12, 12, 17, 17)
     assert cm.BUS_WAIT["AHB"] == (2, 1) and cm.BUS_WAIT["APB"] == (3, 2)
-    assert cm.BUDGET_CYCLES == 10625
+    assert cm.BUDGET_CYCLES == pil.BUDGET_CYCLES == 10625
 
 
 def test_docs_show_the_model_table() -> None:

@@ -209,8 +209,11 @@ def build_parser() -> argparse.ArgumentParser:
                    "(e.g. docs/benchmarks.md)")
     p.add_argument("--check-worst", type=_positive_int, metavar="N",
                    help="fail when the DB-DFVC worst case reaches N instructions")
-    p.add_argument("--cpi", type=float, default=1.2, help="cycles per instruction for the "
-                   "budget column (default 1.2)")
+    p.add_argument("--board-elf", metavar="PATH", help="board image (e.g. build/stm32g474/hal/"
+                   "stm32g4/fluxdrive-g474.elf): add the ISR wrapper, exception and board HAL "
+                   "(fluxdrive cycles-board) to a board estimate")
+    p.add_argument("--cpi", type=float, default=None, help="legacy: also show the worst case at "
+                   "this flat cycles/instruction (the report uses the cycle model)")
     p.add_argument("--free-running", action="store_true",
                    help="do not force the applied voltage (docs/pil.md)")
     p.add_argument("--timeout", type=float, default=600.0, help="per QEMU run [s]")
@@ -222,6 +225,12 @@ def build_parser() -> argparse.ArgumentParser:
     mx.add_argument("--write", action="store_true", help="regenerate the files that differ")
     mx.add_argument("--check", action="store_true", help="exit 1 when a file differs")
     p.set_defaults(func=lambda a: __import__("fluxdrive.params").params.main(a))
+
+    p = sub.add_parser("cycles-board", help="cycle bound of the board's ISR path outside "
+                       "drive_isr (wrapper, exception, register HAL)")
+    p.add_argument("elf", metavar="ELF", help="board image, e.g. "
+                   "build/stm32g474/hal/stm32g4/fluxdrive-g474.elf")
+    p.set_defaults(func=lambda a: __import__("fluxdrive.cm4_cycles").cm4_cycles.main_board(a))
     from fluxdrive.can.cli import add_parser as add_can_parser  # fluxdrive can ...
 
     add_can_parser(sub)

@@ -20,13 +20,14 @@ import json
 import os
 import shutil
 import subprocess
+import sys
 import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from fluxdrive import params, sil
+from fluxdrive import cm4_cycles, params, sil
 from fluxdrive.errors import FluxdriveError
 
 ENV_ELF = "FLUXDRIVE_PIL_ELF"
@@ -173,32 +174,78 @@ def run_qemu(elf: Path, workdir: Path, timeout: float) -> np.ndarray:
 class TraceResult:
     counts: list[int] = field(default_factory=list)  # per ISR, in order
     funcs: list[dict[str, int]] = field(default_factory=list)  # per ISR
+    cycles: list[int] = field(default_factory=list)  # per ISR: model cycles (cm4_cycles)
+    func_cycles: list[dict[str, int]] = field(default_factory=list)  # per ISR
+    unknown_pcs: set[bytes] = field(default_factory=set)  # executed PCs not in the listing
 
 
-def _parse_trace(stream, res: TraceResult) -> None:
-    """Stream parser: line = 'Trace 0: HOSTPTR [cs_base/pc/flags/cflags] SYMBOL'."""
+ISR_FUNC, ISR_CALLER = "drive_isr", "pil_step"
+
+
+def _parse_trace(stream, res: TraceResult, tab: dict) -> None:
+    """Stream parser: line = 'Trace 0: HOSTPTR [cs_base/pc/flags/cflags] SYMBOL'.
+
+    ``tab`` (cm4_cycles.trace_table of the traced ELF) maps the printed PC
+    to (seq cycles, jump cycles, fall-through PC, taken penalty, function).
+    An ISR runs from drive_isr's first line after a line in pil_step to
+    the next line in pil_step. Per line: one dict lookup; the instruction
+    costs its seq cycles when it is its predecessor's fall-through, else its
+    jump cycles plus the predecessor's taken-branch penalty. Counts and
+    cycles are running totals; per-function shares are booked when the
+    function changes (calls and returns), not per line."""
     in_isr = False
-    prev = b""
-    cur: dict[bytes, int] = {}
-    n = 0
+    prev = ""  # function of the previous line
+    nxt = b""  # fall-through PC of the previous instruction
+    pen = 0  # its penalty when the next PC is not nxt (taken branch)
+    n = cyc = 0  # running instructions / cycles over the whole trace
+    n0 = c0 = fn0 = fc0 = 0  # at the ISR's entry / the current function's entry
+    cur_n: dict[str, int] = {}
+    cur_c: dict[str, int] = {}
     for line in stream:
         j = line.rfind(b"] ")
         if j < 0:
             continue
-        s = line[j + 2:-1]
-        if s == b"drive_isr" and prev == b"pil_step":
-            in_isr, cur, n = True, {}, 0
-        elif s == b"pil_step" and in_isr:
-            in_isr = False
-            res.counts.append(n)
-            res.funcs.append({k.decode(): v for k, v in cur.items()})
-        if in_isr:
-            n += 1
-            cur[s] = cur.get(s, 0) + 1
-        prev = s
+        k = line[j - 26:j - 18]  # [cs_base/PC/flags/cflags]: each field 8 hex digits
+        try:
+            sc, jc, f_next, p, fn = tab[k]
+        except KeyError:
+            sc, jc, f_next, p, fn = tab[k] = _unknown_pc(line, j, k, res)
+        if k != nxt:
+            cyc += pen
+            sc = jc
+        if fn is not prev:
+            if in_isr:
+                cur_n[prev] = cur_n.get(prev, 0) + n - fn0
+                cur_c[prev] = cur_c.get(prev, 0) + cyc - fc0
+                if fn == ISR_CALLER:
+                    in_isr = False
+                    res.counts.append(n - n0)
+                    res.cycles.append(cyc - c0)
+                    res.funcs.append(cur_n)
+                    res.func_cycles.append(cur_c)
+            elif fn == ISR_FUNC and prev == ISR_CALLER:
+                in_isr = True
+                n0, c0, cur_n, cur_c = n, cyc, {}, {}
+            fn0, fc0, prev = n, cyc, fn
+        n += 1
+        cyc += sc
+        nxt, pen = f_next, p
 
 
-def run_qemu_trace(elf: Path, workdir: Path, timeout: float) -> tuple[TraceResult, np.ndarray]:
+def _unknown_pc(line: bytes, j: int, k: bytes, res: TraceResult) -> tuple:
+    """A PC the disassembly does not list: 1 cycle, function from QEMU's
+    symbol; reported (fluxdrive pil fails on it)."""
+    if line[j - 36:j - 35] != b"[":
+        raise FluxdriveError(f"unexpected QEMU trace line: {line[:120]!r}", exit_code=1)
+    res.unknown_pcs.add(k)
+    return (1, 1, b"", 0, sys.intern(line[j + 2:-1].decode(errors="replace")))
+
+
+def run_qemu_trace(elf: Path, workdir: Path, timeout: float,
+                   tab: dict | None = None) -> tuple[TraceResult, np.ndarray]:
+    """Traced replay; ``tab``: cm4_cycles.trace_table of ``elf`` (built when None)."""
+    if tab is None:
+        tab = cm4_cycles.trace_table(cm4_cycles.load_program(elf))
     fifo = workdir / "trace.fifo"
     fifo.unlink(missing_ok=True)
     os.mkfifo(fifo)
@@ -212,7 +259,7 @@ def run_qemu_trace(elf: Path, workdir: Path, timeout: float) -> tuple[TraceResul
     def reader() -> None:
         try:
             with open(fifo, "rb", buffering=1 << 22) as f:
-                _parse_trace(f, res)
+                _parse_trace(f, res, tab)
         except BaseException as exc:  # pragma: no cover - reported below
             err.append(exc)
 
@@ -233,6 +280,10 @@ def run_qemu_trace(elf: Path, workdir: Path, timeout: float) -> tuple[TraceResul
                              f"{msg.decode(errors='replace').strip()}", exit_code=1)
     if err:
         raise FluxdriveError(f"trace parser failed: {err[0]}", exit_code=1)
+    if res.unknown_pcs:
+        raise FluxdriveError(f"{len(res.unknown_pcs)} executed PCs are not in the disassembly of "
+                             f"{elf} (e.g. {sorted(res.unknown_pcs)[0].decode()}): the cycle "
+                             "model cannot price them", exit_code=1)
     return res, np.fromfile(out, OUT)
 
 
@@ -280,6 +331,32 @@ class Counts:
     worst_isr: int
     blocks: dict[str, float]  # mean instructions per ISR per block
     funcs: dict[str, float]
+    # Estimated Cortex-M4 cycles (cm4_cycles model) over the same ISRs
+    cycles_mean: float = 0.0
+    cycles_worst: int = 0
+    cycles_worst_isr: int = 0
+    block_cycles: dict[str, float] = field(default_factory=dict)  # mean per ISR
+    func_cycles: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def cpi(self) -> float:
+        return self.cycles_mean / self.mean if self.mean else 0.0
+
+    def stand_in_cycles(self) -> float:
+        """Mean cycles per ISR in the PIL replay HAL (the board runs its own)."""
+        return sum(v for f, v in self.func_cycles.items() if f in cm4_cycles.BOARD_HAL)
+
+
+def _mean_by(run: list[int], per_isr: list[dict[str, int]]) -> tuple[dict, dict]:
+    funcs: dict[str, int] = {}
+    for j in run:
+        for f, v in per_isr[j].items():
+            funcs[f] = funcs.get(f, 0) + v
+    blocks: dict[str, float] = {}
+    for f, v in funcs.items():
+        b = block_of(f)
+        blocks[b] = blocks.get(b, 0.0) + v / len(run)
+    return blocks, {f: v / len(run) for f, v in funcs.items()}
 
 
 def law_counts(tr: TraceResult, host: np.ndarray) -> Counts:
@@ -290,17 +367,16 @@ def law_counts(tr: TraceResult, host: np.ndarray) -> Counts:
         raise FluxdriveError("no ISR ran the control law in the traced window "
                              "(raise --isrs beyond the offset calibration)", exit_code=1)
     c = np.array([tr.counts[j] for j in run])
-    funcs: dict[str, int] = {}
-    for j in run:
-        for f, v in tr.funcs[j].items():
-            funcs[f] = funcs.get(f, 0) + v
-    blocks: dict[str, float] = {}
-    for f, v in funcs.items():
-        b = block_of(f)
-        blocks[b] = blocks.get(b, 0.0) + v / len(run)
+    blocks, funcs = _mean_by(run, tr.funcs)
     w = int(np.argmax(c))
-    return Counts(len(run), float(c.mean()), int(c[w]), run[w], blocks,
-                  {f: v / len(run) for f, v in funcs.items()})
+    out = Counts(len(run), float(c.mean()), int(c[w]), run[w], blocks, funcs)
+    if len(tr.cycles) >= n:
+        y = np.array([tr.cycles[j] for j in run])
+        wy = int(np.argmax(y))
+        out.cycles_mean, out.cycles_worst, out.cycles_worst_isr = float(y.mean()), int(y[wy]), \
+            run[wy]
+        out.block_cycles, out.func_cycles = _mean_by(run, tr.func_cycles)
+    return out
 
 
 # ------------------------------------------------------------------- run
@@ -341,7 +417,7 @@ def scenario_with_law(src: Path, law: str | None, dst: Path) -> str:
 
 
 def run_one(runner: Path, elf: Path, scenario: Path, law: str | None, isrs: int,
-            workdir: Path, force: bool, timeout: float) -> PilRun:
+            workdir: Path, force: bool, timeout: float, tab: dict | None = None) -> PilRun:
     workdir.mkdir(parents=True, exist_ok=True)
     scen = workdir / "scenario.json"
     law_name = scenario_with_law(scenario, law, scen)
@@ -359,7 +435,7 @@ def run_one(runner: Path, elf: Path, scenario: Path, law: str | None, isrs: int,
 
     n = min(isrs, len(body))
     write_pil_input(workdir / "pil_in.bin", head, body, n, force)
-    tr, traced_out = run_qemu_trace(elf, workdir, timeout)
+    tr, traced_out = run_qemu_trace(elf, workdir, timeout, tab)
     if len(tr.counts) != n:
         raise FluxdriveError(f"trace shows {len(tr.counts)} ISRs, replayed {n}", exit_code=1)
     exact = traced_out.tobytes() == pil_out[:n].tobytes()
@@ -367,7 +443,22 @@ def run_one(runner: Path, elf: Path, scenario: Path, law: str | None, isrs: int,
 
 
 # ---------------------------------------------------------------- report
-def format_report(runs: list[PilRun], isrs: int, cpi: float) -> str:
+def _pct(cycles: float) -> str:
+    return f"{100 * cycles / BUDGET_CYCLES:.0f} %"
+
+
+def board_estimate(c: Counts, board: cm4_cycles.BoardBound) -> tuple[float, float]:
+    """(typical, worst) cycles on the board: the PIL's drive_isr cycles with
+    its replay HAL replaced by the board HAL, plus the ISR wrapper and the
+    exception (typical with the PIL mean, worst with the PIL worst)."""
+    base = -c.stand_in_cycles()
+    t, w = board.typical, board.worst
+    return (c.cycles_mean + base + t.hal_cycles + t.wrapper_cycles,
+            c.cycles_worst + base + w.hal_cycles + w.wrapper_cycles)
+
+
+def format_report(runs: list[PilRun], isrs: int, cpi: float | None = None,
+                  board: cm4_cycles.BoardBound | None = None) -> str:
     lines = []
     for r in runs:
         a, c = r.agreement, r.counts
@@ -380,47 +471,90 @@ def format_report(runs: list[PilRun], isrs: int, cpi: float) -> str:
         )
         lines.append(
             f"instructions per ISR over {c.isrs} law ISRs (first {isrs} ISRs traced): mean "
-            f"{c.mean:.0f}, worst {c.worst} (ISR {c.worst_isr}); budget {BUDGET_CYCLES} cycles: "
-            f"{100 * c.worst * cpi / BUDGET_CYCLES:.0f} % at {cpi:g} cycles/instruction "
-            f"(worst case); traced outputs identical to untraced: {r.trace_exact}"
+            f"{c.mean:.0f}, worst {c.worst} (ISR {c.worst_isr}); traced outputs identical to "
+            f"untraced: {r.trace_exact}"
         )
+        lines.append(
+            f"estimated cycles (Cortex-M4 model, docs/pil.md): mean {c.cycles_mean:.0f}, worst "
+            f"{c.cycles_worst} (ISR {c.cycles_worst_isr}); {c.cpi:.2f} cycles/instruction; "
+            f"{_pct(c.cycles_mean)} mean / {_pct(c.cycles_worst)} worst of {BUDGET_CYCLES}"
+            + (f" (legacy {cpi:g} cycles/instruction: {_pct(c.worst * cpi)} worst)"
+               if cpi else "")
+        )
+        if board is not None:
+            bt, bw = board_estimate(c, board)
+            lines.append(
+                f"board estimate (PIL - replay HAL {c.stand_in_cycles():.0f} + board HAL + ISR "
+                f"wrapper and exception, `fluxdrive cycles-board`): typical {bt:.0f} "
+                f"({_pct(bt)}), worst {bw:.0f} ({_pct(bw)})"
+            )
+        lines.append("  instr/ISR  share  cycles/ISR  cyc/instr  block")
         for b, v in sorted(c.blocks.items(), key=lambda kv: -kv[1]):
-            lines.append(f"  {v:8.1f}  {100 * v / c.mean:5.1f} %  {b}")
+            y = c.block_cycles.get(b, 0.0)
+            cpi_b = y / v if v else 0.0
+            lines.append(f"  {v:8.1f}  {100 * v / c.mean:5.1f} %  {y:9.1f}  {cpi_b:8.2f}   {b}")
     return "\n".join(lines)
 
 
 SECTION = "## ISR instruction counts (PIL, QEMU mps2-an386)"
 
 
-def format_markdown(runs: list[PilRun], isrs: int, cpi: float, build: str) -> str:
+def format_markdown(runs: list[PilRun], isrs: int, cpi: float | None, build: str,
+                    board: cm4_cycles.BoardBound | None = None) -> str:
     out = [SECTION, ""]
     out.append(
         f"Measured by `fluxdrive pil` (docs/pil.md): the ISR inputs of a SIL run replayed on "
         f"the Cortex-M4F image in QEMU 7.2 `mps2-an386` (`{build}`), executed instructions "
         f"counted exactly from the `-singlestep -d exec,nochain` trace, from `drive_isr` "
         f"entry to its return, callees included, over the ISRs that ran the control law "
-        f"within the first {isrs} ISRs of each scenario. These are instructions, not cycles: "
-        f"the budget column assumes {cpi:g} cycles per instruction against "
-        f"{BUDGET_CYCLES} cycles per ISR (170 MHz / 16 kHz)."
+        f"within the first {isrs} ISRs of each scenario. The cycles are an **estimate**: "
+        f"every traced instruction priced with the Cortex-M4 cycle model of docs/pil.md "
+        f"(TRM instruction timings, zero wait states, taken branches from the traced PC "
+        f"sequence, P = {cm4_cycles.P}), against {BUDGET_CYCLES} cycles per ISR "
+        f"(170 MHz / 16 kHz). Not included: the board's ISR wrapper, exception entry/exit "
+        f"and register HAL (`fluxdrive cycles-board`{', below' if board else ''})."
     )
     out.append("")
-    out.append("| scenario | law | law ISRs | mean | worst | worst x "
-               f"{cpi:g} / {BUDGET_CYCLES} | duties max dev (full run) | ISRs compared |")
-    out.append("|---|---|---:|---:|---:|---:|---:|---:|")
+    legacy = f" worst x {cpi:g} (legacy) |" if cpi else ""
+    out.append("| scenario | law | law ISRs | instructions mean | instructions worst | "
+               "cycles mean | cycles worst | cycles/instr | budget mean | budget worst |"
+               f"{legacy} duties max dev (full run) | ISRs compared |")
+    out.append("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|" + ("---:|" if cpi else "")
+               + "---:|---:|")
     for r in runs:
         c, a = r.counts, r.agreement
         out.append(
             f"| {r.scenario} | {r.law} | {c.isrs} | {c.mean:.0f} | {c.worst} | "
-            f"{100 * c.worst * cpi / BUDGET_CYCLES:.0f} % | {a.max_duty_dev:.2g}"
-            f"{'' if a.ok else ' (FAIL)'} | {a.isrs} |"
+            f"{c.cycles_mean:.0f} | {c.cycles_worst} | {c.cpi:.2f} | {_pct(c.cycles_mean)} | "
+            f"{_pct(c.cycles_worst)} |" + (f" {_pct(c.worst * cpi)} |" if cpi else "")
+            + f" {a.max_duty_dev:.2g}{'' if a.ok else ' (FAIL)'} | {a.isrs} |"
         )
     out.append("")
-    out.append("Share of the mean per block (instructions per ISR, % of the mean):")
+    if board is not None:
+        t, w = board.typical, board.worst
+        out.append(
+            f"Board ISR path outside `drive_isr` (`fluxdrive cycles-board`, same model plus "
+            f"exception entry/exit with lazy FP stacking and bus wait states): wrapper "
+            f"{t.wrapper_cycles} cycles typical (ADC2 ready at the first check) / "
+            f"{w.wrapper_cycles} worst (wait loop exhausted, 200 checks); board HAL called by "
+            f"`drive_isr` {t.hal_cycles} / {w.hal_cycles} (replaces the PIL's replay HAL). "
+            f"Board estimate = PIL cycles - replay HAL + board HAL + wrapper:"
+        )
+        out.append("")
+        out.append("| scenario | law | board typical (PIL mean) | board worst (PIL worst) |")
+        out.append("|---|---|---:|---:|")
+        for r in runs:
+            bt, bw = board_estimate(r.counts, board)
+            out.append(f"| {r.scenario} | {r.law} | {bt:.0f} ({_pct(bt)}) | "
+                       f"{bw:.0f} ({_pct(bw)}) |")
+        out.append("")
+    out.append("Share of the mean per block (instructions per ISR, % of the mean; estimated "
+               "cycles per ISR):")
     out.append("")
     for r in runs:
         c = r.counts
         out.append(f"* {r.scenario} / {r.law}: " + "; ".join(
-            f"{b} {v:.0f} ({100 * v / c.mean:.0f} %)"
+            f"{b} {v:.0f} ({100 * v / c.mean:.0f} %, {c.block_cycles.get(b, 0.0):.0f} cyc)"
             for b, v in sorted(c.blocks.items(), key=lambda kv: -kv[1]) if v >= 0.5))
     out.append("")
     return "\n".join(out)
@@ -472,18 +606,33 @@ def main(args) -> int:
         if bad:
             raise FluxdriveError(f"unknown law {bad[0]!r}; use {', '.join(LAWS)}")
     out_dir = Path(args.out) if args.out else Path("out") / "pil"
+    prog = cm4_cycles.load_program(elf)
+    if prog.unclassified():
+        print(f"warning: instructions outside the cycle model (1 cycle assumed): "
+              f"{prog.unclassified()}")
+    tab = cm4_cycles.trace_table(prog)
+    board = None
+    if args.board_elf:
+        bp = Path(args.board_elf)
+        if not bp.is_file():
+            raise FluxdriveError(f"board image not found: {bp}",
+                                 hint="cmake --preset stm32g474 && cmake --build --preset "
+                                      "stm32g474")
+        board = cm4_cycles.bound_board(cm4_cycles.load_program(bp), str(bp))
+        print(cm4_cycles.format_board(board), flush=True)
+    cpi = getattr(args, "cpi", None)
     runs: list[PilRun] = []
     for sc in scenarios:
         for law in laws:
             t0 = time.monotonic()
             wd = out_dir / f"{sc.stem}-{law or 'scenario'}"
             r = run_one(runner, elf, sc, law, args.isrs, wd, not args.free_running,
-                        args.timeout)
+                        args.timeout, dict(tab))
             runs.append(r)
-            print(format_report([r], args.isrs, args.cpi), flush=True)
+            print(format_report([r], args.isrs, cpi, board), flush=True)
             print(f"  ({time.monotonic() - t0:.1f} s, files in {wd})", flush=True)
     build = "MinSizeRel -Os, -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard"
-    md = format_markdown(runs, args.isrs, args.cpi, build)
+    md = format_markdown(runs, args.isrs, cpi, build, board)
     if args.markdown:
         update_markdown(Path(args.markdown), md)
         print(f"markdown: {args.markdown} (section '{SECTION[3:]}')")

@@ -1,9 +1,19 @@
 """Acceptance of the deadbeat DFVC issue: Rubino et al. 2020 reproduced in SIL.
 
 Runs every sil/scenarios/rubino_*.json once (switching-level inverter with
-1 us dead time, 12-bit ADC, encoder) through fluxdrive-sil and asserts the
-paper's figures. `fluxdrive rubino2020` prints the same numbers as a table
+1 us dead time, 12-bit ADC, 4096-count encoder) through fluxdrive-sil,
+logging every sample (`--decimate 1`), and asserts the paper's figures.
+`fluxdrive rubino2020` prints the same numbers as a table
 (docs/results-rubino2020.md).
+
+Every limit comes from the paper (`rb.PAPER`, Table I and section IV) and
+the plant's true machine and DC link, never from what the drive prints: the
+capability the flux-weakening tests compare with is that of the plant's
+machine under i_max = 2.5 sqrt(2) A, v_s,max = v_dc / sqrt(3) and
+delta_max = 80 deg. Each bound states its source next to it.
+
+FLUXDRIVE_RUBINO_SCENARIOS=DIR runs the suite on the rubino_*.json of DIR
+instead (deliberate breaks: scripts/rubino-breaks.py).
 """
 
 from __future__ import annotations
@@ -17,87 +27,236 @@ import pytest
 from conftest import REAL_SIL, REPO_ROOT
 from fluxdrive import rubino2020 as rb
 
+P = rb.PAPER
+SCENARIO_DIR = Path(os.environ.get("FLUXDRIVE_RUBINO_SCENARIOS") or REPO_ROOT / "sil" / "scenarios")
+
+# ---------------------------------------------------------------- tolerances
+# The ADC resolves 2 x 17.7 A over 12 bits: 8.6 mA a step. The current bound
+# allows 4 steps (35 mA, 1 % of i_max): quantisation plus the extremes of the
+# 3 mA rms current noise over ~45 000 samples (4.5 sigma = 14 mA).
+I_TOL = 0.01
+# One encoder count is 360 deg * 21 / 4096 = 1.85 electrical degrees: the
+# resolution of the rotor angle the drive works with.
+ENC_COUNT_DEG = 360.0 * P.pole_pairs / 4096
+# Settling band of the small step: 5 % of it (0.05 N m), above the residual
+# switching ripple (0.014 N m rms at 10 N m, 100 rpm).
+STEP_BAND = 0.05
+# Band of the deadbeat claim (n_ref): 2 % of the reference.
+REF_BAND = 0.02
+# The 1 kHz PI loop's time constant in samples: tau = 1/(2 pi 1 kHz) = 2.55 Ts.
+TAU_PI = 1.0 / (2 * np.pi * P.pi_bw_hz * P.ts)
+
 
 @pytest.fixture(scope="module")
 def results(tmp_path_factory):
     if not REAL_SIL.is_file():
         pytest.skip(f"fluxdrive-sil not built ({REAL_SIL})")
-    runs, met = rb.run_all(REAL_SIL, REPO_ROOT / "sil" / "scenarios", tmp_path_factory.mktemp("rubino"))
+    runs, met = rb.run_all(REAL_SIL, SCENARIO_DIR, tmp_path_factory.mktemp("rubino"))
     print("\n" + rb.report(met))
     return runs, met
 
 
-def test_torque_step_deadbeat_vs_pi(results):
+def test_plant_is_the_paper_machine(results):
+    """The capability is computed from the plant's machine: it must be the
+    Table I machine, on the paper's DC link (section IV.A: about 310 V)."""
+    runs, _ = results
+    for key, r in runs.items():
+        m = rb.plant_machine(r.config)
+        assert (m.pole_pairs, m.rs, m.ld, m.lq, m.lambda_m) == pytest.approx(
+            (P.pole_pairs, P.rs, P.ls, P.ls, P.lambda_m)), key
+        assert r.config["v_dc"] == pytest.approx(P.v_dc), key
+        assert r.config["ts"] == pytest.approx(P.ts), key
+        # every sample logged
+        assert np.median(np.diff(r.log["t"])) == pytest.approx(P.ts), key
+
+
+def test_torque_step_deadbeat(results):
+    """Fig. 21: the DB-DFVC meets the 10 -> 11 N m target in one sampling
+    period. Counted from the first ISR that sees the step (k): the voltage
+    computed at k acts over [k+1, k+2), so the target can be met at k+2."""
+    _, met = results
+    db = met["step_db"]
+    f1, f2, f3 = db.frac
+    # nothing moves before the new voltage acts (band: the settling band)
+    assert abs(f1) <= STEP_BAND, db
+    # one beat gives what v_dc/sqrt(3) allows over one period (model from the
+    # paper's machine, frac_vlim), to within the settling band, and no more
+    # than the step plus the band
+    assert min(1.0, db.frac_vlim) - STEP_BAND <= f2 <= 1.0 + STEP_BAND, db
+    # the next beat completes it
+    assert 1.0 - STEP_BAND <= f3 <= 1.0 + STEP_BAND, db
+    # torque and i_qs within 2 % of their references at k+2
+    assert db.n_ref <= 2, db
+    # transient over at k+3 (around the response's own final value; against
+    # the reference: test_step_settles_on_the_reference)
+    assert db.n_final <= 3, db
+
+
+def test_torque_step_pi(results):
+    """Fig. 22: the PI-DFVC (1 kHz, feed-forward) needs eleven sampling
+    periods; ours counts from the ISR that sees the step, one more (12).
+    Band: +-4 samples, 1.5 time constants of the 1 kHz loop (tau = 2.55 Ts)."""
     _, met = results
     db, pi = met["step_db"], met["step_pi"]
-    # true torque and i_qs within 2 % of their references two samples after
-    # the step: one sample of computation delay + one deadbeat beat
-    assert db.n_ref <= 2, db
-    assert db.overshoot <= 0.02, db
-    # the PI-DFVC (1 kHz, feed-forward) settles several times slower
-    assert pi.n_step >= 3 * db.n_step, (db, pi)
+    lo, hi = P.pi_step_samples + 1 - 1.5 * TAU_PI, P.pi_step_samples + 1 + 1.5 * TAU_PI
+    assert lo <= pi.n_final <= hi, (pi, lo, hi)
+    assert pi.n_final >= 3 * db.n_final, (db, pi)
+    # and behind the deadbeat at k+2
+    assert pi.frac[1] < db.frac[1], (db, pi)
+
+
+@pytest.mark.xfail(strict=True, raises=AssertionError, reason=(
+    "static torque error of the truncating encoder (half a count, 0.92 deg "
+    "electrical): +0.068 N m (DB) and +0.080 N m (PI) after the 1 N m step, "
+    "+0.139 N m after the reversal, above the 0.05 N m band; with an ideal "
+    "encoder (2^20 counts) +0.001, +0.003, +0.010 N m and settled at k+3 / k+14"))
+def test_step_settles_on_the_reference(results):
+    """Settling against the torque reference, not the measured final value:
+    within 5 % of the step (0.05 N m) from k+3 on (DB, Fig. 21: one period),
+    from sample 12 + 4 on (PI, Fig. 22); the reversal (Fig. 13: "zero
+    steady-state error") within the same 0.05 N m."""
+    _, met = results
+    db, pi, rv = met["step_db"], met["step_pi"], met["reversal"]
+    failures = []
+    if db.n_settle > 3:
+        failures.append(f"DB settles at k+{db.n_settle} (static error {db.static_err:+.3f} N m)")
+    if pi.n_settle > P.pi_step_samples + 1 + 1.5 * TAU_PI:
+        failures.append(f"PI settles at k+{pi.n_settle} (static error {pi.static_err:+.3f} N m)")
+    if abs(rv.static_err) > STEP_BAND * abs(db.step):
+        failures.append(f"reversal static error {rv.static_err:+.3f} N m")
+    assert not failures, failures
 
 
 def test_torque_reversal(results):
+    """Figs. 12-13: -20 -> +20 N m at 100 rpm in the shortest possible rise
+    time, no overshoot, flux amplitude unchanged."""
     _, met = results
     rv = met["reversal"]
-    assert rv.overshoot <= 0.02, rv
-    assert rv.flux_dev <= 0.02, rv
+    # shortest rise: the model's minimum-time path at constant flux amplitude
+    # with |v| <= v_dc/sqrt(3) (n_rise_vlim); -1 sample for the model's
+    # Euler step, +10 % for the dead time (1 us of 62.5 us, 5 V of the
+    # ~135 V left over the back-EMF)
+    assert rv.n_rise_vlim - 1 <= rv.n_rise <= 1.1 * rv.n_rise_vlim, rv
+    # and stays within 2 % of the reference after that
+    assert rv.n_ref <= 1.1 * rv.n_rise_vlim, rv
+    # no overshoot beyond the 2 % band
+    assert rv.overshoot <= REF_BAND, rv
+    # flux unchanged: within 2 % (a 2 % flux error is a 2 % torque error)
+    assert rv.flux_dev <= REF_BAND, rv
 
 
-def test_flux_weakening_ramp(results):
+def test_fw_current_limit(results):
+    """Fig. 14: the current limit (25), i_max = 2.5 sqrt(2) A (Table I),
+    holds at every sample, and the drive uses it where the capability is
+    current-limited (between base speed and MTPV entry, 50 rpm clear)."""
+    _, met = results
+    fw = met["fw"]
+    assert fw.current_max <= P.i_max * (1 + I_TOL), (fw.current_max, P.i_max)
+    assert fw.current_lim_min >= P.i_max * (1 - I_TOL), (fw.current_lim_min, P.i_max)
+    assert not fw.faults
+
+
+def test_fw_load_angle_limit(results):
+    """Fig. 14: delta_max = 80 deg holds in MTPV and is reached there.
+    Mean over 8 ms: within one encoder count (1.85 deg) of 80 deg above
+    the MTPV entry (+50 rpm). Every sample: below 80 deg + 2 counts (one
+    count of angle error, one of noise: with an ideal encoder the 3 mA rms
+    current noise gives 0.46 deg rms, 4 sigma = 1.84 deg)."""
+    _, met = results
+    fw = met["fw"]
+    assert fw.delta_max_deg <= P.delta_max_deg + 2 * ENC_COUNT_DEG, fw.delta_max_deg
+    assert fw.delta_mtpv_min_deg >= P.delta_max_deg - ENC_COUNT_DEG, fw.delta_mtpv_min_deg
+    assert fw.delta_mtpv_max_deg <= P.delta_max_deg + ENC_COUNT_DEG, fw.delta_mtpv_max_deg
+
+
+# Torque against the true capability: at most 2 % above (1 % current
+# resolution, as I_TOL, + 1 % for the torque's static error, 0.7 % measured
+# at 20 N m), at least 97 % (1 % current resolution + 1.6 % of the voltage
+# that the 1 us dead time takes from a 62.5 us period).
+CAP_HI, CAP_LO = 1.02, 0.97
+
+
+def test_fw_torque_not_above_capability(results):
+    """Fig. 14: the torque never exceeds what the machine allows under the
+    paper's limits; flux-weakening ratio 1:5; constant power in MTPV."""
     runs, met = results
     fw = met["fw"]
-    i_max = runs["fw"].config["controller"]["i_max"]
-    # at least 90 % of what the current, voltage (with margin) and load-angle
-    # limits allow, at every speed (capability from the machine model)
-    assert fw.worst_ratio >= 0.90, fw.worst_ratio
-    assert fw.delta_max_deg <= 80.0 + 2.0, fw.delta_max_deg
-    # the limit holds to within the sampled-current ripple and ADC resolution
-    # (full scale 17.7 A over 12 bits: 8.6 mA a step; 1 % = 35 mA)
-    assert fw.current_max <= 1.01 * i_max, (fw.current_max, i_max)
-    assert 4.0 <= fw.fw_ratio <= 6.0, fw.fw_ratio  # paper: about 1:5
-    assert not fw.faults
-    # constant power in the MTPV region: within 5 % between 700 and 1200 rpm
+    assert fw.top_ratio <= CAP_HI, (fw.top_ratio, fw.top_ratio_rpm)
+    # flux-weakening ratio: the paper's 1:5 (Fig. 14) is the model's 1:4.52
+    # within its one significant figure; the SIL within 5 % of the model
+    # (flux ripple 0.8 % rms at 1200 rpm, base-speed flux read off a ramp)
+    assert abs(fw.fw_ratio / fw.fw_ratio_model - 1.0) <= 0.05, (fw.fw_ratio, fw.fw_ratio_model)
+    assert abs(fw.fw_ratio_model / P.fw_ratio - 1.0) <= 0.10, fw.fw_ratio_model
+    # at least the paper's 600 W (the model has no iron or mechanical losses)
+    assert fw.power_top >= P.fw_power_w, fw.power_top
+    # constant power in the MTPV region: within 5 % between 700 and 1195 rpm
     log = runs["fw"].log
-    rpm = log["speed"] * 30 / np.pi
-    p = log["torque"] * log["speed"]
+    rpm = log["speed"] / rb.RPM
+    k = np.ones(128) / 128  # 8 ms
+    p = np.convolve(log["torque"], k, mode="same") * log["speed"]
     hi = (rpm > 700) & (rpm < 1195)
-    assert np.percentile(p[hi], 5) >= 0.95 * np.median(p[hi])
+    assert np.min(p[hi]) >= 0.95 * np.median(p[hi])
+
+
+@pytest.mark.xfail(strict=True, raises=AssertionError, reason=(
+    "the drive keeps 5 % voltage margin (0.95 v_dc/sqrt(3)): 93.9 % of the "
+    "capability at 1200 rpm, 722 W of 766 W over 1000-1200 rpm"))
+def test_fw_torque_reaches_capability(results):
+    """Fig. 14: maximum torque at every speed, to within 3 % of the
+    capability under v_s,max = v_dc/sqrt(3) (section III, (23))."""
+    _, met = results
+    fw = met["fw"]
+    assert fw.worst_ratio >= CAP_LO, (fw.worst_ratio, fw.worst_ratio_rpm)
+    assert fw.power_top >= CAP_LO * fw.power_top_model, (fw.power_top, fw.power_top_model)
 
 
 def test_detuning_stable_with_power_loss(results):
+    """Figs. 19-20: L_s x1.2 and lambda_m x0.8 stay stable and lose power
+    in MTPV: "near to 17 %" (600 W -> 500 W, Fig. 19; lambda_m: "similar").
+    The watts are read off a figure: +-25 W each gives 8 % to 26 %."""
     runs, met = results
     fw = met["fw"]
-    i_max = runs["fw"].config["controller"]["i_max"]
+    p0, p1 = P.detuned_power_w
+    lo, hi = (p0 - p1 - 50) / (p0 + 25), (p0 - p1 + 50) / (p0 - 25)
     for key in ("fw_ls120", "fw_lm080"):
         d = met[key]
         assert not d.faults, (key, d.faults)
-        # stable: currents bounded (the controller's current estimate is
-        # detuned too, so the true limit may be exceeded by the model error)
-        assert d.current_max <= 1.1 * i_max, (key, d.current_max)
+        # the current limit holds on the true current (the ADC is not detuned)
+        assert d.current_max <= P.i_max * (1 + I_TOL), (key, d.current_max)
+        # the load angle stays below the limit (Fig. 19: 55 deg)
+        assert d.delta_max_deg <= P.delta_max_deg + 2 * ENC_COUNT_DEG, (key, d.delta_max_deg)
         loss = 1.0 - d.power_top / fw.power_top
-        # MTPV torque limit underestimated -> less power (paper: about 17 %)
-        assert 0.05 <= loss <= 0.35, (key, loss)
+        assert lo <= loss <= hi, (key, loss, lo, hi)
         # and it keeps producing motoring torque all the way to 1200 rpm
         log = runs[key].log
-        top = log["speed"] > 1100 * np.pi / 30
-        assert np.min(log["torque"][top]) > 0.5 * d.power_top / (1200 * np.pi / 30)
+        top = log["speed"] > 1100 * rb.RPM
+        assert np.min(log["torque"][top]) > 0.5 * d.power_top / (P.speed_max_rpm * rb.RPM)
 
 
 def test_torque_bandwidth_1500hz(results):
+    """Figs. 23-24: DB follows 0.5 N m at 1.5 kHz; reference, prediction and
+    observation one period apart (lag 2 samples: computation delay + one
+    beat); the PI-DFVC does not follow."""
     _, met = results
     db, pi = met["bw_db"], met["bw_pi"]
-    assert 0.9 <= db.ratio <= 1.1, db
-    # two samples: computation delay + one beat; 0.05 sample is the
+    # +-10 %: 0.05 N m of the 0.5 N m amplitude; +-0.05 sample: the
     # resolution of the sine fit on a rippled signal
-    assert db.lag <= 2.05, db
-    assert abs(pi.ratio - 1.0) > abs(db.ratio - 1.0), (db, pi)
+    assert 0.9 <= db.ratio <= 1.1, db
+    assert 1.95 <= db.lag <= 2.05, db
+    assert not (0.9 <= pi.ratio <= 1.1 and 1.95 <= pi.lag <= 2.05), pi
 
 
 def test_speed_control_0_to_1200(results):
+    """Fig. 18: 0 -> 1200 rpm, acceleration limited at 1200 rpm/s, no
+    overshoot."""
     _, met = results
     sp = met["speed"]
     assert not sp.faults
-    assert sp.overshoot <= 0.02, sp
-    assert sp.t_reach < 1.3, sp  # 1 s of 1200 rpm/s ramp + settling
+    # no overshoot: 1 % (12 rpm), the band t_reach uses
+    assert sp.overshoot <= 0.01, sp
+    # the acceleration limit, over 50 ms: +5 % (the 1 kHz ramp starts with a
+    # 1.2 rpm step, 2 % of 50 ms at 1200 rpm/s, and the PI catches up)
+    assert sp.accel_max <= 1.05 * P.accel_rpm_s, sp
+    # within 1 % of 1200 rpm: not before the ramp allows (5 ms: the speed
+    # loop's lead), at most 0.1 s after it ("about 1 s", Fig. 18)
+    assert sp.t_reach_min - 0.005 <= sp.t_reach <= sp.t_reach_min + 0.1, sp

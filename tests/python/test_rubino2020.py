@@ -18,6 +18,7 @@ instead (deliberate breaks: scripts/rubino-breaks.py).
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 
@@ -260,3 +261,28 @@ def test_speed_control_0_to_1200(results):
     # within 1 % of 1200 rpm: not before the ramp allows (5 ms: the speed
     # loop's lead), at most 0.1 s after it ("about 1 s", Fig. 18)
     assert sp.t_reach_min - 0.005 <= sp.t_reach <= sp.t_reach_min + 0.1, sp
+
+
+def test_flux_weakening_ramp_full_voltage(tmp_path):
+    """The ramp of Fig. 14 with the paper's v_s,max = v_dc/sqrt(3) in (23)
+    (v_margin 1): no voltage headroom is left for the q_s deadbeat (33).
+    With (23) evaluated at i_qs(tau) only, a lagging i_qs raised the flux
+    reference and the drive lost torque control from ~280 rpm without a
+    fault (load angle -169 deg, 5.65 A). (23) at the limited i_qs* restores
+    i_qs through Rs (dfvc_refs.h): bounded, motoring, limits held."""
+    if not REAL_SIL.is_file():
+        pytest.skip(f"fluxdrive-sil not built ({REAL_SIL})")
+    sc = json.loads((REPO_ROOT / "sil" / "scenarios" / rb.SCENARIOS["fw"]).read_text())
+    sc["controller"]["v_margin"] = 1.0
+    path = tmp_path / "rubino_fw_ramp_margin1.json"
+    path.write_text(json.dumps(sc))
+    r = rb.run(REAL_SIL, path, tmp_path)
+    fw = rb.ramp_metrics(r)
+    i_max = r.config["controller"]["i_max"]
+    assert not fw.faults
+    assert fw.delta_max_deg <= 80.0 + 2.0, fw.delta_max_deg
+    assert fw.current_max <= 1.01 * i_max, (fw.current_max, i_max)
+    # zero headroom: i_qs lags i_qs* by (unmodelled voltage) / Rs at the
+    # flux-weakening knee (about 10 % of torque near 300 rpm), not more
+    assert fw.worst_ratio >= 0.85, (fw.worst_ratio, fw.worst_ratio_rpm)
+    assert fw.power_top >= 700.0, fw.power_top

@@ -107,10 +107,12 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
   const float theta_r1 = in->theta_r + in->omega_r * k->ts;
   const dq_t i1_dqs = frames_park(i1, o.sc_s_next);
   const float delta1 = frames_wrap_pi(o.theta_s_next - theta_r1);
+  const sincos_t sc_delta1 = frames_sincos_sub(o.sc_s_next, scr1);
 
-  /* references, Fig. 5, eqs. (22)-(26), from the quantities at tau */
-  const dfvc_refs_in_t ri = {in->torque_ref, in->lambda_ref, in->omega_r,
-                             in->v_lin,      o.i_dqs.d,      o.i_dqs.q};
+  /* references, Fig. 5, eqs. (22)-(26), from the quantities at tau; the
+   * current limit (25) at tau+2 from the MPE prediction (dfvc_refs.h) */
+  const dfvc_refs_in_t ri = {in->torque_ref, in->lambda_ref, in->omega_r, in->v_lin,
+                             o.i_dqs.d,      o.i_dqs.q,      i1_dqs,      sc_delta1};
   dfvc_refs_out_t r;
   dfvc_refs_update(&c->refs, &ri, &r);
 
@@ -125,10 +127,10 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
     di.lambda_s_next = o.lambda_s_next;
     di.i_dqs_next = i1_dqs;
     di.omega_r = in->omega_r;
-    di.omega_delta = (k->omega_delta_mode == DFVC_OMEGA_DELTA_TARGET)
-                         ? dfvc_deadbeat_omega_delta_target_sc(&c->db, r.iqs_ref, i1_dqs.q, delta1,
-                                                               frames_sincos_sub(o.sc_s_next, scr1))
-                         : frames_wrap_pi(delta1 - o.delta) / k->ts;
+    di.omega_delta =
+        (k->omega_delta_mode == DFVC_OMEGA_DELTA_TARGET)
+            ? dfvc_deadbeat_omega_delta_target_sc(&c->db, r.iqs_ref, i1_dqs.q, delta1, sc_delta1)
+            : frames_wrap_pi(delta1 - o.delta) / k->ts;
     di.v_max = v_max;
     dfvc_deadbeat_out_t dout;
     /* Rubino 2020, eqs. (28), (29), (33) */

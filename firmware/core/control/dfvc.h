@@ -53,6 +53,9 @@
  *    0 is the paper's rotation by theta_s(tau+1).
  *  - omega_r(tau+1) = omega_r(tau), theta_r(tau+1) = theta_r + omega_r Ts.
  *  - PI-DFVC bandwidths 2 pi 1000 rad/s (paper: 1 kHz); design in dfvc_pi.h.
+ *  - (23) also at the limited i_qs* (smaller flux kept) and (25) at tau+2
+ *    from the MPE current (dfvc_refs.h): without them the DB-DFVC loses
+ *    torque control at v_margin = 1 and the current limit (25) oscillates.
  */
 #ifndef FD_CONTROL_DFVC_H
 #define FD_CONTROL_DFVC_H

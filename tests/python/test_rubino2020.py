@@ -106,11 +106,6 @@ def test_torque_step_pi(results):
     assert pi.frac[1] < db.frac[1], (db, pi)
 
 
-@pytest.mark.xfail(strict=True, raises=AssertionError, reason=(
-    "static torque error of the truncating encoder (half a count, 0.92 deg "
-    "electrical): +0.068 N m (DB) and +0.080 N m (PI) after the 1 N m step, "
-    "+0.139 N m after the reversal, above the 0.05 N m band; with an ideal "
-    "encoder (2^20 counts) +0.001, +0.003, +0.010 N m and settled at k+3 / k+14"))
 def test_step_settles_on_the_reference(results):
     """Settling against the torque reference, not the measured final value:
     within 5 % of the step (0.05 N m) from k+3 on (DB, Fig. 21: one period),
@@ -199,9 +194,6 @@ def test_fw_torque_not_above_capability(results):
     assert np.min(p[hi]) >= 0.95 * np.median(p[hi])
 
 
-@pytest.mark.xfail(strict=True, raises=AssertionError, reason=(
-    "the drive keeps 5 % voltage margin (0.95 v_dc/sqrt(3)): 93.9 % of the "
-    "capability at 1200 rpm, 722 W of 766 W over 1000-1200 rpm"))
 def test_fw_torque_reaches_capability(results):
     """Fig. 14: maximum torque at every speed, to within 3 % of the
     capability under v_s,max = v_dc/sqrt(3) (section III, (23))."""

@@ -45,9 +45,9 @@ int dfvc_pi_init(dfvc_pi_t *c, const dfvc_pi_cfg_t *cfg) {
     return -1;
   }
   c->cfg = *cfg;
-  /* flux: plant 1/s after ff_d; integral zero a decade below the crossover */
+  /* flux: plant 1/s after ff_d; integral zero at a quarter of the crossover */
   c->kp_flux = k->bw_flux;
-  c->ki_flux = 0.1f * k->bw_flux * k->bw_flux;
+  c->ki_flux = 0.25f * k->bw_flux * k->bw_flux;
   /* i_qs: plant 1/(Ls s + Rs), pole-zero cancellation */
   c->kp_iqs = k->bw_iqs * machine_ls(k->machine);
   c->ki_iqs = k->bw_iqs * k->machine->rs;

@@ -12,9 +12,13 @@
  * derivative of the controlled variable):
  *   ff_d = Rs i_ds,   ff_q = w_r lambda_s + w_delta Ls i_ds   (values at tau)
  * Gains from the bandwidths (rad/s):
- *   flux:  plant 1/s after ff_d.  kp = w_f, ki = w_f^2 / 10 (integral zero a
- *          decade below the crossover, only to absorb Rs and ff errors);
- *          closed loop ~ w_f/(s + w_f).
+ *   flux:  plant 1/s after ff_d.  kp = w_f, ki = w_f^2 / 4 (integral zero
+ *          at w_f/4, as the speed loop's, to absorb Rs and ff errors);
+ *          closed loop ~ w_f/(s + w_f). With the zero a decade below, the
+ *          flux error after a torque step decayed with 1/(0.1 w_f) = 1.6 ms
+ *          and the torque stayed outside 5 % of a 1 N m step for 16
+ *          samples (18 around the reference); at w_f/4: 14 and 14 (the
+ *          paper's PI-DFVC: eleven, Fig. 22).
  *   i_qs:  plant 1/(Ls s + Rs).    kp = w_i Ls, ki = w_i Rs (pole-zero
  *          cancellation); closed loop ~ w_i/(s + w_i).
  * The paper uses 1 kHz for both (w = 2 pi 1000 rad/s); with the 1.5 Ts

@@ -16,7 +16,11 @@ typedef struct {
   size_t n, cap;
   double *t, *iq, *id, *speed, *torque, *v_dc, *imax_abs, *speed_ref;
   double *v_dc_meas, *imax_meas, *speed_est; /* what the ISR saw */
-  unsigned *faults, *state, *gates;
+  /* what the law estimated (loss-of-control monitor inputs) */
+  double *iamp_meas, *delta_est, *torque_est, *torque_ref, *flux_est, *flux_ref, *obs_err;
+  double *flux, *delta, *theta_err; /* true flux amplitude, load angle, used - true angle */
+  double *duty_max;                 /* largest duty of the pattern the HAL applies */
+  unsigned *faults, *state, *gates, *lc_cause;
 } trace_t;
 
 static inline void trace_observer(void *user, const sil_step_t *st) {
@@ -39,6 +43,18 @@ static inline void trace_observer(void *user, const sil_step_t *st) {
   tr->v_dc_meas[k] = st->adc->v_dc;
   tr->imax_meas[k] = fmax(fabs(tm->i_abc[0]), fmax(fabs(tm->i_abc[1]), fabs(tm->i_abc[2])));
   tr->speed_est[k] = tm->omega_m;
+  tr->iamp_meas[k] = hypot(tm->i_dq[0], tm->i_dq[1]);
+  tr->delta_est[k] = tm->law_tm.delta;
+  tr->torque_est[k] = tm->torque_est;
+  tr->torque_ref[k] = tm->torque_ref;
+  tr->flux_est[k] = tm->law_tm.flux;
+  tr->flux_ref[k] = tm->law_tm.flux_ref;
+  tr->obs_err[k] = tm->law_tm.obs_err;
+  tr->flux[k] = hypot(p->lambda_dq[0], p->lambda_dq[1]);
+  tr->delta[k] = atan2(p->lambda_dq[1], p->lambda_dq[0]);
+  tr->theta_err[k] = remainder(tm->theta_e - p->theta_e, 2.0 * 3.14159265358979323846);
+  tr->lc_cause[k] = tm->lc_cause;
+  tr->duty_max[k] = fmax(tm->duty[0], fmax(tm->duty[1], tm->duty[2]));
   tr->faults[k] = st->drive->faults;
   tr->state[k] = st->drive->state;
   tr->gates[k] = st->gates_on;
@@ -47,26 +63,33 @@ static inline void trace_observer(void *user, const sil_step_t *st) {
 static inline void trace_alloc(trace_t *tr, size_t cap) {
   tr->n = 0;
   tr->cap = cap;
-  double **d[] = {&tr->t,         &tr->iq,        &tr->id,       &tr->speed,
-                  &tr->torque,    &tr->v_dc,      &tr->imax_abs, &tr->speed_ref,
-                  &tr->v_dc_meas, &tr->imax_meas, &tr->speed_est};
+  double **d[] = {&tr->t,         &tr->iq,        &tr->id,        &tr->speed,      &tr->torque,
+                  &tr->v_dc,      &tr->imax_abs,  &tr->speed_ref, &tr->v_dc_meas,  &tr->imax_meas,
+                  &tr->speed_est, &tr->iamp_meas, &tr->delta_est, &tr->torque_est, &tr->torque_ref,
+                  &tr->flux_est,  &tr->flux_ref,  &tr->obs_err,   &tr->flux,       &tr->delta,
+                  &tr->theta_err, &tr->duty_max};
   for (size_t i = 0; i < sizeof d / sizeof d[0]; ++i) {
     *d[i] = calloc(cap, sizeof(double));
   }
-  tr->faults = calloc(cap, sizeof(unsigned));
-  tr->state = calloc(cap, sizeof(unsigned));
-  tr->gates = calloc(cap, sizeof(unsigned));
+  unsigned **u[] = {&tr->faults, &tr->state, &tr->gates, &tr->lc_cause};
+  for (size_t i = 0; i < sizeof u / sizeof u[0]; ++i) {
+    *u[i] = calloc(cap, sizeof(unsigned));
+  }
 }
 
 static inline void trace_free(trace_t *tr) {
-  double *d[] = {tr->t,        tr->iq,        tr->id,        tr->speed,     tr->torque,   tr->v_dc,
-                 tr->imax_abs, tr->speed_ref, tr->v_dc_meas, tr->imax_meas, tr->speed_est};
+  double *d[] = {tr->t,         tr->iq,        tr->id,        tr->speed,      tr->torque,
+                 tr->v_dc,      tr->imax_abs,  tr->speed_ref, tr->v_dc_meas,  tr->imax_meas,
+                 tr->speed_est, tr->iamp_meas, tr->delta_est, tr->torque_est, tr->torque_ref,
+                 tr->flux_est,  tr->flux_ref,  tr->obs_err,   tr->flux,       tr->delta,
+                 tr->theta_err, tr->duty_max};
   for (size_t i = 0; i < sizeof d / sizeof d[0]; ++i) {
     free(d[i]);
   }
-  free(tr->faults);
-  free(tr->state);
-  free(tr->gates);
+  unsigned *u[] = {tr->faults, tr->state, tr->gates, tr->lc_cause};
+  for (size_t i = 0; i < sizeof u / sizeof u[0]; ++i) {
+    free(u[i]);
+  }
 }
 
 /* Parses and runs; fails the test on any error. */

@@ -122,21 +122,29 @@ static int drive_configure(drive_t *drv, const drive_config_t *cfg, drive_law_t 
   return 0;
 }
 
-/* The LIVE parameters of cfg into the set in force (running). Returns true
- * when cfg differs from the set in force in anything else. */
+/* The LIVE parameters of cfg into the set in force (running), if the set
+ * they make with the others in force is valid (a request validated whole
+ * may not be valid in part: its i_trip with the i_max in force); otherwise
+ * nothing now. Returns true when something of cfg waits for the gates to
+ * be off. */
 static bool configure_live(drive_t *drv, const drive_config_t *cfg) {
   unsigned n;
   const drive_param_t *t = drive_params_table(&n);
+  drive_config_t next = drv->cfg;
   bool rest = false;
   for (unsigned k = 0; k < n; ++k) {
     const float v = drive_param_get(cfg, &t[k]);
     if (t[k].access == DRIVE_PARAM_LIVE) {
-      drive_param_set(&drv->cfg, &t[k], v);
+      drive_param_set(&next, &t[k], v);
     } else {
       const float w = drive_param_get(&drv->cfg, &t[k]);
       rest = rest || v < w || v > w;
     }
   }
+  if (drive_config_check(&next, NULL) != 0) {
+    return true; /* all of it when the gates are off */
+  }
+  drv->cfg = next;
   speed_ctrl_cfg_t scfg;
   speed_cfg_from(&scfg, &drv->cfg);
   /* new gains and limits; the integral and the ramp carry on */

@@ -7,6 +7,10 @@
  * --print-config prints the resolved parameters (JSON) and exits.
  * --print-params prints the parameter table and the drive's named values
  * (JSON; no scenario needed) and exits.
+ * --preempt PERIODS [--seed N] [--max-gap-us U] runs PERIODS ISRs of the
+ * scenario's plant and drive with the ISR preempting the main loop at
+ * random points (sil/runner/sil_preempt.h; at most 600 s of wall time) and
+ * prints the result (JSON); exit code 3 when an invariant was violated.
  * --record-isr PATH.bin records every ISR's inputs and outputs for the PIL
  * replay (sil/runner/isr_record.h, docs/pil.md).
  * --can socketcand:PORT | socketcan:IFACE [--node N] [--can-timeout MS]:
@@ -31,6 +35,7 @@
 #include "isr_record.h"
 #include "log_npy.h"
 #include "scenario.h"
+#include "sil_preempt.h"
 #include "sil_run.h"
 #include "summary.h"
 
@@ -39,6 +44,7 @@ static int usage(void) {
           "usage: fluxdrive-sil SCENARIO.json [--log PATH.npy] [--summary PATH.json]\n"
           "                     [--decimate N] [--bench] [--print-config] [--print-params]\n"
           "                     [--record-isr PATH.bin] [--realtime]\n"
+          "                     [--preempt PERIODS [--seed N] [--max-gap-us U]]\n"
           "                     [--can socketcand:PORT | --can socketcan:IFACE]\n"
           "                     [--node N] [--can-timeout MS]\n");
   return 2;
@@ -86,6 +92,9 @@ int main(int argc, char **argv) {
   const char *scenario = NULL, *log_path = NULL, *summary_path = NULL, *record_path = NULL;
   int decimate = 0, bench = 0, print_config = 0, print_params = 0, realtime = 0;
   const char *can = NULL;
+  long preempt_n = 0;
+  double max_gap_us = 20.0;
+  long seed = 1;
   long node = -1, can_timeout = -1;
   for (int i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--log") == 0 && i + 1 < argc) {
@@ -120,6 +129,20 @@ int main(int argc, char **argv) {
       print_config = 1;
     } else if (strcmp(argv[i], "--print-params") == 0) {
       print_params = 1;
+    } else if (strcmp(argv[i], "--preempt") == 0 && i + 1 < argc) {
+      if (parse_long("--preempt", argv[++i], 1, 100000000, &preempt_n) != 0) {
+        return 2;
+      }
+    } else if (strcmp(argv[i], "--seed") == 0 && i + 1 < argc) {
+      if (parse_long("--seed", argv[++i], 0, 0x7fffffff, &seed) != 0) {
+        return 2;
+      }
+    } else if (strcmp(argv[i], "--max-gap-us") == 0 && i + 1 < argc) {
+      long g;
+      if (parse_long("--max-gap-us", argv[++i], 1, 100000, &g) != 0) {
+        return 2;
+      }
+      max_gap_us = (double)g;
     } else if (argv[i][0] == '-' || scenario != NULL) {
       return usage();
     } else {
@@ -152,6 +175,21 @@ int main(int argc, char **argv) {
     printf("%s\n", js);
     free(js);
     return 0;
+  }
+  if (preempt_n > 0) {
+    const sil_preempt_opts_t po = {(uint64_t)preempt_n, 600.0, (uint32_t)seed, max_gap_us};
+    static sil_preempt_result_t pr;
+    if (sil_preempt_run(&sc, &po, &pr, err, sizeof err) != 0) {
+      fprintf(stderr, "fluxdrive-sil: %s\n", err);
+      return 2;
+    }
+    char *js = preempt_json(&pr);
+    if (js == NULL) {
+      return 1;
+    }
+    printf("%s\n", js);
+    free(js);
+    return pr.violations != 0u || pr.tm_torn != 0u ? 3 : 0;
   }
   if (decimate > 0) {
     sc.log_decimation = decimate;

@@ -161,3 +161,34 @@ char *params_json(void) {
   cJSON_Delete(o);
   return s;
 }
+
+char *preempt_json(const sil_preempt_result_t *r) {
+  cJSON *o = cJSON_CreateObject();
+  const struct {
+    const char *key;
+    uint64_t v;
+  } n[] = {{"periods", r->periods},
+           {"main_iterations", r->main_iterations},
+           {"commands", r->commands},
+           {"clears", r->clears},
+           {"fault_requests", r->fault_requests},
+           {"param_writes", r->param_writes},
+           {"param_refused", r->param_refused},
+           {"tm_reads", r->tm_reads},
+           {"tm_retries", r->tm_retries},
+           {"tm_failed", r->tm_failed},
+           {"tm_torn", r->tm_torn},
+           {"in_publication", r->in_publication},
+           {"cfg_in_publication", r->cfg_in_publication},
+           {"starts", r->starts},
+           {"trips", r->trips},
+           {"violations", r->violations}};
+  for (size_t i = 0; i < sizeof n / sizeof n[0]; ++i) {
+    cJSON_AddNumberToObject(o, n[i].key, (double)n[i].v);
+  }
+  cJSON_AddStringToObject(o, "first_violation", r->first_violation);
+  cJSON_AddNumberToObject(o, "wall_s", r->wall_s);
+  char *s = cJSON_Print(o);
+  cJSON_Delete(o);
+  return s;
+}

@@ -5,6 +5,7 @@
 #define FD_SIL_SUMMARY_H
 
 #include "scenario.h"
+#include "sil_preempt.h"
 #include "sil_run.h"
 
 /* Returns a malloc'ed, formatted JSON string (caller frees), or NULL. */
@@ -20,5 +21,8 @@ char *config_json(const scenario_t *sc);
  * params` generates the DBC value tables, the tools' table and the docs.
  * Caller frees. */
 char *params_json(void);
+
+/* The result of a preempting run (sil_preempt.h), as JSON. Caller frees. */
+char *preempt_json(const sil_preempt_result_t *r);
 
 #endif

@@ -377,6 +377,27 @@ static void alignment_sets_the_encoder_offset(void **state) {
   assert_float_equal(drv.pos_st.enc.offset, want, 1e-4f);
 }
 
+/* The angle the law uses is the position source's, extrapolated from the
+ * encoder's sampling instant to the currents' (hal_sample_t timestamps). */
+static void angle_extrapolated_from_timestamps(void **state) {
+  (void)state;
+  start_running();
+  const float w_m = 20.0f, t_enc = 20e-6f, ts = drv.cfg.ts;
+  const float p = drv.cfg.pole_pairs, half = 3.14159265f / (float)drv.cfg.enc_cpr;
+  float th = 0.0f;
+  for (int k = 0; k < 4000; ++k) { /* the PLL locks on the speed */
+    th = remainderf(w_m * (float)k * ts, 6.2831853f);
+    hal.sample.enc_angle = th < 0.0f ? th + 6.2831853f : th;
+    hal.sample.t_enc = t_enc;
+    hal.sample.t_i = 0.0f;
+    drive_isr(&drv);
+  }
+  const float want = remainderf(
+      p * (hal.sample.enc_angle + half) - drv.cfg.enc_offset - p * w_m * t_enc, 6.2831853f);
+  assert_float_equal(remainderf(drv.tm.theta_e - want, 6.2831853f), 0.0f, 2e-4f);
+  assert_float_equal(drv.pos.omega, p * w_m, 0.01f * p * w_m);
+}
+
 static void bad_config_is_named(void **state) {
   (void)state;
   drive_config_t cfg;
@@ -411,6 +432,7 @@ int main(void) {
                                      cmocka_unit_test(parameter_requests_are_applied_by_the_isr),
                                      cmocka_unit_test(watchdog_needs_both_contexts),
                                      cmocka_unit_test(alignment_sets_the_encoder_offset),
+                                     cmocka_unit_test(angle_extrapolated_from_timestamps),
                                      cmocka_unit_test(bad_config_is_named)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

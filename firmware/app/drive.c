@@ -583,6 +583,8 @@ bool drive_telemetry_read(drive_t *drv, drive_telemetry_t *out) {
     DRIVE_BARRIER();
     *out = drv->tm;
     DRIVE_BARRIER();
+    /* the ISR may have run between the two reads (volatile) */
+    // cppcheck-suppress knownConditionTrueFalse
     if (drv->tm_seq == s1) {
       return true;
     }
@@ -661,8 +663,9 @@ const char *drive_cmd_set_law(drive_t *drv, drive_law_t law) {
     return "no such law";
   }
   const ctrl_setup_t su = host_setup(drv);
-  const char *why = row->check(&su);
+  const char *why = row->check(&su); /* a static string, not into su */
   if (why != NULL) {
+    // cppcheck-suppress returnDanglingLifetime
     return why;
   }
   if (drv->req.cmd.mode == DRIVE_MODE_CURRENT && (row->caps & CTRL_CAP_CURRENT) == 0u) {

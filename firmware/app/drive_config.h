@@ -25,8 +25,9 @@ typedef struct {
 #undef DRIVE_CONFIG_FIELD
 } drive_config_t;
 
-/* Number of parameters (rows of the table). */
-#define DRIVE_PARAM_ONE(...) +1
+/* Number of parameters (rows of the table): "0 +1 +1 ...", the bare "+1"
+ * is the point of this arm. */
+#define DRIVE_PARAM_ONE(...) +1 // NOLINT(bugprone-macro-parentheses)
 enum { DRIVE_PARAM_COUNT = 0 DRIVE_PARAM_TABLE(DRIVE_PARAM_ONE) };
 #undef DRIVE_PARAM_ONE
 

@@ -18,7 +18,7 @@
 
 /* Shared by the handler ("the ISR") and the main thread; each field of the
  * result has one writer. */
-static sil_ctx_t x;
+static sil_ctx_t g_x;
 static const scenario_t *g_sc;
 static sil_preempt_result_t *g_r;
 static volatile sig_atomic_t g_running;
@@ -66,11 +66,11 @@ static void on_interrupt(int sig) {
     return;
   }
   const int saved_errno = errno;
-  drive_t *d = &x.drv;
+  drive_t *d = &g_x.drv;
   const uint64_t k = atomic_load(&g_k);
   const double t = (double)k * g_sc->plant.ts;
-  x.hal.time_us = (uint32_t)(uint64_t)(t * 1e6);
-  sil_sample(&x, g_sc, t);
+  g_x.hal.time_us = (uint32_t)(uint64_t)(t * 1e6);
+  sil_sample(&g_x, g_sc, t);
 
   const drive_state_t st0 = d->state;
   const uint32_t clear0 = d->clear_seen;
@@ -86,13 +86,13 @@ static void on_interrupt(int sig) {
     if (d->faults == 0u) {
       violation("fault state with no fault latched");
     }
-    if (x.hal.gates_on) {
+    if (g_x.hal.gates_on) {
       violation("gates on in the fault state");
     }
   } else if (d->faults != 0u) {
     violation("faults latched outside the fault state (e.g. idle after a racing clear)");
   }
-  if (x.hal.gates_on && !gates_state(st)) {
+  if (g_x.hal.gates_on && !gates_state(st)) {
     violation("gates on outside run and alignment");
   }
   if (drive_config_check(&d->cfg, NULL) != 0) {
@@ -130,7 +130,7 @@ static void on_interrupt(int sig) {
   if (st0 != DRIVE_STATE_FAULT && st == DRIVE_STATE_FAULT) {
     g_r->trips++;
   }
-  sil_advance(&x, g_sc, t);
+  sil_advance(&g_x, g_sc, t);
   g_r->periods++;
   atomic_store(&g_k, k + 1u);
   errno = saved_errno;
@@ -138,7 +138,7 @@ static void on_interrupt(int sig) {
 
 /* The interrupt source: SIGUSR1 to the main thread after random gaps. */
 static void *interrupter(void *arg) {
-  uint64_t s = (uint64_t)(uintptr_t)arg | 1u;
+  uint64_t s = *(const uint64_t *)arg | 1u;
   while (!atomic_load(&g_stop)) {
     s ^= s << 13;
     s ^= s >> 7;
@@ -181,7 +181,7 @@ static void random_param(rng_t *r, sil_preempt_result_t *res) {
   const drive_param_t *p = drive_params_by_name(is_live ? live[j] : idle[j]);
   const float v = is_live ? rnd_f(r, live_lo[j], live_hi[j]) : rnd_f(r, idle_lo[j], idle_hi[j]);
   res->param_writes++;
-  if (drive_params_set(&x.drv, p->id, v, NULL) != DRIVE_PARAM_OK) {
+  if (drive_params_set(&g_x.drv, p->id, v, NULL) != DRIVE_PARAM_OK) {
     res->param_refused++;
   }
 }
@@ -190,7 +190,7 @@ static void random_param(rng_t *r, sil_preempt_result_t *res) {
  * would be invalid - i_max (early in the struct) of A with align_current
  * (late) of B, or i_trip of A with i_max of B - which the handler sees. */
 static void random_set(rng_t *r, sil_preempt_result_t *res) {
-  drive_config_t c = *drive_requested_config(&x.drv);
+  drive_config_t c = *drive_requested_config(&g_x.drv);
   const bool a = rnd(r, 2u) == 0u;
   c.i_max = a ? 3.0f : 3.7f;
   c.i_trip = a ? 3.2f : 7.5f;
@@ -198,16 +198,16 @@ static void random_set(rng_t *r, sil_preempt_result_t *res) {
   c.current_bw = a ? 1800.0f : 2200.0f;
   c.speed_bw = a ? 40.0f : 60.0f;
   res->param_writes++;
-  const drive_state_t st = x.drv.state;
-  if (st != DRIVE_STATE_IDLE && st != DRIVE_STATE_FAULT) {
-    res->param_refused++; /* not LIVE: wait for the gates to be off */
-  } else if (drive_request_config(&x.drv, &c, NULL) != 0) {
+  const drive_state_t st = g_x.drv.state;
+  /* not LIVE: only with the gates off */
+  const bool off = st == DRIVE_STATE_IDLE || st == DRIVE_STATE_FAULT;
+  if (!off || drive_request_config(&g_x.drv, &c, NULL) != 0) {
     res->param_refused++;
   }
 }
 
 static void main_loop(rng_t *r, const sil_preempt_opts_t *o, sil_preempt_result_t *res) {
-  drive_t *d = &x.drv;
+  drive_t *d = &g_x.drv;
   const double t0 = now_s(), t_end = t0 + o->wall_max_s;
   uint64_t next = 0u;
   unsigned turn = 0u;
@@ -275,7 +275,7 @@ static void main_loop(rng_t *r, const sil_preempt_opts_t *o, sil_preempt_result_
 int sil_preempt_run(const scenario_t *sc, const sil_preempt_opts_t *opts, sil_preempt_result_t *r,
                     char *err, size_t errlen) {
   memset(r, 0, sizeof *r);
-  if (sil_setup(&x, sc, err, errlen) != 0) {
+  if (sil_setup(&g_x, sc, err, errlen) != 0) {
     return -1;
   }
   g_sc = sc;
@@ -296,7 +296,9 @@ int sil_preempt_run(const scenario_t *sc, const sil_preempt_opts_t *opts, sil_pr
   }
   g_running = 1;
   pthread_t th;
-  if (pthread_create(&th, NULL, interrupter, (void *)(uintptr_t)(opts->seed * 2654435761u)) != 0) {
+  static uint64_t seed_box;
+  seed_box = (uint64_t)opts->seed * 2654435761u;
+  if (pthread_create(&th, NULL, interrupter, &seed_box) != 0) {
     snprintf(err, errlen, "cannot start the interrupter thread");
     return -1;
   }
@@ -313,7 +315,7 @@ int sil_preempt_run(const scenario_t *sc, const sil_preempt_opts_t *opts, sil_pr
     g_running = 0;
   }
   for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {
-    if (x.drv.fault_seen[b] != x.drv.req.cmd.fault_count[b]) {
+    if (g_x.drv.fault_seen[b] != g_x.drv.req.cmd.fault_count[b]) {
       violation("a fault request was never taken");
     }
   }

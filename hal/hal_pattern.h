@@ -9,7 +9,6 @@
 #ifndef FLUXDRIVE_HAL_PATTERN_H
 #define FLUXDRIVE_HAL_PATTERN_H
 
-#include <math.h>
 #include <stdint.h>
 
 #include "hal.h"
@@ -21,8 +20,14 @@ static inline float hal_pattern_clamp(float x, float lo, float hi) {
   return x > hi ? hi : x;
 }
 
+/* To the nearest count, as the board's duty_to_ccr (x >= 0 here: a clamped
+ * duty or an edge inside the period; no libm call in the ISR). */
 static inline float hal_pattern_round(float x, uint32_t counts) {
-  return counts > 0u ? roundf(x * (float)counts) / (float)counts : x;
+  if (counts == 0u) {
+    return x;
+  }
+  const float n = x > 0.0f ? x * (float)counts + 0.5f : 0.0f;
+  return (float)(uint32_t)n / (float)counts;
 }
 
 static inline void hal_pattern_apply(const hal_pwm_t *p, const hal_caps_t *caps, uint32_t counts,

@@ -90,6 +90,15 @@ int drive_config_usable(const drive_config_t *cfg, drive_law_t law, machine_t *m
   return 0;
 }
 
+/* What the ISR would otherwise divide for every period (LIVE parameters
+ * included: called again when they change). */
+static void drive_derive(drive_t *drv) {
+  const drive_config_t *c = &drv->cfg;
+  drv->lc_n_fast = c->lc_time / c->ts;
+  drv->lc_n_track = c->lc_track_time / c->ts;
+  drv->inv_pole_pairs = 1.0f / c->pole_pairs;
+}
+
 /* Everything derived from the parameter set (ISR-owned; gates off). */
 static int drive_configure(drive_t *drv, const drive_config_t *cfg, drive_law_t law,
                            drive_config_err_t *err) {
@@ -99,6 +108,7 @@ static int drive_configure(drive_t *drv, const drive_config_t *cfg, drive_law_t 
   }
   drv->cfg = *cfg;
   drv->machine = m;
+  drive_derive(drv);
   const char *reason = "";
   if (ctrl_init(&drv->ctrl, &drv->cfg, &drv->machine, drive_t_out(drv, cfg), law, &reason) != 0) {
     err->field = "law";
@@ -145,6 +155,7 @@ static bool configure_live(drive_t *drv, const drive_config_t *cfg) {
     return true; /* all of it when the gates are off */
   }
   drv->cfg = next;
+  drive_derive(drv);
   speed_ctrl_cfg_t scfg;
   speed_cfg_from(&scfg, &drv->cfg);
   /* new gains and limits; the integral and the ramp carry on */
@@ -311,7 +322,7 @@ static void drive_monitor(drive_t *drv, const ctrl_in_t *in, const ctrl_out_t *o
     }
   }
   /* current and load angle within lc_time; tracking within lc_track_time */
-  const float n_fast = c->lc_time / c->ts, n_track = c->lc_track_time / c->ts;
+  const float n_fast = drv->lc_n_fast, n_track = drv->lc_n_track;
   uint32_t trip = 0u;
   for (unsigned k = 0; k < DRIVE_LC_COUNT; ++k) {
     drv->lc_n[k] = (cond & (1u << k)) != 0u ? drv->lc_n[k] + 1u : 0u;
@@ -520,7 +531,7 @@ void drive_isr(drive_t *drv) {
   }
   drive_speed_loop(drv); /* on the rates of the previous slow_div periods */
   drv->pos_src->update(&drv->pos_st, &drv->cfg, &s, &drv->pos);
-  drv->omega_m = drv->pos.omega / drv->cfg.pole_pairs;
+  drv->omega_m = drv->pos.omega * drv->inv_pole_pairs;
   drv->rate_acc += drv->pos.rate;
   drv->rate_n++;
   drv->v_lin = modulation_v_max(s.v_dc, drv->caps->duty_min, drv->caps->duty_max);

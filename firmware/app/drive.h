@@ -138,6 +138,8 @@ typedef struct {
   float torque_min_avail, torque_max_avail; /* what the law can deliver now */
   uint32_t lc_n[DRIVE_LC_COUNT];            /* periods each condition has held */
   float torque_scale, flux_scale;           /* torque and flux amplitude on MTPA at i_max */
+  float lc_n_fast, lc_n_track;              /* lc_time, lc_track_time in periods */
+  float inv_pole_pairs;
   float v_lin;                              /* linear voltage range now [V] */
 
   /* telemetry, under a sequence lock */

@@ -74,8 +74,11 @@ IN_SIZE = 240
 #: Blocks of the per-function share: the first pattern that a function name
 #: starts with (or equals) names its block.
 BLOCKS = [
-    ("drive (ISR body, protections, PLL, offsets)", ("drive_", "angle_pll_")),
-    ("control-law dispatch", ("ctrl_",)),
+    ("drive (ISR body, commands, protections, offsets)", ("drive_", "hal_pwm_centred")),
+    ("speed loop (speed_ctrl, every slow_div ISRs)", ("speed_ctrl_",)),
+    ("position source (encoder, PLL)", ("enc_", "pos_source", "angle_pll_")),
+    ("control-law dispatch (ctrl, law tables)", ("ctrl_", "dfvc_law_", "db_step", "pi_step",
+                                                 "foc_step")),
     ("DFVC step", ("dfvc_step", "dfvc_reset")),
     ("flux observer", ("flux_observer_", "flux_obs_")),
     ("current predictor", ("current_predictor_",)),
@@ -88,6 +91,7 @@ BLOCKS = [
     ("modulation", ("modulation_",)),
     ("dead-time compensation", ("deadtime_comp_",)),
     ("frames (Clarke/Park, wrap)", ("frames_",)),
+    ("machine model", ("machine_", "mtpa_at")),
     ("core trig fd_sincosf/fd_atan2f (math/fast_trig)", ("fd_",)),
     (
         "libm sinf/cosf (newlib)",
@@ -100,7 +104,9 @@ BLOCKS = [
     ("libm classify/min/max/floor (newlib)", ("__fpclassifyf", "fmaxf", "fminf", "floorf",
                                               "fabsf", "scalbnf", "copysignf")),
     ("libc memset/memcpy", ("memset", "memcpy")),
-    ("PIL replay HAL (stands in for the register HAL)", ("hal_",)),
+    # roundf: the replay HAL's timer model (hal_pattern.h) rounds the edges;
+    # called by hal_pwm_write only (cm4_cycles.stand_ins checks the image)
+    ("PIL replay HAL (stands in for the register HAL)", ("hal_", "roundf")),
 ]
 
 
@@ -337,6 +343,8 @@ class Counts:
     cycles_worst_isr: int = 0
     block_cycles: dict[str, float] = field(default_factory=dict)  # mean per ISR
     func_cycles: dict[str, float] = field(default_factory=dict)
+    #: the image's replay-HAL functions the board replaces (cm4_cycles.stand_ins)
+    stand_ins: frozenset = frozenset(cm4_cycles.BOARD_HAL)
 
     @property
     def cpi(self) -> float:
@@ -344,7 +352,7 @@ class Counts:
 
     def stand_in_cycles(self) -> float:
         """Mean cycles per ISR in the PIL replay HAL (the board runs its own)."""
-        return sum(v for f, v in self.func_cycles.items() if f in cm4_cycles.BOARD_HAL)
+        return sum(v for f, v in self.func_cycles.items() if f in self.stand_ins)
 
 
 def _mean_by(run: list[int], per_isr: list[dict[str, int]]) -> tuple[dict, dict]:
@@ -359,7 +367,8 @@ def _mean_by(run: list[int], per_isr: list[dict[str, int]]) -> tuple[dict, dict]
     return blocks, {f: v / len(run) for f, v in funcs.items()}
 
 
-def law_counts(tr: TraceResult, host: np.ndarray) -> Counts:
+def law_counts(tr: TraceResult, host: np.ndarray,
+               stand_ins: frozenset = frozenset(cm4_cycles.BOARD_HAL)) -> Counts:
     n = min(len(tr.counts), len(host))
     st = host["state"][:n]
     run = [j for j in range(1, n) if st[j] == RUN and st[j - 1] == RUN]
@@ -369,7 +378,8 @@ def law_counts(tr: TraceResult, host: np.ndarray) -> Counts:
     c = np.array([tr.counts[j] for j in run])
     blocks, funcs = _mean_by(run, tr.funcs)
     w = int(np.argmax(c))
-    out = Counts(len(run), float(c.mean()), int(c[w]), run[w], blocks, funcs)
+    out = Counts(len(run), float(c.mean()), int(c[w]), run[w], blocks, funcs,
+                 stand_ins=frozenset(stand_ins))
     if len(tr.cycles) >= n:
         y = np.array([tr.cycles[j] for j in run])
         wy = int(np.argmax(y))
@@ -417,7 +427,8 @@ def scenario_with_law(src: Path, law: str | None, dst: Path) -> str:
 
 
 def run_one(runner: Path, elf: Path, scenario: Path, law: str | None, isrs: int,
-            workdir: Path, force: bool, timeout: float, tab: dict | None = None) -> PilRun:
+            workdir: Path, force: bool, timeout: float, tab: dict | None = None,
+            stand_ins: frozenset = frozenset(cm4_cycles.BOARD_HAL)) -> PilRun:
     workdir.mkdir(parents=True, exist_ok=True)
     scen = workdir / "scenario.json"
     law_name = scenario_with_law(scenario, law, scen)
@@ -439,7 +450,7 @@ def run_one(runner: Path, elf: Path, scenario: Path, law: str | None, isrs: int,
     if len(tr.counts) != n:
         raise FluxdriveError(f"trace shows {len(tr.counts)} ISRs, replayed {n}", exit_code=1)
     exact = traced_out.tobytes() == pil_out[:n].tobytes()
-    return PilRun(scenario.stem, law_name, agreement, law_counts(tr, host), exact)
+    return PilRun(scenario.stem, law_name, agreement, law_counts(tr, host, stand_ins), exact)
 
 
 # ---------------------------------------------------------------- report
@@ -611,6 +622,7 @@ def main(args) -> int:
         print(f"warning: instructions outside the cycle model (1 cycle assumed): "
               f"{prog.unclassified()}")
     tab = cm4_cycles.trace_table(prog)
+    hal = cm4_cycles.stand_ins(prog)
     board = None
     if args.board_elf:
         bp = Path(args.board_elf)
@@ -627,7 +639,7 @@ def main(args) -> int:
             t0 = time.monotonic()
             wd = out_dir / f"{sc.stem}-{law or 'scenario'}"
             r = run_one(runner, elf, sc, law, args.isrs, wd, not args.free_running,
-                        args.timeout, dict(tab))
+                        args.timeout, dict(tab), hal)
             runs.append(r)
             print(format_report([r], args.isrs, cpi, board), flush=True)
             print(f"  ({time.monotonic() - t0:.1f} s, files in {wd})", flush=True)

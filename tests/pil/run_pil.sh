@@ -1,10 +1,14 @@
 #!/usr/bin/env bash
 # PIL test (docs/pil.md): cross-builds the PIL image (preset cortex-m4f, the
 # board's MinSizeRel flags, -Werror) into BUILD_DIR, then `fluxdrive pil`
-# replays the two PIL scenarios with every law on QEMU mps2-an386: outputs
-# must agree with this host build's within the stated tolerance, and the
-# DB-DFVC worst case must stay below 2000 instructions. Prints the report
-# and writes its markdown section to BUILD_DIR/benchmarks.md.
+# replays the two PIL scenarios with every law on QEMU mps2-an386 and traces
+# every ISR of both (--isrs all: the whole flux-weakening ramp, current
+# limit, voltage limit and MTPV included). Outputs must agree with this host
+# build's within the stated tolerance; the DB-DFVC worst case must stay
+# below 3000 instructions (measured 2907, whole ramp) and at or below 50 %
+# of the 10625-cycle budget in estimated Cortex-M4 cycles (measured 46.2 %;
+# why 50 %: docs/pil.md, "Scenarios and checks"). Prints the report and writes its
+# markdown section to BUILD_DIR/benchmarks.md.
 # Usage: run_pil.sh SRC_DIR BUILD_DIR PYTHON FLUXDRIVE_SIL
 set -euo pipefail
 src=$1
@@ -14,7 +18,9 @@ sil=$4
 cmake --preset cortex-m4f -S "$src" -B "$build/cross" >/dev/null
 cmake --build "$build/cross" --target fluxdrive-pil.elf
 cd "$build"
+# the tools of the tree under test, whatever the venv's editable install points to
+export PYTHONPATH="$src/tools/src${PYTHONPATH:+:$PYTHONPATH}"
 "$python" -m fluxdrive pil "$src/sil/scenarios/pil_torque_step.json" \
-  "$src/sil/scenarios/pil_fw_ramp.json" --law foc,pi_dfvc,db_dfvc --isrs 3000 \
+  "$src/sil/scenarios/pil_fw_ramp.json" --law foc,pi_dfvc,db_dfvc --isrs all \
   --sil "$sil" --elf "$build/cross/pil/fluxdrive-pil.elf" --out "$build/work" \
-  --markdown "$build/benchmarks.md" --check-worst 2000
+  --markdown "$build/benchmarks.md" --check-worst 3000 --check-cycles 50

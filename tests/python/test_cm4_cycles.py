@@ -321,6 +321,22 @@ def test_walker_calls_veneer_and_single_register_pop() -> None:
     assert worst.bus == cm.FLASH_WS  # one flash line entered
 
 
+def test_stand_ins_follow_calls_made_only_by_the_hal() -> None:
+    """The replay HAL's helpers (hal_pattern.h's roundf) are stand-ins too;
+    a function the core also calls (memcpy) is not."""
+    prog = cm.parse_objdump(listing(
+        (0x600, "drive_isr", [(4, "bl 610 <hal_pwm_write>"), (4, "bl 620 <memcpy>"),
+                              (4, "bl 630 <hal_adc_read>"), (2, "bx lr")]),
+        (0x610, "hal_pwm_write", [(4, "bl 640 <roundf>"), (4, "b.w 620 <memcpy>")]),
+        (0x620, "memcpy", [(2, "bx lr")]),
+        (0x630, "hal_adc_read", [(2, "bx lr")]),
+        (0x640, "roundf", [(4, "bl 650 <helper>"), (2, "bx lr")]),
+        (0x650, "helper", [(2, "bx lr")]),
+    ))
+    assert prog.callers()["memcpy"] == {"drive_isr", "hal_pwm_write"}
+    assert cm.stand_ins(prog) == {"hal_pwm_write", "hal_adc_read", "roundf", "helper"}
+
+
 # ------------------------------------------------------------ real images
 @pytest.mark.skipif(not PIL_ELF.is_file(), reason="PIL image not built (preset cortex-m4f)")
 def test_pil_image_fully_classified() -> None:
@@ -328,6 +344,10 @@ def test_pil_image_fully_classified() -> None:
     assert prog.unclassified() == {}
     tab = cm.trace_table(prog)
     assert tab[b"%08x" % prog.funcs["drive_isr"]][4] == "drive_isr"
+    # the replay HAL the board replaces: its three ISR functions and the
+    # timer model's rounding (hal_pattern.h), nothing of the core
+    assert cm.stand_ins(prog) == {"hal_adc_read", "hal_fault_hw_tripped", "hal_pwm_write",
+                                  "roundf"}
 
 
 @pytest.mark.skipif(not BOARD_ELF.is_file(), reason="board image not built (preset stm32g474)")
@@ -340,7 +360,19 @@ def test_board_bound() -> None:
     # each extra check: load + AHB wait + lsls + bmi + subs + taken bne >= 9 cycles
     assert w.wrapper_cycles - t.wrapper_cycles >= 199 * 9
     assert [p.name for p in t.hal] == list(cm.BOARD_HAL)
+    assert cm.BOARD_HAL == ("hal_adc_read", "hal_fault_hw_tripped", "hal_pwm_write")
     assert 0 < t.hal_cycles <= w.hal_cycles
+    # drive_isr's board HAL calls, as linked (hal_caps through hal_adc_read)
+    prog = cm.load_program(BOARD_ELF)
+    calls = prog.callers()
+    assert "drive_isr" in calls["hal_adc_read"] and "__hal_fault_hw_tripped_veneer" in \
+        prog.funcs and "drive_isr" in calls["__hal_fault_hw_tripped_veneer"]
+    assert "drive_write" in calls["hal_pwm_write"] and "hal_adc_read" in \
+        calls["__hal_caps_veneer"]
+    adc = t.hal[0]
+    assert "hal_caps" in adc.note and "flash x2" in adc.note  # hal_caps' literal loads
+    assert "AHB x5" in adc.note  # three currents, v_dc, star point through s_jdr
+    assert "APB x3" in t.hal[2].note  # CCR1..3
     text = cm.format_board(b)
     assert "wrapper + exception" in text
 
@@ -351,7 +383,8 @@ def fake_run() -> pil.PilRun:
                    funcs={"dfvc_step": 1800.0}, cycles_mean=3188.0, cycles_worst=3300,
                    cycles_worst_isr=8, block_cycles={"DFVC step": 3188.0},
                    func_cycles={"dfvc_step": 3100.0, "hal_adc_read": 50.0,
-                                "hal_pwm_set_duty": 38.0})
+                                "hal_pwm_write": 26.0, "roundf": 12.0},
+                   stand_ins=frozenset(cm.BOARD_HAL) | {"roundf"})
     a = pil.Agreement(100, 0.0, 0, 0, 0, 0, 0)
     return pil.PilRun("scen", "db_dfvc", a, c, True)
 
@@ -372,7 +405,7 @@ def test_board_estimate() -> None:
     case_t = cm.BoardCase([cm.Part("w", 40, 100, 10)], [cm.Part("h", 90, 200, 20)])
     case_w = cm.BoardCase([cm.Part("w", 1000, 1600, 400)], [cm.Part("h", 90, 210, 30)])
     b = cm.BoardBound("x.elf", case_t, case_w, [])
-    # PIL minus its replay HAL (50 + 38) plus the board's HAL and wrapper
+    # PIL minus its replay HAL (50 + 26 + 12) plus the board's HAL and wrapper
     assert pil.board_estimate(fake_run().counts, b) == (3188 - 88 + 220 + 110,
                                                         3300 - 88 + 240 + 2000)
     md = pil.format_markdown([fake_run()], 3000, None, "flags", b)

@@ -23,6 +23,30 @@ def _positive_int(text: str) -> int:
     return value
 
 
+def _isrs(text: str) -> int:
+    """``--isrs``: a count, or ``all`` / 0 for every ISR (returned as 0)."""
+    if text.strip().lower() == "all":
+        return 0
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of ISRs or 'all', got {text!r}") \
+            from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a number of ISRs or 'all', got {value}")
+    return value
+
+
+def _percent(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a percentage, got {text!r}") from None
+    if not 0.0 < value <= 100.0:
+        raise argparse.ArgumentTypeError(f"expected a percentage in (0, 100], got {value}")
+    return value
+
+
 def _existing_file(path: str, what: str) -> Path:
     p = Path(path)
     if not p.exists():
@@ -199,8 +223,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("pil", help="PIL: replay a scenario's ISRs on QEMU, compare, count")
     p.add_argument("scenario", nargs="+", metavar="SCENARIO", help="scenario JSON file(s)")
     p.add_argument("--law", metavar="LAWS", help="foc,pi_dfvc,db_dfvc (default: the scenario's)")
-    p.add_argument("--isrs", type=_positive_int, default=3000, metavar="N",
-                   help="ISRs traced for the instruction counts (default 3000)")
+    p.add_argument("--isrs", type=_isrs, default=3000, metavar="N|all",
+                   help="ISRs traced for the instruction and cycle counts, from the start "
+                   "of each run (default 3000; all or 0: the whole run)")
     p.add_argument("--sil", metavar="PATH", help=sil_help)
     p.add_argument("--elf", metavar="PATH", help="PIL image (default: $FLUXDRIVE_PIL_ELF, else "
                    "build/cortex-m4f/pil/fluxdrive-pil.elf)")
@@ -209,6 +234,9 @@ def build_parser() -> argparse.ArgumentParser:
                    "(e.g. docs/benchmarks.md)")
     p.add_argument("--check-worst", type=_positive_int, metavar="N",
                    help="fail when the DB-DFVC worst case reaches N instructions")
+    p.add_argument("--check-cycles", type=_percent, metavar="PCT",
+                   help="fail when the DB-DFVC worst case's estimated cycles exceed PCT %% of "
+                   "the 10625-cycle budget (170 MHz / 16 kHz)")
     p.add_argument("--board-elf", metavar="PATH", help="board image (e.g. build/stm32g474/hal/"
                    "stm32g4/fluxdrive-g474.elf): add the ISR wrapper, exception and board HAL "
                    "(fluxdrive cycles-board) to a board estimate")

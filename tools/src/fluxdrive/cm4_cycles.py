@@ -477,6 +477,17 @@ class Program:
         return sorted((i for i in self.insns.values() if i.func == func and i.cond and i.branch),
                       key=lambda i: i.addr)
 
+    def callers(self) -> dict[str, set[str]]:
+        """Direct calls and tail calls: function -> the functions that branch
+        to its entry (indirect calls are not seen)."""
+        entry = {a: f for f, a in self.funcs.items()}
+        out: dict[str, set[str]] = {}
+        for i in self.insns.values():
+            f = entry.get(i.target) if i.branch and i.target is not None else None
+            if f is not None and f != i.func:
+                out.setdefault(f, set()).add(i.func)
+        return out
+
     def ordinal(self, ins: Insn) -> int:
         """Index of a conditional branch in :meth:`cond_branches` of its function."""
         if not hasattr(self, "_ordinals"):
@@ -873,9 +884,27 @@ def _alu_value(b: str, ops: list[str], regs: dict) -> object:
 
 
 # ------------------------------------------------------------- the board
-#: Board HAL functions drive_isr calls in every ISR that runs the law; the
-#: PIL runs its replay stand-ins (pil/hal_pil.c) instead.
-BOARD_HAL = ("hal_adc_read", "hal_fault_hw_tripped", "hal_pwm_set_duty")
+#: Board HAL functions drive_isr calls in every ISR that runs the law
+#: (hal_adc_read also calls hal_caps, in flash through a veneer; the walk
+#: follows it); the PIL runs its replay stand-ins (pil/hal_pil.c) instead.
+BOARD_HAL = ("hal_adc_read", "hal_fault_hw_tripped", "hal_pwm_write")
+
+
+def stand_ins(prog: Program) -> frozenset[str]:
+    """The functions of a PIL image that the board replaces: :data:`BOARD_HAL`
+    and what only they call (the replay's timer model calls roundf from
+    hal_pwm_write, hal_pattern.h)."""
+    calls = prog.callers()
+    out = set(f for f in BOARD_HAL if f in prog.funcs)
+    grew = True
+    while grew:
+        grew = False
+        for f, by in calls.items():
+            if f not in out and by and by <= out:
+                out.add(f)
+                grew = True
+    return frozenset(out)
+
 #: The core's trig entry points, bound to the CORDIC on the board (cordic_bind.c).
 BOARD_TRIG = ("fd_sincosf", "fd_atan2f")
 ADC_WAIT_CHECKS = 200  # adc.c: for (t = 0; t < 200u && !(ADC2->ISR & JEOS); t++)
@@ -938,46 +967,68 @@ def _path_part(prog: Program, name: str, p: ExecPath, note: str = "") -> Part:
     return Part(name, len(p.pcs), sequence_cycles(prog, p.pcs), p.bus, note)
 
 
+#: What each board HAL part includes (shown in the report).
+HAL_NOTES = {
+    "hal_adc_read": "with hal_caps (flash, through a veneer) for t_i",
+    "hal_fault_hw_tripped": "flash, through a veneer",
+    "hal_pwm_write": "3 x duty_to_ccr, the applied pattern",
+}
+
+
 def bound_board(prog: Program, elf: str = "") -> BoardBound:
     """The board's ISR path that the PIL does not run, with the same model.
 
     * typical: ADC2 ready at the first check, no overrun, duties inside
       (0, max) (no clamp), ART cache hits; board-configuration branches
-      (which signals are measured) take the longer side;
+      (which signals are measured, ADC2 in use) take the longer side;
     * worst: the wait loop exhausted (200 checks of ADC2->ISR), the overrun
       bookkeeping, the longer side of every other branch, ART cache misses.
+
+    Both: hal_caps() already initialised (drive_init called it), and
+    hal_pwm_write() asked for the applied pattern (drive_write does).
 
     Wrapper = exception entry/exit with lazy FP stacking + ADC1_2_IRQHandler
     (with hal_tim1_clear_update, board_control_isr's tail call and
     hal_tim1_update_pending), drive_isr excluded. The board HAL that
-    drive_isr calls (:data:`BOARD_HAL`) is bounded separately: the PIL
-    counts its stand-ins instead."""
-    need = ("ADC1_2_IRQHandler", "board_control_isr", "drive_isr") + BOARD_HAL
+    drive_isr calls (:data:`BOARD_HAL`, hal_adc_read with its hal_caps call)
+    is bounded separately: the PIL counts its stand-ins instead."""
+    need = ("ADC1_2_IRQHandler", "board_control_isr", "drive_isr", "hal_caps") + BOARD_HAL
     missing = [f for f in need if f not in prog.funcs]
     if missing:
         raise FluxdriveError(f"{elf or 'image'}: not a board image (no {', '.join(missing)})",
                              exit_code=1)
     h = "ADC1_2_IRQHandler"
-    _check_branches(prog, h, ("bmi", "bne", "cbz"))  # ADC2 ready, loop, no overrun
-    _check_branches(prog, "hal_adc_read", ("beq", "bne", "cbz", "cbz"))
+    # ADC2 ready, wait loop, ADC2 in use (JEXTEN), overrun
+    _check_branches(prog, h, ("bmi", "bne", "beq", "cbz"))
+    # channel k measured, loop over k, v_dc measured, star point measured
+    _check_branches(prog, "hal_adc_read", ("beq", "bne", "beq", "cbz"))
+    _check_branches(prog, "hal_caps", ("cbnz",))  # initialised
+    _check_branches(prog, "hal_pwm_write", ("beq",))  # applied == NULL
+    _check_branches(prog, "duty_to_ccr", ("ble",))  # d <= 0 (or NaN): 0
+    _check_branches(prog, "hal_fault_hw_tripped", ())
     stop = {prog.funcs["drive_isr"]}
 
-    def loops(ins: Insn, k: int, n: int) -> bool | None:
+    def common(ins: Insn, k: int, n: int) -> bool | None:
         if ins.func == "hal_adc_read" and k == 1:
             return n < 2  # for k in 0..2
+        if ins.func == "hal_caps":
+            return True  # initialised by drive_init
+        if ins.func == "hal_pwm_write":
+            return False  # drive_write asks for the applied pattern
         return None
 
     def typical(ins: Insn, k: int, n: int) -> bool | None:
         if ins.func == h:
-            return (True, False, True)[k]  # ready at once; (loop unused); no overrun
+            # ready at once; (loop unused); ADC2 in use: longer side; no overrun
+            return (True, False, None, True)[k]
         if ins.func == "duty_to_ccr":
             return False  # d > 0: no clamp to 0
-        return loops(ins, k, n)
+        return common(ins, k, n)
 
     def worst(ins: Insn, k: int, n: int) -> bool | None:
         if ins.func == h:
-            return (False, n < ADC_WAIT_CHECKS - 1, False)[k]
-        return loops(ins, k, n)
+            return (False, n < ADC_WAIT_CHECKS - 1, None, False)[k]
+        return common(ins, k, n)
 
     cases = {}
     for label, decide, wf in (("typical", typical, False), ("worst", worst, True)):
@@ -991,7 +1042,8 @@ def bound_board(prog: Program, elf: str = "") -> BoardBound:
             _path_part(prog, f"{h} (+ hal_tim1_*, board_control_isr)", p,
                        f"{checks} ADC2 check{'s' if checks != 1 else ''}"),
         ]
-        hal = [_path_part(prog, name, walk(prog, _entry(prog, name), decide, stop, wf))
+        hal = [_path_part(prog, name, walk(prog, _entry(prog, name), decide, stop, wf),
+                          HAL_NOTES.get(name, ""))
                for name in BOARD_HAL]
         cases[label] = BoardCase(wrapper, hal)
     trig = []

@@ -8,10 +8,16 @@ Per scenario and control law:
    replays the whole stream in QEMU; its outputs are compared with the
    host's: duties within ``DUTY_TOL``, gate state, fault bits and drive
    state identical.
-3. The first ``isrs`` ISRs are replayed again with ``-singlestep -d
-   exec,nochain``: every executed instruction is one trace line, streamed
-   through a FIFO and counted per ISR (from drive_isr's entry to the first
-   line back in its caller pil_step, callees included) and per function.
+3. The first ``isrs`` ISRs (0: all of them) are replayed again with
+   ``-singlestep -d exec,nochain``: every executed instruction is one trace
+   line, streamed through a FIFO and counted per ISR (from drive_isr's entry
+   to the first line back in its caller pil_step, callees included) and per
+   function, and priced with the Cortex-M4 model (cm4_cycles).
+
+Without ``--elf`` / ``$FLUXDRIVE_PIL_ELF`` and ``--sil`` / ``$FLUXDRIVE_SIL``
+the default image and runner of the repo are used, and built first when
+they are missing (presets ``cortex-m4f`` and ``host-release``). Every path
+handed to QEMU and the runner is absolute.
 """
 
 from __future__ import annotations
@@ -32,10 +38,13 @@ from fluxdrive.errors import FluxdriveError
 
 ENV_ELF = "FLUXDRIVE_PIL_ELF"
 ELF_RELPATH = Path("build/cortex-m4f/pil/fluxdrive-pil.elf")
-ELF_HINT = (
-    "build it with: cmake --preset cortex-m4f && "
-    "cmake --build build/cortex-m4f --target fluxdrive-pil.elf"
-)
+#: How the default image and runner are built when missing (run in the repo root).
+ELF_BUILD = (["cmake", "--preset", "cortex-m4f"],
+             ["cmake", "--build", "build/cortex-m4f", "--target", "fluxdrive-pil.elf"])
+SIL_BUILD = (["cmake", "--preset", "host-release"],
+             ["cmake", "--build", "--preset", "host-release", "--target", "fluxdrive-sil"])
+ELF_HINT = "build it with: " + " && ".join(" ".join(a) for a in ELF_BUILD)
+CROSS_CC = "arm-none-eabi-gcc"
 QEMU = "qemu-system-arm"
 
 #: Absolute tolerance on the duties (0..1). Both builds are IEEE-754 binary32
@@ -74,8 +83,11 @@ IN_SIZE = 240
 #: Blocks of the per-function share: the first pattern that a function name
 #: starts with (or equals) names its block.
 BLOCKS = [
-    ("drive (ISR body, protections, PLL, offsets)", ("drive_", "angle_pll_")),
-    ("control-law dispatch", ("ctrl_",)),
+    ("drive (ISR body, commands, protections, offsets)", ("drive_", "hal_pwm_centred")),
+    ("speed loop (speed_ctrl, every slow_div ISRs)", ("speed_ctrl_",)),
+    ("position source (encoder, PLL)", ("enc_", "pos_source", "angle_pll_")),
+    ("control-law dispatch (ctrl, law tables)", ("ctrl_", "dfvc_law_", "db_step", "pi_step",
+                                                 "foc_step")),
     ("DFVC step", ("dfvc_step", "dfvc_reset")),
     ("flux observer", ("flux_observer_", "flux_obs_")),
     ("current predictor", ("current_predictor_",)),
@@ -88,6 +100,7 @@ BLOCKS = [
     ("modulation", ("modulation_",)),
     ("dead-time compensation", ("deadtime_comp_",)),
     ("frames (Clarke/Park, wrap)", ("frames_",)),
+    ("machine model", ("machine_", "mtpa_at")),
     ("core trig fd_sincosf/fd_atan2f (math/fast_trig)", ("fd_",)),
     (
         "libm sinf/cosf (newlib)",
@@ -100,7 +113,9 @@ BLOCKS = [
     ("libm classify/min/max/floor (newlib)", ("__fpclassifyf", "fmaxf", "fminf", "floorf",
                                               "fabsf", "scalbnf", "copysignf")),
     ("libc memset/memcpy", ("memset", "memcpy")),
-    ("PIL replay HAL (stands in for the register HAL)", ("hal_",)),
+    # roundf: the replay HAL's timer model (hal_pattern.h) rounds the edges;
+    # called by hal_pwm_write only (cm4_cycles.stand_ins checks the image)
+    ("PIL replay HAL (stands in for the register HAL)", ("hal_", "roundf")),
 ]
 
 
@@ -154,6 +169,7 @@ def qemu_argv(elf: Path, trace: Path | None) -> list[str]:
 
 
 def run_qemu(elf: Path, workdir: Path, timeout: float) -> np.ndarray:
+    workdir, elf = workdir.resolve(), elf.resolve()
     out = workdir / "pil_out.bin"
     out.unlink(missing_ok=True)
     try:
@@ -244,6 +260,7 @@ def _unknown_pc(line: bytes, j: int, k: bytes, res: TraceResult) -> tuple:
 def run_qemu_trace(elf: Path, workdir: Path, timeout: float,
                    tab: dict | None = None) -> tuple[TraceResult, np.ndarray]:
     """Traced replay; ``tab``: cm4_cycles.trace_table of ``elf`` (built when None)."""
+    workdir, elf = workdir.resolve(), elf.resolve()  # QEMU's -D path is taken from its cwd
     if tab is None:
         tab = cm4_cycles.trace_table(cm4_cycles.load_program(elf))
     fifo = workdir / "trace.fifo"
@@ -337,6 +354,8 @@ class Counts:
     cycles_worst_isr: int = 0
     block_cycles: dict[str, float] = field(default_factory=dict)  # mean per ISR
     func_cycles: dict[str, float] = field(default_factory=dict)
+    #: the image's replay-HAL functions the board replaces (cm4_cycles.stand_ins)
+    stand_ins: frozenset = frozenset(cm4_cycles.BOARD_HAL)
 
     @property
     def cpi(self) -> float:
@@ -344,7 +363,7 @@ class Counts:
 
     def stand_in_cycles(self) -> float:
         """Mean cycles per ISR in the PIL replay HAL (the board runs its own)."""
-        return sum(v for f, v in self.func_cycles.items() if f in cm4_cycles.BOARD_HAL)
+        return sum(v for f, v in self.func_cycles.items() if f in self.stand_ins)
 
 
 def _mean_by(run: list[int], per_isr: list[dict[str, int]]) -> tuple[dict, dict]:
@@ -359,7 +378,8 @@ def _mean_by(run: list[int], per_isr: list[dict[str, int]]) -> tuple[dict, dict]
     return blocks, {f: v / len(run) for f, v in funcs.items()}
 
 
-def law_counts(tr: TraceResult, host: np.ndarray) -> Counts:
+def law_counts(tr: TraceResult, host: np.ndarray,
+               stand_ins: frozenset = frozenset(cm4_cycles.BOARD_HAL)) -> Counts:
     n = min(len(tr.counts), len(host))
     st = host["state"][:n]
     run = [j for j in range(1, n) if st[j] == RUN and st[j - 1] == RUN]
@@ -369,7 +389,8 @@ def law_counts(tr: TraceResult, host: np.ndarray) -> Counts:
     c = np.array([tr.counts[j] for j in run])
     blocks, funcs = _mean_by(run, tr.funcs)
     w = int(np.argmax(c))
-    out = Counts(len(run), float(c.mean()), int(c[w]), run[w], blocks, funcs)
+    out = Counts(len(run), float(c.mean()), int(c[w]), run[w], blocks, funcs,
+                 stand_ins=frozenset(stand_ins))
     if len(tr.cycles) >= n:
         y = np.array([tr.cycles[j] for j in run])
         wy = int(np.argmax(y))
@@ -389,7 +410,24 @@ class PilRun:
     trace_exact: bool  # traced replay's outputs == untraced replay's
 
 
-def locate_elf(explicit: str | None) -> Path:
+def build_default(root: Path, steps: tuple[list[str], ...], what: str) -> None:
+    """Build a missing default artefact in the repo root, saying so."""
+    for argv in steps:
+        print(f"fluxdrive pil: {what} missing, building it: {' '.join(argv)}  (in {root})",
+              flush=True)
+        try:
+            r = subprocess.run(argv, cwd=root, check=False)
+        except FileNotFoundError:
+            raise FluxdriveError(f"cannot build the {what}: {argv[0]} not found",
+                                 hint="apt-get install cmake ninja-build") from None
+        if r.returncode != 0:
+            raise FluxdriveError(f"building the {what} failed (exit {r.returncode}): "
+                                 f"{' '.join(argv)}", exit_code=1)
+
+
+def locate_elf(explicit: str | None, build: bool = True) -> Path:
+    """--elf, else $FLUXDRIVE_PIL_ELF (both authoritative: never built), else
+    the repo's build/cortex-m4f image, built first when missing."""
     if explicit:
         p = Path(explicit)
     elif os.environ.get(ENV_ELF):
@@ -399,9 +437,26 @@ def locate_elf(explicit: str | None) -> Path:
         if root is None:
             raise FluxdriveError("cannot find the repo root; pass --elf", hint=ELF_HINT)
         p = root / ELF_RELPATH
+        if not p.exists() and build:
+            if shutil.which(CROSS_CC) is None:
+                raise FluxdriveError(
+                    f"PIL image not found: {p}; building it needs {CROSS_CC}, not found",
+                    hint="apt-get install gcc-arm-none-eabi libnewlib-arm-none-eabi "
+                         "(or pass --elf)")
+            build_default(root, ELF_BUILD, "PIL image")
     if not p.is_file():
         raise FluxdriveError(f"PIL image not found: {p}", hint=ELF_HINT)
     return p.resolve()
+
+
+def locate_runner(explicit: str | None, build: bool = True) -> Path:
+    """--sil, else $FLUXDRIVE_SIL (both authoritative: never built), else the
+    repo's build/host-release runner, built first when missing."""
+    if not explicit and not os.environ.get(sil.ENV_SIL) and build:
+        root = sil.find_repo_root()
+        if root is not None and not (root / sil.SIL_RELPATH).exists():
+            build_default(root, SIL_BUILD, "SIL runner")
+    return sil.locate_sil(explicit)
 
 
 def scenario_with_law(src: Path, law: str | None, dst: Path) -> str:
@@ -417,7 +472,10 @@ def scenario_with_law(src: Path, law: str | None, dst: Path) -> str:
 
 
 def run_one(runner: Path, elf: Path, scenario: Path, law: str | None, isrs: int,
-            workdir: Path, force: bool, timeout: float, tab: dict | None = None) -> PilRun:
+            workdir: Path, force: bool, timeout: float, tab: dict | None = None,
+            stand_ins: frozenset = frozenset(cm4_cycles.BOARD_HAL)) -> PilRun:
+    """One scenario and law; ``isrs`` ISRs traced (0: all)."""
+    workdir = workdir.resolve()  # QEMU runs in it and gets the FIFO's path
     workdir.mkdir(parents=True, exist_ok=True)
     scen = workdir / "scenario.json"
     law_name = scenario_with_law(scenario, law, scen)
@@ -433,13 +491,13 @@ def run_one(runner: Path, elf: Path, scenario: Path, law: str | None, isrs: int,
     pil_out = run_qemu(elf, workdir, timeout)
     agreement = compare(host, pil_out)
 
-    n = min(isrs, len(body))
+    n = len(body) if isrs <= 0 else min(isrs, len(body))
     write_pil_input(workdir / "pil_in.bin", head, body, n, force)
     tr, traced_out = run_qemu_trace(elf, workdir, timeout, tab)
     if len(tr.counts) != n:
         raise FluxdriveError(f"trace shows {len(tr.counts)} ISRs, replayed {n}", exit_code=1)
     exact = traced_out.tobytes() == pil_out[:n].tobytes()
-    return PilRun(scenario.stem, law_name, agreement, law_counts(tr, host), exact)
+    return PilRun(scenario.stem, law_name, agreement, law_counts(tr, host, stand_ins), exact)
 
 
 # ---------------------------------------------------------------- report
@@ -457,6 +515,12 @@ def board_estimate(c: Counts, board: cm4_cycles.BoardBound) -> tuple[float, floa
             c.cycles_worst + base + w.hal_cycles + w.wrapper_cycles)
 
 
+def traced_text(isrs: int, total: int) -> str:
+    if isrs <= 0 or isrs >= total:
+        return f"all {total} ISRs traced"
+    return f"first {isrs} of {total} ISRs traced"
+
+
 def format_report(runs: list[PilRun], isrs: int, cpi: float | None = None,
                   board: cm4_cycles.BoardBound | None = None) -> str:
     lines = []
@@ -470,7 +534,7 @@ def format_report(runs: list[PilRun], isrs: int, cpi: float | None = None,
             f"{'OK' if a.ok else 'FAIL'}"
         )
         lines.append(
-            f"instructions per ISR over {c.isrs} law ISRs (first {isrs} ISRs traced): mean "
+            f"instructions per ISR over {c.isrs} law ISRs ({traced_text(isrs, a.isrs)}): mean "
             f"{c.mean:.0f}, worst {c.worst} (ISR {c.worst_isr}); traced outputs identical to "
             f"untraced: {r.trace_exact}"
         )
@@ -502,13 +566,14 @@ SECTION = "## ISR instruction counts (PIL, QEMU mps2-an386)"
 def format_markdown(runs: list[PilRun], isrs: int, cpi: float | None, build: str,
                     board: cm4_cycles.BoardBound | None = None) -> str:
     out = [SECTION, ""]
+    window = ("every ISR of each run traced" if isrs <= 0
+              else f"within the first {isrs} ISRs of each scenario")
     out.append(
         f"Measured by `fluxdrive pil` (docs/pil.md): the ISR inputs of a SIL run replayed on "
         f"the Cortex-M4F image in QEMU 7.2 `mps2-an386` (`{build}`), executed instructions "
         f"counted exactly from the `-singlestep -d exec,nochain` trace, from `drive_isr` "
         f"entry to its return, callees included, over the ISRs that ran the control law "
-        f"within the first {isrs} ISRs of each scenario. The cycles are an **estimate**: "
-        f"every traced instruction priced with the Cortex-M4 cycle model of docs/pil.md "
+        f"({window}). The cycles are an **estimate**: every traced instruction priced with the Cortex-M4 cycle model of docs/pil.md "
         f"(TRM instruction timings, zero wait states, taken branches from the traced PC "
         f"sequence, P = {cm4_cycles.P}), against {BUDGET_CYCLES} cycles per ISR "
         f"(170 MHz / 16 kHz). Not included: the board's ISR wrapper, exception entry/exit "
@@ -591,26 +656,28 @@ def main(args) -> int:
     import time
 
     tools_available()
-    runner = sil.locate_sil(args.sil)
-    elf = locate_elf(args.elf)
     scenarios = []
     for s in args.scenario:
         p = Path(s)
         if not p.is_file():
             raise FluxdriveError(f"scenario not found: {p}")
-        scenarios.append(p)
+        scenarios.append(p.resolve())
     laws: list[str | None] = [None]
     if args.law:
         laws = [x.strip() for x in args.law.split(",") if x.strip()]
         bad = [x for x in laws if x not in LAWS]
         if bad:
             raise FluxdriveError(f"unknown law {bad[0]!r}; use {', '.join(LAWS)}")
-    out_dir = Path(args.out) if args.out else Path("out") / "pil"
+    runner = locate_runner(args.sil)
+    elf = locate_elf(args.elf)
+    # absolute: QEMU runs with its working directory in here
+    out_dir = (Path(args.out) if args.out else Path("out") / "pil").resolve()
     prog = cm4_cycles.load_program(elf)
     if prog.unclassified():
         print(f"warning: instructions outside the cycle model (1 cycle assumed): "
               f"{prog.unclassified()}")
     tab = cm4_cycles.trace_table(prog)
+    hal = cm4_cycles.stand_ins(prog)
     board = None
     if args.board_elf:
         bp = Path(args.board_elf)
@@ -627,7 +694,7 @@ def main(args) -> int:
             t0 = time.monotonic()
             wd = out_dir / f"{sc.stem}-{law or 'scenario'}"
             r = run_one(runner, elf, sc, law, args.isrs, wd, not args.free_running,
-                        args.timeout, dict(tab))
+                        args.timeout, dict(tab), hal)
             runs.append(r)
             print(format_report([r], args.isrs, cpi, board), flush=True)
             print(f"  ({time.monotonic() - t0:.1f} s, files in {wd})", flush=True)
@@ -636,16 +703,36 @@ def main(args) -> int:
     if args.markdown:
         update_markdown(Path(args.markdown), md)
         print(f"markdown: {args.markdown} (section '{SECTION[3:]}')")
+    return check_runs(runs, args.check_worst, getattr(args, "check_cycles", None))
+
+
+def check_runs(runs: list[PilRun], worst_instr: int | None, worst_pct: float | None) -> int:
+    """Agreement and exact trace for every run; with limits, the DB-DFVC
+    worst case: fewer than ``worst_instr`` instructions and at most
+    ``worst_pct`` % of the cycle budget (estimated). Prints; 1 on failure."""
     rc = 0
     for r in runs:
+        name = f"{r.scenario}/{r.law}"
         if not r.agreement.ok:
-            print(f"FAIL: {r.scenario}/{r.law}: PIL outputs disagree with the host build")
+            print(f"FAIL: {name}: PIL outputs disagree with the host build")
             rc = 1
         if not r.trace_exact:
-            print(f"FAIL: {r.scenario}/{r.law}: traced replay differs from the untraced one")
+            print(f"FAIL: {name}: traced replay differs from the untraced one")
             rc = 1
-        if args.check_worst and r.law == "db_dfvc" and r.counts.worst >= args.check_worst:
-            print(f"FAIL: {r.scenario}/{r.law}: worst case {r.counts.worst} instructions, "
-                  f"limit {args.check_worst}")
-            rc = 1
+        if r.law != "db_dfvc":
+            continue
+        c = r.counts
+        if worst_instr:
+            ok = c.worst < worst_instr
+            print(f"{'check' if ok else 'FAIL'}: {name}: worst case {c.worst} instructions "
+                  f"(ISR {c.worst_isr}), limit {worst_instr}")
+            rc |= 0 if ok else 1
+        if worst_pct:
+            lim = worst_pct / 100.0 * BUDGET_CYCLES
+            ok = c.cycles_worst <= lim
+            pct = 100 * c.cycles_worst / BUDGET_CYCLES
+            print(f"{'check' if ok else 'FAIL'}: {name}: worst case {c.cycles_worst} estimated "
+                  f"cycles (ISR {c.cycles_worst_isr}) = {pct:.1f} % of {BUDGET_CYCLES}, "
+                  f"limit {worst_pct:g} % ({lim:.0f})")
+            rc |= 0 if ok else 1
     return rc

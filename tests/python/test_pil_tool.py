@@ -1,0 +1,182 @@
+"""``fluxdrive pil`` without QEMU: defaults, builds of missing artefacts,
+absolute paths, --isrs all, the checks."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import pytest
+
+from fluxdrive import cm4_cycles as cm
+from fluxdrive import pil, sil
+from fluxdrive.cli import _isrs, build_parser
+from fluxdrive.errors import FluxdriveError
+
+
+@pytest.fixture
+def repo(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """An empty repo root (cwd) with nothing built; builds are recorded."""
+    root = tmp_path / "repo"
+    (root / "sil").mkdir(parents=True)
+    (root / "CMakePresets.json").write_text("{}")
+    monkeypatch.chdir(root)
+    monkeypatch.delenv(pil.ENV_ELF, raising=False)
+    monkeypatch.delenv(sil.ENV_SIL, raising=False)
+    monkeypatch.setattr(sil, "find_repo_root", lambda start=None: root)
+    return root
+
+
+def fake_build(monkeypatch: pytest.MonkeyPatch, produce: dict[str, Path]) -> list[list[str]]:
+    """subprocess.run stand-in: records cmake calls; a build creates its artefact."""
+    done: list[list[str]] = []
+
+    class R:
+        returncode = 0
+
+    def run(argv, cwd=None, check=False):
+        done.append(list(argv))
+        for target, path in produce.items():
+            if "--build" in argv and target in argv:
+                path.parent.mkdir(parents=True, exist_ok=True)
+                path.write_text("")
+                path.chmod(0o755)
+        return R()
+
+    monkeypatch.setattr(pil.subprocess, "run", run)
+    return done
+
+
+def test_default_elf_is_built_when_missing(repo, monkeypatch, capsys) -> None:
+    elf = repo / pil.ELF_RELPATH
+    done = fake_build(monkeypatch, {"fluxdrive-pil.elf": elf})
+    monkeypatch.setattr(pil.shutil, "which", lambda name: f"/usr/bin/{name}")
+    assert pil.locate_elf(None) == elf.resolve()
+    assert done == [list(a) for a in pil.ELF_BUILD]
+    assert "PIL image missing, building it: cmake --preset cortex-m4f" in capsys.readouterr().out
+    done.clear()
+    assert pil.locate_elf(None) == elf.resolve()  # present: not built again
+    assert done == []
+
+
+def test_default_elf_without_cross_compiler(repo, monkeypatch) -> None:
+    done = fake_build(monkeypatch, {})
+    monkeypatch.setattr(pil.shutil, "which", lambda name: None)
+    with pytest.raises(FluxdriveError, match="needs arm-none-eabi-gcc, not found") as e:
+        pil.locate_elf(None)
+    assert "gcc-arm-none-eabi" in (e.value.hint or "")
+    assert done == []
+
+
+def test_explicit_elf_is_authoritative(repo, monkeypatch, tmp_path) -> None:
+    done = fake_build(monkeypatch, {"fluxdrive-pil.elf": repo / pil.ELF_RELPATH})
+    with pytest.raises(FluxdriveError, match="PIL image not found"):
+        pil.locate_elf(str(tmp_path / "nope.elf"))
+    monkeypatch.setenv(pil.ENV_ELF, str(tmp_path / "env.elf"))
+    with pytest.raises(FluxdriveError, match="env.elf"):
+        pil.locate_elf(None)
+    assert done == []  # never built when a path was given
+
+
+def test_default_runner_is_built_when_missing(repo, monkeypatch, capsys) -> None:
+    runner = repo / sil.SIL_RELPATH
+    done = fake_build(monkeypatch, {"fluxdrive-sil": runner})
+    assert pil.locate_runner(None) == runner.resolve()
+    assert done == [list(a) for a in pil.SIL_BUILD]
+    assert done[1] == ["cmake", "--build", "--preset", "host-release", "--target", "fluxdrive-sil"]
+    assert "SIL runner missing, building it" in capsys.readouterr().out
+
+
+def test_explicit_runner_is_authoritative(repo, monkeypatch, tmp_path) -> None:
+    done = fake_build(monkeypatch, {"fluxdrive-sil": repo / sil.SIL_RELPATH})
+    with pytest.raises(FluxdriveError, match="SIL runner not found"):
+        pil.locate_runner(str(tmp_path / "nope"))
+    monkeypatch.setenv(sil.ENV_SIL, str(tmp_path / "env-sil"))
+    with pytest.raises(FluxdriveError, match="env-sil"):
+        pil.locate_runner(None)
+    assert done == []
+
+
+def test_failed_build_is_an_error(repo, monkeypatch) -> None:
+    class R:
+        returncode = 1
+
+    monkeypatch.setattr(pil.subprocess, "run", lambda argv, cwd=None, check=False: R())
+    with pytest.raises(FluxdriveError, match="building the SIL runner failed"):
+        pil.locate_runner(None)
+
+
+def test_qemu_gets_absolute_paths(tmp_path, monkeypatch) -> None:
+    """QEMU runs in the work directory: the FIFO and image paths it gets must
+    not be relative to the caller's cwd (README on a fresh clone)."""
+    monkeypatch.chdir(tmp_path)
+    seen = {}
+
+    class P:
+        returncode = 0
+
+        def communicate(self, timeout=None):
+            return b"", b""
+
+    def popen(argv, cwd=None, **kw):
+        seen["argv"], seen["cwd"] = argv, cwd
+        (Path(cwd) / "pil_out.bin").write_bytes(b"")
+        return P()
+
+    def run(argv, cwd=None, **kw):
+        seen["run_argv"], seen["run_cwd"] = argv, cwd
+        (Path(cwd) / "pil_out.bin").write_bytes(b"")
+        return P()
+
+    monkeypatch.setattr(pil.subprocess, "Popen", popen)
+    monkeypatch.setattr(pil.subprocess, "run", run)
+    monkeypatch.setattr(pil.threading.Thread, "start", lambda self: None)
+    monkeypatch.setattr(pil.threading.Thread, "join", lambda self, timeout=None: None)
+    (tmp_path / "out" / "w").mkdir(parents=True)
+    pil.run_qemu_trace(Path("x.elf"), Path("out/w"), 1.0, tab={})
+    argv = seen["argv"]
+    assert Path(seen["cwd"]) == tmp_path / "out" / "w"
+    assert Path(argv[argv.index("-D") + 1]) == tmp_path / "out" / "w" / "trace.fifo"
+    assert Path(argv[argv.index("-kernel") + 1]) == tmp_path / "x.elf"
+    pil.run_qemu(Path("x.elf"), Path("out/w"), 1.0)
+    assert Path(seen["run_cwd"]) == tmp_path / "out" / "w"
+    assert Path(seen["run_argv"][seen["run_argv"].index("-kernel") + 1]) == tmp_path / "x.elf"
+
+
+def test_isrs_all() -> None:
+    assert _isrs("all") == 0 and _isrs("ALL") == 0 and _isrs("0") == 0 and _isrs("3000") == 3000
+    for bad in ("-1", "many"):
+        with pytest.raises(argparse.ArgumentTypeError):
+            _isrs(bad)
+    a = build_parser().parse_args(["pil", "s.json", "--isrs", "all", "--check-cycles", "50"])
+    assert a.isrs == 0 and a.check_cycles == 50.0
+    assert build_parser().parse_args(["pil", "s.json"]).isrs == 3000
+    assert pil.traced_text(0, 6399) == "all 6399 ISRs traced"
+    assert pil.traced_text(3000, 3999) == "first 3000 of 3999 ISRs traced"
+
+
+def run_with(law: str, worst: int, cycles: int) -> pil.PilRun:
+    c = pil.Counts(isrs=10, mean=worst - 100, worst=worst, worst_isr=7, blocks={}, funcs={},
+                   cycles_mean=cycles - 200, cycles_worst=cycles, cycles_worst_isr=8)
+    return pil.PilRun("scen", law, pil.Agreement(100, 0.0, 0, 0, 0, 0, 0), c, True)
+
+
+def test_checks_on_db_dfvc(capsys) -> None:
+    lim = 0.5 * cm.BUDGET_CYCLES  # 5312.5
+    assert pil.check_runs([run_with("db_dfvc", 2999, 5312)], 3000, 50) == 0
+    assert "= 50.0 % of 10625, limit 50 % (5312)" in capsys.readouterr().out
+    assert pil.check_runs([run_with("db_dfvc", 3000, 5312)], 3000, 50) == 1
+    assert pil.check_runs([run_with("db_dfvc", 2000, int(lim) + 1)], 3000, 50) == 1
+    assert "FAIL: scen/db_dfvc: worst case 5313 estimated cycles" in capsys.readouterr().out
+    # other laws are reported for agreement only
+    assert pil.check_runs([run_with("foc", 9000, 9000)], 3000, 50) == 0
+    bad = run_with("foc", 1, 1)
+    bad.agreement.duty_bad = 1
+    assert pil.check_runs([bad], None, None) == 1
+
+
+def test_pil_help_documents_all(capsys) -> None:
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["pil", "--help"])
+    text = capsys.readouterr().out
+    assert "all or 0: the whole run" in " ".join(text.split())

@@ -381,7 +381,7 @@ static void drive_speed_loop(drive_t *drv) {
     const float w_ref = fd_clampf(drv->cmd.speed, -c->speed_max, c->speed_max);
     drv->speed_torque =
         speed_ctrl_update(&drv->speed, w_ref, w, drv->torque_min_avail, drv->torque_max_avail);
-  } else {
+  } else if (drv->speed_active) { /* reset once, when the loop stops */
     speed_ctrl_reset(&drv->speed, drv->omega_m, 0.0f);
     drv->speed_active = false;
     drv->speed_torque = 0.0f;

@@ -59,6 +59,9 @@ static float adc_sample_instant(void) {
   return (2.0f + 0.25f * half) / f_adc;
 }
 
+/* adc_sample_instant(), set by hal_adc_init (the ISR reads it, no call). */
+static float s_t_i;
+
 static adc_regs_t *adc_of(uint32_t n) {
   return (n == 1u) ? ADC1 : ADC2;
 }
@@ -105,6 +108,7 @@ static bool adc_power_up(adc_regs_t *adc) {
 }
 
 bool hal_adc_init(void) {
+  s_t_i = adc_sample_instant();
   opamp_init();
   for (uint32_t i = 0; i < BOARD_ADC_NPINS; i++) {
     hal_gpio_analog(k_adc_pins[i].port, k_adc_pins[i].pin);
@@ -192,7 +196,7 @@ HOT void hal_adc_read(hal_sample_t *s) {
   s->i_abc[1] = i[1];
   s->i_abc[2] = i[2];
   s->v_dc = (s_jdr[SIG_VDC] != 0) ? raw_volts(s_jdr[SIG_VDC]) * BOARD_VDC_RATIO : 0.0f;
-  s->t_i = hal_caps()->t_i;
+  s->t_i = s_t_i;
   /* star point measured to ground; hal.h wants it w.r.t. the DC midpoint;
    * sampled with the currents (the DFC window needs HAL_CAP_STAR_POINT) */
   s->n_star = (s_jdr[SIG_VSTAR] != 0) ? 1u : 0u;

@@ -180,3 +180,16 @@ def test_pil_help_documents_all(capsys) -> None:
         build_parser().parse_args(["pil", "--help"])
     text = capsys.readouterr().out
     assert "all or 0: the whole run" in " ".join(text.split())
+
+
+def test_functions_listed_on_request() -> None:
+    r = run_with("db_dfvc", 2000, 4000)
+    r.counts.funcs = {"drive_isr": 460.0, "dfvc_step": 293.0}
+    r.counts.func_cycles = {"drive_isr": 672.0, "dfvc_step": 493.0}
+    assert "function" not in pil.format_report([r], 3000)
+    text = pil.format_report([r], 3000, functions=True)
+    lines = text.splitlines()
+    k = next(i for i, line in enumerate(lines) if line.endswith("function"))
+    assert lines[k + 1].split()[-1] == "drive_isr" and "672.0" in lines[k + 1]
+    assert lines[k + 2].split()[-1] == "dfvc_step"
+    assert build_parser().parse_args(["pil", "s.json", "--functions"]).functions

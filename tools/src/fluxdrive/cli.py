@@ -242,6 +242,8 @@ def build_parser() -> argparse.ArgumentParser:
                    "(fluxdrive cycles-board) to a board estimate")
     p.add_argument("--cpi", type=float, default=None, help="legacy: also show the worst case at "
                    "this flat cycles/instruction (the report uses the cycle model)")
+    p.add_argument("--functions", action="store_true",
+                   help="also list the mean instructions and cycles per function")
     p.add_argument("--free-running", action="store_true",
                    help="do not force the applied voltage (docs/pil.md)")
     p.add_argument("--timeout", type=float, default=600.0, help="per QEMU run [s]")

@@ -522,7 +522,7 @@ def traced_text(isrs: int, total: int) -> str:
 
 
 def format_report(runs: list[PilRun], isrs: int, cpi: float | None = None,
-                  board: cm4_cycles.BoardBound | None = None) -> str:
+                  board: cm4_cycles.BoardBound | None = None, functions: bool = False) -> str:
     lines = []
     for r in runs:
         a, c = r.agreement, r.counts
@@ -557,6 +557,13 @@ def format_report(runs: list[PilRun], isrs: int, cpi: float | None = None,
             y = c.block_cycles.get(b, 0.0)
             cpi_b = y / v if v else 0.0
             lines.append(f"  {v:8.1f}  {100 * v / c.mean:5.1f} %  {y:9.1f}  {cpi_b:8.2f}   {b}")
+        if functions:
+            lines.append("  instr/ISR  share  cycles/ISR  cyc/instr  function")
+            for f, v in sorted(c.funcs.items(), key=lambda kv: -kv[1]):
+                y = c.func_cycles.get(f, 0.0)
+                cpi_f = y / v if v else 0.0
+                lines.append(f"  {v:8.1f}  {100 * v / c.mean:5.1f} %  {y:9.1f}  {cpi_f:8.2f}   "
+                             f"{f or '?'}")
     return "\n".join(lines)
 
 
@@ -696,7 +703,7 @@ def main(args) -> int:
             r = run_one(runner, elf, sc, law, args.isrs, wd, not args.free_running,
                         args.timeout, dict(tab), hal)
             runs.append(r)
-            print(format_report([r], args.isrs, cpi, board), flush=True)
+            print(format_report([r], args.isrs, cpi, board, args.functions), flush=True)
             print(f"  ({time.monotonic() - t0:.1f} s, files in {wd})", flush=True)
     build = "MinSizeRel -Os, -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard"
     md = format_markdown(runs, args.isrs, cpi, build, board)

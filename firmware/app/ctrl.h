@@ -65,8 +65,15 @@ typedef struct {
   float t_out; /* from the current sample to the centre of the output interval [s] */
 } ctrl_setup_t;
 
+/* FOC: the current loop and the MTPA torque at i_max (machine and i_max
+ * change only through init). */
+typedef struct {
+  current_ctrl_t cc;
+  float t_mtpa_max; /* [N m] */
+} ctrl_foc_t;
+
 typedef union {
-  current_ctrl_t foc;
+  ctrl_foc_t foc;
   dfvc_t dfvc;
 } ctrl_state_t;
 

@@ -26,12 +26,13 @@ static const char *foc_check(const ctrl_setup_t *su) {
 
 static int foc_init(ctrl_state_t *s, const ctrl_setup_t *su) {
   const current_ctrl_cfg_t ccfg = {su->machine, su->cfg->current_bw, su->cfg->ts};
-  current_ctrl_init(&s->foc, &ccfg);
+  current_ctrl_init(&s->foc.cc, &ccfg);
+  s->foc.t_mtpa_max = machine_mtpa_torque(su->machine, su->cfg->i_max);
   return 0;
 }
 
 static void foc_reset(ctrl_state_t *s) {
-  current_ctrl_reset(&s->foc);
+  current_ctrl_reset(&s->foc.cc);
 }
 
 static void foc_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *in,
@@ -40,7 +41,7 @@ static void foc_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *i
   const float i_max = su->cfg->i_max;
   const sincos_t sc = frames_sincos(in->theta_e);
   const dq_t i = frames_park(in->i_ab, sc);
-  const float t_lim = fd_minf(su->cfg->torque_max, machine_mtpa_torque(m, i_max));
+  const float t_lim = fd_minf(su->cfg->torque_max, s->foc.t_mtpa_max);
   dq_t i_ref;
   if (in->mode == DRIVE_MODE_CURRENT) {
     i_ref = (dq_t){in->id_ref, in->iq_ref};
@@ -53,7 +54,7 @@ static void foc_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *i
     i_ref.q *= i_max / mag;
   }
   const float v_max = su->cfg->v_margin * in->v_lin;
-  const dq_t v = current_ctrl_update(&s->foc, i_ref, i, in->omega_e, v_max);
+  const dq_t v = current_ctrl_update(&s->foc.cc, i_ref, i, in->omega_e, v_max);
   const sincos_t sc_next = frames_sincos(in->theta_e + in->omega_e * su->t_out);
   out->v_ref = frames_park_inv(v, sc_next);
   out->i_dq = i;

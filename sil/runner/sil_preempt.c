@@ -26,7 +26,7 @@ static _Atomic uint64_t g_k; /* periods done (written by the handler) */
 static atomic_bool g_stop;
 static pthread_t g_main;
 static double g_max_gap_us;
-static bool g_need_low; /* handler: a clear was taken, enable not yet seen low */
+static bool g_need_low; /* handler: a fault was cleared, enable not yet seen low */
 
 static double now_s(void) {
   struct timespec ts;
@@ -110,7 +110,9 @@ static void on_interrupt(int sig) {
     violation("the ISR's command block differs from the published one");
   }
   if (d->clear_seen != clear0) {
-    g_need_low = true;
+    /* a clear that found a fault needs a fresh enable; one that found none
+     * is void (the enable in the same block may start the drive) */
+    g_need_low = g_need_low || st0 == DRIVE_STATE_FAULT;
   } else {
     for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {
       if (d->fault_seen[b] != seen0[b] && (d->faults & (1u << b)) == 0u) {

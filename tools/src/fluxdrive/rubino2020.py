@@ -444,20 +444,25 @@ def plot_speed(run_: Run, path: Path) -> None:
 
 
 # ------------------------------------------------------------------- all
+def metrics(key: str, r: Run):
+    """The metrics of one scenario (a key of SCENARIOS) from its run."""
+    vdc = float(r.config["v_dc"])  # the plant's DC link
+    if key in ("step_db", "step_pi"):
+        return step_metrics(r.log, 0.1, v_dc=vdc)
+    if key == "reversal":
+        return step_metrics(r.log, 0.1, horizon=400, v_dc=vdc)
+    if key in ("fw", "fw_ls120", "fw_lm080"):
+        return ramp_metrics(r)
+    if key in ("bw_db", "bw_pi"):
+        return sine_metrics(r.log, 0.105, 1500.0)
+    if key == "speed":
+        return speed_metrics(r)
+    raise KeyError(key)
+
+
 def run_all(sil: Path, scenario_dir: Path, out: Path) -> tuple[dict, dict]:
     runs = {k: run(sil, scenario_dir / f, out) for k, f in SCENARIOS.items()}
-    vdc = lambda key: float(runs[key].config["v_dc"])  # noqa: E731  (the plant's DC link)
-    met = {
-        "step_db": step_metrics(runs["step_db"].log, 0.1, v_dc=vdc("step_db")),
-        "step_pi": step_metrics(runs["step_pi"].log, 0.1, v_dc=vdc("step_pi")),
-        "reversal": step_metrics(runs["reversal"].log, 0.1, horizon=400, v_dc=vdc("reversal")),
-        "fw": ramp_metrics(runs["fw"]),
-        "fw_ls120": ramp_metrics(runs["fw_ls120"]),
-        "fw_lm080": ramp_metrics(runs["fw_lm080"]),
-        "bw_db": sine_metrics(runs["bw_db"].log, 0.105, 1500.0),
-        "bw_pi": sine_metrics(runs["bw_pi"].log, 0.105, 1500.0),
-        "speed": speed_metrics(runs["speed"]),
-    }
+    met = {k: metrics(k, runs[k]) for k in SCENARIOS}
     return runs, met
 
 

@@ -345,9 +345,11 @@ static void drive_monitor(drive_t *drv, const ctrl_in_t *in, const ctrl_out_t *o
  * really apply (rounding, limits) less the dead-time correction where the
  * leg switches (no switching, no dead-time error). */
 static ab_t drive_write(drive_t *drv, const float duty[3], const float dtc[3], float v_dc) {
+  /* the correction may not take a leg out of the board's range: the drive
+   * asks only for what the board can do (the HAL would clamp the same) */
   float dc[3];
   for (int x = 0; x < 3; ++x) {
-    dc[x] = fd_clampf(duty[x] + dtc[x], 0.0f, 1.0f);
+    dc[x] = fd_clampf(duty[x] + dtc[x], drv->caps->duty_min, drv->caps->duty_max);
   }
   const hal_pwm_t req = hal_pwm_centred(dc[0], dc[1], dc[2]);
   hal_pwm_t got;

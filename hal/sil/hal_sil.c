@@ -39,6 +39,14 @@ void hal_adc_read(hal_sample_t *s) {
 }
 
 void hal_pwm_write(const hal_pwm_t *p, hal_pwm_t *applied) {
+  const float tol = 1e-6f; /* float rounding of off - on */
+  for (int x = 0; x < 3; ++x) {
+    const float d = p->off[x] - p->on[x];
+    if (!(d >= bound->caps.duty_min - tol && d <= bound->caps.duty_max + tol)) {
+      bound->pwm_clamped++;
+      break;
+    }
+  }
   hal_pattern_apply(p, &bound->caps, bound->timer_counts, &bound->pwm);
   if (applied != NULL) {
     *applied = bound->pwm;

@@ -27,6 +27,14 @@ static atomic_bool g_stop;
 static pthread_t g_main;
 static double g_max_gap_us;
 static bool g_need_low; /* handler: a fault was cleared, enable not yet seen low */
+/* What the ISR owns, as the last ISR left it: nobody else may change it. */
+static struct {
+  bool valid;
+  drive_state_t state;
+  uint32_t faults;
+  bool armed;
+  drive_cmd_t cmd;
+} g_owned;
 
 static double now_s(void) {
   struct timespec ts;
@@ -72,6 +80,10 @@ static void on_interrupt(int sig) {
   g_x.hal.time_us = (uint32_t)(uint64_t)(t * 1e6);
   sil_sample(&g_x, g_sc, t);
 
+  if (g_owned.valid && (d->state != g_owned.state || d->faults != g_owned.faults ||
+                        d->armed != g_owned.armed || !same_block(&d->cmd, &g_owned.cmd))) {
+    violation("the main loop wrote drive state the ISR owns (state, faults, armed, commands)");
+  }
   const drive_state_t st0 = d->state;
   const uint32_t clear0 = d->clear_seen;
   uint32_t seen0[DRIVE_FAULT_COUNT];
@@ -132,6 +144,11 @@ static void on_interrupt(int sig) {
   if (st0 != DRIVE_STATE_FAULT && st == DRIVE_STATE_FAULT) {
     g_r->trips++;
   }
+  g_owned.state = d->state;
+  g_owned.faults = d->faults;
+  g_owned.armed = d->armed;
+  g_owned.cmd = d->cmd;
+  g_owned.valid = true;
   sil_advance(&g_x, g_sc, t);
   g_r->periods++;
   atomic_store(&g_k, k + 1u);
@@ -284,6 +301,7 @@ int sil_preempt_run(const scenario_t *sc, const sil_preempt_opts_t *opts, sil_pr
   g_r = r;
   g_max_gap_us = opts->max_gap_us;
   g_need_low = false;
+  g_owned.valid = false;
   atomic_store(&g_k, 0u);
   atomic_store(&g_stop, false);
   g_main = pthread_self();

@@ -267,6 +267,7 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
   }
   res->steps = n;
   res->sim_time = (double)n * ts;
+  res->pwm_clamped = x.hal.pwm_clamped;
   if (can) {
     res->can = proto.stats;
   }

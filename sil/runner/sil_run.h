@@ -70,6 +70,7 @@ typedef struct {
   drive_state_t final_state;
   uint32_t watchdog_kicks;
   uint32_t watchdog_resets; /* MCU resets by the watchdog */
+  uint32_t pwm_clamped;     /* PWM writes the board had to clamp (hal_sil_t) */
   double first_watchdog_t;  /* -1 if none */
   can_proto_stats_t can;    /* CAN runs only */
   bool stopped;             /* ended early on request (sil_opts_t.stop) */

@@ -45,6 +45,7 @@ char *summary_json(const scenario_t *sc, const sil_result_t *r) {
   cJSON_AddNumberToObject(o, "first_fault_t", r->first_fault_t);
   cJSON_AddNumberToObject(o, "watchdog_resets", (double)r->watchdog_resets);
   cJSON_AddNumberToObject(o, "first_watchdog_t", r->first_watchdog_t);
+  cJSON_AddNumberToObject(o, "pwm_clamped", (double)r->pwm_clamped);
   char *s = cJSON_Print(o);
   cJSON_Delete(o);
   return s;

@@ -53,6 +53,8 @@ static void observer_sees_the_board_voltage(void **state) {
   assert_true(duty > 0.94);     /* the range was used: flux weakening */
   assert_true(flux_min < 0.06); /* deep flux weakening (0.19 Vs at rest) */
   assert_true(worst < 0.01);
+  /* the modulator kept to the board's range: the HAL never had to clamp */
+  assert_int_equal(res.pwm_clamped, 0u);
   trace_free(&tr);
 }
 

@@ -140,7 +140,7 @@ typedef struct {
   float torque_scale, flux_scale;           /* torque and flux amplitude on MTPA at i_max */
   float lc_n_fast, lc_n_track;              /* lc_time, lc_track_time in periods */
   float inv_pole_pairs;
-  float v_lin;                              /* linear voltage range now [V] */
+  float v_lin; /* linear voltage range now [V] */
 
   /* telemetry, under a sequence lock */
   volatile uint32_t tm_seq;

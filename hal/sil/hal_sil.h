@@ -38,8 +38,8 @@ typedef struct {
 typedef struct {
   hal_caps_t caps;
   uint32_t timer_counts;
-  hal_sample_t sample; /* what hal_adc_read returns */
-  hal_pwm_t pwm;       /* preloaded pattern (acts from the next period) */
+  hal_sample_t sample;  /* what hal_adc_read returns */
+  hal_pwm_t pwm;        /* preloaded pattern (acts from the next period) */
   uint32_t pwm_clamped; /* writes with a leg outside the duty range (caps): the
                          * drive asked for what the board cannot do */
   bool gates_on;

@@ -884,16 +884,16 @@ def _alu_value(b: str, ops: list[str], regs: dict) -> object:
 
 
 # ------------------------------------------------------------- the board
-#: Board HAL functions drive_isr calls in every ISR that runs the law
-#: (hal_adc_read also calls hal_caps, in flash through a veneer; the walk
-#: follows it); the PIL runs its replay stand-ins (pil/hal_pil.c) instead.
+#: Board HAL functions drive_isr calls in every ISR that runs the law (the
+#: walk follows whatever they call); the PIL runs its replay stand-ins
+#: (pil/hal_pil.c) instead.
 BOARD_HAL = ("hal_adc_read", "hal_fault_hw_tripped", "hal_pwm_write")
 
 
 def stand_ins(prog: Program) -> frozenset[str]:
     """The functions of a PIL image that the board replaces: :data:`BOARD_HAL`
-    and what only they call (the replay's timer model calls roundf from
-    hal_pwm_write, hal_pattern.h)."""
+    and what only they call (none today: the replay's timer model,
+    hal_pattern.h, is inline)."""
     calls = prog.callers()
     out = set(f for f in BOARD_HAL if f in prog.funcs)
     grew = True
@@ -969,7 +969,7 @@ def _path_part(prog: Program, name: str, p: ExecPath, note: str = "") -> Part:
 
 #: What each board HAL part includes (shown in the report).
 HAL_NOTES = {
-    "hal_adc_read": "with hal_caps (flash, through a veneer) for t_i",
+    "hal_adc_read": "t_i from a word set at init (no hal_caps call)",
     "hal_fault_hw_tripped": "flash, through a veneer",
     "hal_pwm_write": "3 x duty_to_ccr, the applied pattern",
 }
@@ -990,8 +990,7 @@ def bound_board(prog: Program, elf: str = "") -> BoardBound:
     Wrapper = exception entry/exit with lazy FP stacking + ADC1_2_IRQHandler
     (with hal_tim1_clear_update, board_control_isr's tail call and
     hal_tim1_update_pending), drive_isr excluded. The board HAL that
-    drive_isr calls (:data:`BOARD_HAL`, hal_adc_read with its hal_caps call)
-    is bounded separately: the PIL counts its stand-ins instead."""
+    drive_isr calls (:data:`BOARD_HAL`) is bounded separately: the PIL counts its stand-ins instead."""
     need = ("ADC1_2_IRQHandler", "board_control_isr", "drive_isr", "hal_caps") + BOARD_HAL
     missing = [f for f in need if f not in prog.funcs]
     if missing:

@@ -95,12 +95,6 @@ typedef struct {
   float value;
 } reply_t;
 
-/* Enabled as the main loop's last telemetry copy says (drive_background). */
-static bool enabled_state(const drive_t *drv) {
-  const drive_state_t s = drive_telemetry(drv)->state;
-  return s == DRIVE_STATE_RUN || s == DRIVE_STATE_OFFSET_CAL || s == DRIVE_STATE_ALIGN;
-}
-
 /* First signal of message m outside its DBC range, NO_SIGNAL if none. */
 static can_sig_t first_out_of_range(can_msg_t m, const uint8_t data[8]) {
   const can_msg_desc_t *md = can_codec_msg(m);
@@ -345,7 +339,8 @@ static bool handle_frame(can_proto_t *p, drive_t *drv, const hal_can_frame_t *f,
 
 /* -------------------------------------------------------------- timeout */
 static void timeout_step(can_proto_t *p, drive_t *drv, uint32_t now) {
-  const bool enabled = enabled_state(drv);
+  /* as the main loop's last telemetry copy says (drive_background) */
+  const bool enabled = drive_state_enabled(drive_telemetry(drv)->state);
   if (!p->ramp) {
     if (!enabled || p->cfg.timeout_ms == 0u ||
         now - p->last_rx_us < (uint32_t)p->cfg.timeout_ms * 1000u) {

@@ -30,7 +30,7 @@ static bool gates_on_state(drive_state_t s) {
   return s == DRIVE_STATE_RUN || s == DRIVE_STATE_ALIGN;
 }
 
-static bool enabled_state(drive_state_t s) {
+bool drive_state_enabled(drive_state_t s) {
   return s == DRIVE_STATE_OFFSET_CAL || gates_on_state(s);
 }
 
@@ -284,7 +284,7 @@ static uint32_t drive_protect(const drive_t *drv, const hal_sample_t *s, const f
   }
   /* the position must be usable before the gates go on, and plausible
    * while they are */
-  if (enabled_state(drv->state) &&
+  if (drive_state_enabled(drv->state) &&
       (!drv->pos.valid || (drv->state == DRIVE_STATE_RUN && drv->pos.health > c->pos_err_max))) {
     f |= DRIVE_FAULT_POSITION;
   }

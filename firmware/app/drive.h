@@ -175,6 +175,10 @@ int drive_init(drive_t *drv, const drive_config_t *cfg, drive_config_err_t *err)
 int drive_config_usable(const drive_config_t *cfg, drive_law_t law, machine_t *m,
                         drive_config_err_t *err);
 
+/* States in which the drive is enabled: offset calibration, alignment, run
+ * (non-LIVE parameters are refused then). */
+bool drive_state_enabled(drive_state_t s);
+
 /* The PWM-period interrupt body. Bounded time, never blocks. */
 void drive_isr(drive_t *drv);
 

@@ -33,10 +33,7 @@ drive_param_status_t drive_params_set(drive_t *drv, uint8_t id, float value,
   }
   /* the ISR's state, one word: a race with a start only delays the
    * non-LIVE part until the gates are off again (drive.h) */
-  const drive_state_t st = drv->state;
-  const bool running =
-      st == DRIVE_STATE_RUN || st == DRIVE_STATE_OFFSET_CAL || st == DRIVE_STATE_ALIGN;
-  if (running && p->access != DRIVE_PARAM_LIVE) {
+  if (drive_state_enabled(drv->state) && p->access != DRIVE_PARAM_LIVE) {
     return DRIVE_PARAM_RUNNING;
   }
   drive_config_t next = *drive_requested_config(drv);

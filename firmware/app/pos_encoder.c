@@ -19,12 +19,10 @@
 #include "math/frames.h"
 #include "pos_source.h"
 
-#define ENC_PI 3.14159265f
-
 static void enc_init(pos_state_t *s, const drive_config_t *cfg) {
   angle_pll_init(&s->enc.pll, cfg->pll_bw, cfg->ts);
   s->enc.offset = cfg->enc_offset;
-  s->enc.half = cfg->enc_cpr > 0u ? ENC_PI / (float)cfg->enc_cpr : 0.0f;
+  s->enc.half = cfg->enc_cpr > 0u ? FRAMES_PI / (float)cfg->enc_cpr : 0.0f;
   s->enc.started = false;
 }
 
@@ -66,7 +64,7 @@ static void enc_update(pos_state_t *s, const drive_config_t *cfg, const hal_samp
 /* Held at electrical angle theta: offset = measured - theta. */
 static void enc_align(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
                       float theta) {
-  s->enc.offset = frames_wrap_pi(cfg->pole_pairs * (smp->enc_angle + s->enc.half) - theta);
+  s->enc.offset = frames_wrap_pi(s->enc.offset + enc_electrical(s, cfg, smp) - theta);
   s->enc.started = false;
 }
 

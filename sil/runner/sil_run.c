@@ -67,18 +67,23 @@ int sil_run(const scenario_t *sc, sil_observer_fn obs, void *user, sil_result_t 
   return sil_run_ex(sc, NULL, obs, user, res, err, errlen);
 }
 
-/* The MCU restarts after a watchdog reset: gates off at once (the timer's
- * outputs go idle), the firmware starts again from drive_init. */
-static int sil_reset_mcu(sil_ctx_t *x, const scenario_t *sc, char *err, size_t errlen) {
-  x->hal.gates_on = false;
-  x->hal.reset_by_watchdog = true;
-  x->hal.watchdog_last_us = x->hal.time_us;
+/* The firmware's start: drive_init with the scenario's parameter set. */
+static int sil_start_firmware(sil_ctx_t *x, const scenario_t *sc, char *err, size_t errlen) {
   drive_config_err_t e;
   if (drive_init(&x->drv, &sc->drive, &e) != 0) {
     snprintf(err, errlen, "controller: %s: %s", e.field, e.reason);
     return -1;
   }
   return 0;
+}
+
+/* The MCU restarts after a watchdog reset: gates off at once (the timer's
+ * outputs go idle), the firmware starts again from drive_init. */
+static int sil_reset_mcu(sil_ctx_t *x, const scenario_t *sc, char *err, size_t errlen) {
+  x->hal.gates_on = false;
+  x->hal.reset_by_watchdog = true;
+  x->hal.watchdog_last_us = x->hal.time_us;
+  return sil_start_firmware(x, sc, err, errlen);
 }
 
 int sil_setup(sil_ctx_t *x, const scenario_t *sc, char *err, size_t errlen) {
@@ -89,12 +94,9 @@ int sil_setup(sil_ctx_t *x, const scenario_t *sc, char *err, size_t errlen) {
   }
   hal_sil_init(&x->hal, &sc->board);
   hal_sil_bind(&x->hal);
-  drive_config_err_t e;
-  if (drive_init(&x->drv, &sc->drive, &e) != 0) {
-    snprintf(err, errlen, "controller: %s: %s", e.field, e.reason);
+  if (sil_start_firmware(x, sc, err, errlen) != 0) {
     return -1;
   }
-  memset(x->pwm_on, 0, sizeof x->pwm_on);
   for (int j = 0; j < 3; ++j) {
     x->pwm_on[j] = 0.25;
     x->pwm_off[j] = 0.75;

@@ -74,8 +74,10 @@ int main(void) {
     return fail(3, "pil_in.bin: short header");
   }
   if (h.magic != ISR_STREAM_MAGIC || h.version != ISR_STREAM_VERSION || h.header_size != sizeof h ||
-      h.config_size != 4u * ISR_STREAM_CONFIG_WORDS || h.caps_size != 4u * ISR_STREAM_CAPS_WORDS ||
-      h.in_size != sizeof(isr_stream_in_t) || h.out_size != sizeof(isr_stream_out_t)) {
+      h.config_size < 4u * ISR_STREAM_CONFIG_WORDS + 4u ||
+      h.config_size > 4u * ISR_STREAM_CONFIG_WORDS + 4u + (uint32_t)ISR_STREAM_MAP_MAX ||
+      h.caps_size != 4u * ISR_STREAM_CAPS_WORDS || h.in_size != sizeof(isr_stream_in_t) ||
+      h.out_size != sizeof(isr_stream_out_t)) {
     return fail(3, "pil_in.bin: not an isr_stream of this version/layout");
   }
   force_applied = (h.flags & ISR_STREAM_FORCE_APPLIED) != 0u;
@@ -85,6 +87,15 @@ int main(void) {
   }
   static drive_config_t cfg;
   isr_stream_config_get(&cfg, words);
+  /* the flux map's blob: the same bytes the host's drive parsed */
+  static uint32_t map[ISR_STREAM_MAP_MAX / 4];
+  uint32_t map_bytes = 0u;
+  if (sh_read(fin, &map_bytes, sizeof map_bytes) != 0 ||
+      map_bytes != h.config_size - 4u * ISR_STREAM_CONFIG_WORDS - 4u ||
+      (map_bytes > 0u && sh_read(fin, map, map_bytes) != 0)) {
+    return fail(3, "pil_in.bin: bad flux-map section");
+  }
+  cfg.machine_map = map_bytes > 0u ? map : NULL;
   static uint32_t cwords[ISR_STREAM_CAPS_WORDS];
   if (sh_read(fin, cwords, sizeof cwords) != 0) {
     return fail(3, "pil_in.bin: short capabilities");

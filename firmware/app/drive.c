@@ -64,13 +64,27 @@ static float drive_t_out(const drive_t *drv, const drive_config_t *cfg) {
   return 1.5f * cfg->ts - drv->caps->t_i;
 }
 
-int drive_config_usable(const drive_config_t *cfg, drive_law_t law, machine_t *m,
+void drive_machine_copy(machine_t *dm, flux_map_t *dmap, const machine_t *m,
+                        const flux_map_t *map) {
+  *dmap = *map;
+  *dm = *m;
+  dm->map = m->kind == MACHINE_FLUX_MAP ? dmap : NULL;
+}
+
+int drive_config_usable(const drive_config_t *cfg, drive_law_t law, machine_t *m, flux_map_t *map,
                         drive_config_err_t *err) {
   if (drive_config_check(cfg, err) != 0) {
     return -1;
   }
-  if (machine_init_linear(m, cfg->pole_pairs, cfg->rs, cfg->ld, cfg->lq, cfg->lambda_m) != 0) {
-    err->field = "ld";
+  *map = (flux_map_t){0};
+  const int linear = drive_config_map(cfg, map, err);
+  if (linear < 0) {
+    return -1;
+  }
+  if ((linear != 0
+           ? machine_init_linear(m, cfg->pole_pairs, cfg->rs, cfg->ld, cfg->lq, cfg->lambda_m)
+           : machine_init_map(m, cfg->rs, map)) != 0) {
+    err->field = linear != 0 ? "ld" : "machine_map";
     err->reason = "the machine model refused the machine parameters";
     return -1;
   }
@@ -103,11 +117,12 @@ static void drive_derive(drive_t *drv) {
 static int drive_configure(drive_t *drv, const drive_config_t *cfg, drive_law_t law,
                            drive_config_err_t *err) {
   machine_t m;
-  if (drive_config_usable(cfg, law, &m, err) != 0) {
+  flux_map_t map;
+  if (drive_config_usable(cfg, law, &m, &map, err) != 0) {
     return -1;
   }
   drv->cfg = *cfg;
-  drv->machine = m;
+  drive_machine_copy(&drv->machine, &drv->map, &m, &map);
   drive_derive(drv);
   const char *reason = "";
   if (ctrl_init(&drv->ctrl, &drv->cfg, &drv->machine, drive_t_out(drv, cfg), law, &reason) != 0) {
@@ -125,7 +140,8 @@ static int drive_configure(drive_t *drv, const drive_config_t *cfg, drive_law_t 
   drv->torque_min_avail = -cfg->torque_max;
   drv->torque_max_avail = cfg->torque_max;
   /* scales of the loss-of-control monitor: torque and flux on MTPA at i_max */
-  const dq_t i_rated = machine_mtpa_current(&drv->machine, machine_mtpa_torque(&m, cfg->i_max));
+  const dq_t i_rated =
+      machine_mtpa_current(&drv->machine, machine_mtpa_torque(&drv->machine, cfg->i_max));
   const dq_t l_rated = machine_flux(&drv->machine, i_rated);
   drv->torque_scale = machine_torque(&drv->machine, i_rated);
   drv->flux_scale = sqrtf(l_rated.d * l_rated.d + l_rated.q * l_rated.q);
@@ -182,7 +198,7 @@ int drive_init(drive_t *drv, const drive_config_t *cfg, drive_config_err_t *err)
   drv->armed = true;
   drv->req.cmd = drv->cmd;
   drv->creq.cfg = *cfg;
-  drv->host.machine = drv->machine;
+  drive_machine_copy(&drv->host.machine, &drv->host.map, &drv->machine, &drv->map);
   if (hal_reset_by_watchdog()) {
     drv->faults = DRIVE_FAULT_WATCHDOG;
     drv->state = DRIVE_STATE_FAULT;
@@ -755,10 +771,11 @@ int drive_request_config(drive_t *drv, const drive_config_t *cfg, drive_config_e
     err = &dummy;
   }
   machine_t m;
-  if (drive_config_usable(cfg, drv->req.cmd.law, &m, err) != 0) {
+  flux_map_t map;
+  if (drive_config_usable(cfg, drv->req.cmd.law, &m, &map, err) != 0) {
     return -1;
   }
-  drv->host.machine = m;
+  drive_machine_copy(&drv->host.machine, &drv->host.map, &m, &map);
   drv->creq.seq++;
   DRIVE_BARRIER();
   drv->creq.cfg = *cfg;

@@ -101,6 +101,7 @@ typedef struct {
   /* ===== owned by the ISR ===== */
   drive_config_t cfg; /* in force */
   machine_t machine;
+  flux_map_t map; /* cfg's flux map, parsed (machine.map points here) */
   const hal_caps_t *caps;
   drive_state_t state;
   uint32_t faults;
@@ -157,6 +158,7 @@ typedef struct {
   } creq;
   struct {
     machine_t machine;    /* of the requested parameter set (law checks) */
+    flux_map_t map;       /* its flux map (machine.map points here) */
     uint32_t isr_seen;    /* ISR count at the last watchdog refresh */
     drive_telemetry_t tm; /* last consistent telemetry copy */
     uint32_t tm_retries;  /* copies that had to be retried (preemption) */
@@ -171,9 +173,13 @@ int drive_init(drive_t *drv, const drive_config_t *cfg, drive_config_err_t *err)
 
 /* Whether cfg is valid and can run `law` on its machine (drive_config_check,
  * the machine model, the law's check), without touching a drive: 0, or -1
- * with *err (field and reason). *m receives the machine. */
-int drive_config_usable(const drive_config_t *cfg, drive_law_t law, machine_t *m,
+ * with *err (field and reason). *m receives the machine; a flux-map
+ * machine's map is parsed into *map, which m points to (copy both together:
+ * drive_machine_copy). */
+int drive_config_usable(const drive_config_t *cfg, drive_law_t law, machine_t *m, flux_map_t *map,
                         drive_config_err_t *err);
+/* *dm, *dmap = *m, *map with dm's map pointer on dmap. */
+void drive_machine_copy(machine_t *dm, flux_map_t *dmap, const machine_t *m, const flux_map_t *map);
 
 /* States in which the drive is enabled: offset calibration, alignment, run
  * (non-LIVE parameters are refused then). */

@@ -15,6 +15,7 @@
 #define PARAM_MAX_LAW(m)  ((float)(DRIVE_LAW_COUNT - 1))
 #define PARAM_MAX_MODE(m) ((float)(DRIVE_MODE_COUNT - 1))
 #define PARAM_MAX_POS(m)  ((float)(POS_SOURCE_COUNT - 1))
+#define PARAM_MAX_MAP(m)  (m)
 
 /* The arguments are literals and names from the table: the parentheses
  * clang-tidy asks for would not change a thing (and a name can't take them). */
@@ -105,8 +106,27 @@ static void write_uint(unsigned char *base, unsigned size, uint32_t v) {
   }
 }
 
+/* The blob's CRC word, low 24 bits; 0 without a blob or when its header is
+ * not a map's (the size word bounds the read: a blob's storage holds at
+ * least the size it declares, the contract of whoever set the pointer). */
+static float map_crc24(const uint32_t *w) {
+  enum {
+    MAX_WORDS = 12 + 2 * FLUX_MAP_GRID_MAX * FLUX_MAP_GRID_MAX + 2 + 4 * FLUX_MAP_LUT_MAX + 1
+  };
+  if (w == NULL || w[0] != FLUX_MAP_MAGIC || w[2] < 4u * 13u || w[2] > 4u * MAX_WORDS ||
+      (w[2] & 3u) != 0u) {
+    return 0.0f;
+  }
+  return (float)(w[w[2] / 4u - 1u] & 0xFFFFFFu);
+}
+
 float drive_param_get(const drive_config_t *cfg, const drive_param_t *p) {
   const unsigned char *base = (const unsigned char *)cfg + p->offset;
+  if (p->type == DRIVE_PARAM_MAP) {
+    const uint32_t *w;
+    memcpy(&w, base, sizeof w);
+    return map_crc24(w);
+  }
   if (p->type == DRIVE_PARAM_F32) {
     float f;
     memcpy(&f, base, sizeof f);
@@ -117,7 +137,12 @@ float drive_param_get(const drive_config_t *cfg, const drive_param_t *p) {
 
 void drive_param_set(drive_config_t *cfg, const drive_param_t *p, float v) {
   unsigned char *base = (unsigned char *)cfg + p->offset;
-  if (p->type == DRIVE_PARAM_F32) {
+  if (p->type == DRIVE_PARAM_MAP) {
+    if (!(v > 0.0f || v < 0.0f)) {
+      const uint32_t *none = NULL;
+      memcpy(base, &none, sizeof none);
+    }
+  } else if (p->type == DRIVE_PARAM_F32) {
     memcpy(base, &v, sizeof v);
   } else {
     write_uint(base, field_size(p), (uint32_t)v);
@@ -172,5 +197,26 @@ int drive_config_check(const drive_config_t *cfg, drive_config_err_t *err) {
   RULE(cfg->align_time <= 0.0f || cfg->align_current > 0.0f, "align_current",
        "must be positive when align_time > 0");
   RULE(cfg->align_current <= cfg->i_max, "align_current", "must be at most i_max");
+  flux_map_t map;
+  const int has_map = drive_config_map(cfg, &map, e);
+  if (has_map < 0) {
+    return -1;
+  }
+  RULE(has_map != 0 || !(map.pole_pairs < cfg->pole_pairs || map.pole_pairs > cfg->pole_pairs),
+       "pole_pairs", "must equal the flux map's pole pairs");
+  return 0;
+}
+
+int drive_config_map(const drive_config_t *cfg, flux_map_t *map, drive_config_err_t *err) {
+  const uint32_t *w = cfg->machine_map;
+  if (w == NULL) {
+    return 1;
+  }
+  flux_map_status_t st;
+  if (flux_map_parse(map, w, w[2], &st) != 0) {
+    err->field = "machine_map";
+    err->reason = flux_map_err_str(st.code);
+    return -1;
+  }
   return 0;
 }

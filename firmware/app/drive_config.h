@@ -10,6 +10,7 @@
 
 #include "drive_enums.h"
 #include "drive_param_table.h"
+#include "model/flux_map.h"
 
 #define DRIVE_PARAM_CTYPE_F32  float
 #define DRIVE_PARAM_CTYPE_U16  uint16_t
@@ -17,6 +18,7 @@
 #define DRIVE_PARAM_CTYPE_LAW  drive_law_t
 #define DRIVE_PARAM_CTYPE_MODE drive_mode_t
 #define DRIVE_PARAM_CTYPE_POS  pos_source_t
+#define DRIVE_PARAM_CTYPE_MAP  const uint32_t *
 
 /* One field per row of DRIVE_PARAM_TABLE, in table order. */
 typedef struct {
@@ -37,7 +39,8 @@ typedef enum {
   DRIVE_PARAM_U32,
   DRIVE_PARAM_LAW,
   DRIVE_PARAM_MODE,
-  DRIVE_PARAM_POS
+  DRIVE_PARAM_POS,
+  DRIVE_PARAM_MAP
 } drive_param_type_t;
 
 typedef enum {
@@ -63,9 +66,11 @@ typedef struct {
 const drive_param_t *drive_params_table(unsigned *count);
 const drive_param_t *drive_params_find(uint8_t id);
 const drive_param_t *drive_params_by_name(const char *name);
-/* Field value as float (integers and enums converted exactly). */
+/* Field value as float (integers and enums converted exactly; a map: the
+ * low 24 bits of its blob's CRC word, 0 for none). */
 float drive_param_get(const drive_config_t *cfg, const drive_param_t *p);
-/* Sets the field from a float, without any check. */
+/* Sets the field from a float, without any check (a map: 0 clears it,
+ * other values leave it as it is: a blob is not a number). */
 void drive_param_set(drive_config_t *cfg, const drive_param_t *p, float v);
 /* 1 when v is finite, inside [min, max] and, for integer and enum types,
  * an integer. */
@@ -83,5 +88,8 @@ void drive_config_default(drive_config_t *cfg);
 /* 0 when valid, else -1 with *err naming the first bad field: its range
  * (table) first, then the relations between fields. err may be NULL. */
 int drive_config_check(const drive_config_t *cfg, drive_config_err_t *err);
+/* The flux map of cfg parsed into *map: 0 when cfg has a valid map, 1 when
+ * it has none (linear machine), -1 with *err when the blob is refused. */
+int drive_config_map(const drive_config_t *cfg, flux_map_t *map, drive_config_err_t *err);
 
 #endif

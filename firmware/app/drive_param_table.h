@@ -16,7 +16,10 @@
  * Columns: X(id, name, type, unit, default, min, max, access, scenario, doc)
  *   id        CAN parameter number (PARAM_REQ.param_id), unique, < 64
  *   type      F32 float | U16 uint16_t | U32 uint32_t | LAW drive_law_t |
- *             MODE drive_mode_t | POS pos_source_t (enums: min 0, max count-1)
+ *             MODE drive_mode_t | POS pos_source_t (enums: min 0, max count-1) |
+ *             MAP a flux-map blob (const uint32_t *, docs/flux-maps.md): read as
+ *             the low 24 bits of its CRC-32 (what a float carries exactly),
+ *             set by the scenario (or a board's linked table), never by a number
  *   access    RO read only | IDLE written with the gates off | LIVE also
  *             while running (applied by the ISR at its next period)
  *   scenario  the scenario key that sets it ("section.key"); keys outside
@@ -40,6 +43,8 @@
     "q-axis inductance")                                                                                    \
   X(5,  lambda_m,       F32,  "Vs",     0.19f,       0.0f,    10.0f,    IDLE, "machine.lambda_m",          \
     "PM flux linkage, peak per phase (0: reluctance machine)")                                              \
+  X(7,  machine_map,    MAP,  "",       0.0f,        0.0f,    16777215.0f, RO, "machine.map",             \
+    "flux map of a saturated machine: its blob's CRC-32, low 24 bits (0: linear, ld, lq, lambda_m)")      \
   X(6,  inertia,        F32,  "kg m^2", 0.021f,      1e-9f,   1e3f,     IDLE, "mechanics.j",               \
     "inertia, for the speed-loop design")                                                                   \
   /* limits and protections */                                                                              \

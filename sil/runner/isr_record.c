@@ -22,7 +22,7 @@ static void write_header(isr_record_t *r, uint32_t count) {
   isr_stream_header_t h = {ISR_STREAM_MAGIC,
                            ISR_STREAM_VERSION,
                            sizeof(isr_stream_header_t),
-                           4u * ISR_STREAM_CONFIG_WORDS,
+                           4u * ISR_STREAM_CONFIG_WORDS + 4u + r->map_bytes,
                            4u * ISR_STREAM_CAPS_WORDS,
                            sizeof(isr_stream_in_t),
                            sizeof(isr_stream_out_t),
@@ -42,10 +42,15 @@ void isr_record_observer(void *user, const sil_step_t *st) {
   const drive_t *drv = st->drive;
   if (!r->started) {
     r->started = true;
+    r->map_bytes = isr_stream_map_bytes(&drv->cfg);
     write_header(r, 0u);
     uint32_t w[ISR_STREAM_CONFIG_WORDS];
     isr_stream_config_put(&drv->cfg, w);
     write_block(r, w, sizeof w);
+    write_block(r, &r->map_bytes, sizeof r->map_bytes);
+    if (r->map_bytes > 0u) {
+      write_block(r, drv->cfg.machine_map, r->map_bytes);
+    }
     uint32_t cw[ISR_STREAM_CAPS_WORDS];
     isr_stream_caps_put(drv->caps, st->timer_counts, cw);
     write_block(r, cw, sizeof cw);

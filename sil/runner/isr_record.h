@@ -24,6 +24,7 @@
 typedef struct {
   FILE *f;
   uint32_t count;
+  uint32_t map_bytes; /* the flux map's blob in the configuration section */
   int failed;
   bool started; /* header, config and caps written */
   bool pending; /* rec holds ISR k-1, waiting for its duties */

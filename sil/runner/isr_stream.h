@@ -4,7 +4,10 @@
  * image (pil/, Cortex-M4F on QEMU mps2-an386). Format in docs/pil.md.
  *
  * File: header; the parameter set in force as ISR_STREAM_CONFIG_WORDS words
- * (one per row of the parameter table, in table order: drive_param_table.h);
+ * (one per row of the parameter table, in table order: drive_param_table.h)
+ * followed by the flux map's blob (a word with its size in bytes, 0 for a
+ * linear machine, then the blob: docs/flux-maps.md), header.config_size
+ * covering both;
  * the board's HAL capabilities (ISR_STREAM_CAPS_WORDS words); then `count`
  * records of isr_stream_in_t followed by isr_stream_out_t (the host's
  * outputs). Every field is 32-bit little-endian (uint32_t or IEEE-754
@@ -21,7 +24,7 @@
 #include "drive.h"
 
 #define ISR_STREAM_MAGIC   0x52534946u /* "FISR" */
-#define ISR_STREAM_VERSION 2u
+#define ISR_STREAM_VERSION 3u
 
 /* isr_stream_header_t.flags: the replay sets the drive's applied-voltage
  * memory (drive_t.v_applied) to the host's before each ISR, see
@@ -42,7 +45,7 @@ typedef struct {
   uint32_t magic;       /* ISR_STREAM_MAGIC */
   uint32_t version;     /* ISR_STREAM_VERSION */
   uint32_t header_size; /* sizeof(isr_stream_header_t) */
-  uint32_t config_size; /* 4 * ISR_STREAM_CONFIG_WORDS */
+  uint32_t config_size; /* 4 * ISR_STREAM_CONFIG_WORDS + 4 + map blob bytes */
   uint32_t caps_size;   /* 4 * ISR_STREAM_CAPS_WORDS */
   uint32_t in_size;     /* sizeof(isr_stream_in_t) */
   uint32_t out_size;    /* sizeof(isr_stream_out_t) */
@@ -95,8 +98,20 @@ _Static_assert(sizeof(isr_stream_out_t) == 24, "isr_stream_out_t layout");
 _Static_assert(DRIVE_FAULT_COUNT <= ISR_STREAM_FAULT_WORDS, "fault counters");
 
 enum { ISR_STREAM_CONFIG_WORDS = DRIVE_PARAM_COUNT };
+/* The largest flux-map blob (docs/flux-maps.md) in bytes. */
+enum {
+  ISR_STREAM_MAP_MAX =
+      4 * (12 + 2 * FLUX_MAP_GRID_MAX * FLUX_MAP_GRID_MAX + 2 + 4 * FLUX_MAP_LUT_MAX + 1)
+};
 
-/* The parameter set as words: floats as their bits, the rest as integers. */
+/* Bytes of the flux-map blob of c (0: linear machine). */
+static inline uint32_t isr_stream_map_bytes(const drive_config_t *c) {
+  return c->machine_map != NULL ? c->machine_map[2] : 0u;
+}
+
+/* The parameter set as words: floats as their bits, the rest as integers
+ * (the map as its CRC word: the blob follows the words, and _get leaves
+ * machine_map to the reader of the blob). */
 static inline void isr_stream_config_put(const drive_config_t *c,
                                          uint32_t w[ISR_STREAM_CONFIG_WORDS]) {
   unsigned n;

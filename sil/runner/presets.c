@@ -41,6 +41,42 @@ static const machine_preset_t presets[] = {
         .torque_rated = 15.0,
         .speed_max = 300.0 * RPM,
     },
+    {
+        .name = "syr_1k1",
+        .source = "Varatharajan et al. 2022, Table I; analytic saturation (docs/flux-maps.md)",
+        .machine = {.pole_pairs = 2, .rs = 6.8, .ld = 0.1, .lq = 0.1, .lambda_m = 0.0},
+        .inertia = 0.04,
+        .friction = 2e-3,
+        .v_dc = 340.0,
+        .i_rated = 2.3,
+        .torque_rated = 7.1,
+        .speed_max = 1800.0 * RPM,
+        .map = "maps/syr_1k1.fdmap",
+    },
+    {
+        .name = "ipm_sat",
+        .source = "interior PM with saturation, analytic (docs/flux-maps.md)",
+        .machine = {.pole_pairs = 4, .rs = 0.1, .ld = 1e-3, .lq = 1e-3, .lambda_m = 0.0},
+        .inertia = 5e-3,
+        .friction = 1e-3,
+        .v_dc = 300.0,
+        .i_rated = 10.0,
+        .torque_rated = 10.0,
+        .speed_max = 3000.0 * RPM,
+        .map = "maps/ipm_sat.fdmap",
+    },
+    {
+        .name = "pmasyr_file",
+        .source = "PM-assisted SyR, map file in the SyR convention (maps/pmasyr_file.npz)",
+        .machine = {.pole_pairs = 2, .rs = 1.0, .ld = 0.1, .lq = 0.1, .lambda_m = 0.0},
+        .inertia = 0.01,
+        .friction = 1e-3,
+        .v_dc = 540.0,
+        .i_rated = 5.0,
+        .torque_rated = 10.0,
+        .speed_max = 3000.0 * RPM,
+        .map = "maps/pmasyr_file.npz",
+    },
 };
 
 const machine_preset_t *preset_find(const char *name) {
@@ -53,7 +89,7 @@ const machine_preset_t *preset_find(const char *name) {
 }
 
 const char *preset_names(void) {
-  return "rubino2020_spm, fabbri2022_t51, fabbri2022_ebike";
+  return "rubino2020_spm, fabbri2022_t51, fabbri2022_ebike, syr_1k1, ipm_sat, pmasyr_file";
 }
 
 void preset_apply(const machine_preset_t *p, plant_params_t *plant, drive_config_t *drive) {
@@ -77,6 +113,8 @@ void preset_apply(const machine_preset_t *p, plant_params_t *plant, drive_config
   drive->v_dc_min = (float)(0.5 * p->v_dc);
   drive->accel_max = drive->speed_max; /* 0 -> max speed in 1 s */
   drive->flux_min = 0.2f * drive->lambda_m;
+  drive->machine_map = NULL; /* a map preset's: set by the scenario parser */
+  plant->machine.map = NULL;
   plant->sensors.i_full_scale = 2.5 * drive->i_trip;
   plant->sensors.v_full_scale = 2.0 * p->v_dc;
 }

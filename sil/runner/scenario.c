@@ -17,6 +17,7 @@
 
 #include "board_presets.h"
 #include "drive.h"
+#include "map_load.h"
 #include "presets.h"
 
 #define PI 3.14159265358979323846
@@ -234,9 +235,22 @@ static int get_profile(ctx_t *c, const cJSON *obj, const char *path, const char 
 
 /* ---- sections ---------------------------------------------------------- */
 
+/* A flux map into plant and drive: the pole pairs are the map's. */
+static int use_map(ctx_t *c, const char *key, const char *file, scenario_t *sc) {
+  char why[640];
+  const map_load_t *e = map_load(file, c->origin, why, sizeof why);
+  if (e == NULL) {
+    return fail(c, key, "%s", why);
+  }
+  sc->plant.machine.map = e->plant;
+  sc->plant.machine.pole_pairs = (int)e->map.pole_pairs;
+  sc->drive.machine_map = e->words;
+  return 0;
+}
+
 static int parse_machine(ctx_t *c, const cJSON *m, scenario_t *sc) {
-  static const char *const keys[] = {"preset", "pole_pairs", "rs",       "ld",
-                                     "lq",     "ls",         "lambda_m", NULL};
+  static const char *const keys[] = {"preset", "pole_pairs", "rs",  "ld", "lq",
+                                     "ls",     "lambda_m",   "map", NULL};
   if (check_keys(c, m, "machine", keys) != 0) {
     return -1;
   }
@@ -247,6 +261,28 @@ static int parse_machine(ctx_t *c, const cJSON *m, scenario_t *sc) {
       return fail(c, "machine.preset", "unknown preset (known: %s)", preset_names());
     }
     preset_apply(p, &sc->plant, &sc->drive);
+    if (p->map != NULL && use_map(c, "machine.preset", p->map, sc) != 0) {
+      return -1;
+    }
+  }
+  const cJSON *map = cJSON_GetObjectItemCaseSensitive(m, "map");
+  if (map != NULL) {
+    if (!cJSON_IsString(map) || map->valuestring[0] == '\0') {
+      return fail(c, "machine.map", "must be a file name (.fdmap, .npz, .csv)");
+    }
+    if (use_map(c, "machine.map", map->valuestring, sc) != 0) {
+      return -1;
+    }
+  }
+  if (sc->plant.machine.map != NULL) {
+    static const char *const linear_only[] = {"ld", "lq", "ls", "lambda_m", NULL};
+    for (int k = 0; linear_only[k] != NULL; ++k) {
+      if (cJSON_GetObjectItemCaseSensitive(m, linear_only[k]) != NULL) {
+        char key[32];
+        snprintf(key, sizeof key, "machine.%s", linear_only[k]);
+        return fail(c, key, "a flux-map machine takes its inductances and PM flux from the map");
+      }
+    }
   }
   plant_machine_t *pm = &sc->plant.machine;
   double ls = -1.0, pp = pm->pole_pairs;
@@ -640,7 +676,8 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
    * field (drive_param_table.h) */
   drive_config_err_t e;
   machine_t m;
-  if (drive_config_usable(&sc->drive, sc->drive.law, &m, &e) != 0) {
+  flux_map_t map;
+  if (drive_config_usable(&sc->drive, sc->drive.law, &m, &map, &e) != 0) {
     const drive_param_t *p = drive_params_by_name(e.field);
     const char *key = p != NULL ? p->scenario : e.field;
     if (p != NULL && strcmp(e.reason, "outside its range") == 0) {

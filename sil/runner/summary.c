@@ -82,6 +82,7 @@ char *config_json(const scenario_t *sc) {
   cJSON_AddNumberToObject(pm, "lq", m->lq);
   cJSON_AddNumberToObject(pm, "lambda_m", m->lambda_m);
   cJSON_AddNumberToObject(pm, "j", sc->plant.mech.j);
+  cJSON_AddStringToObject(pm, "kind", d->machine_map != NULL ? "flux_map" : "linear");
   cJSON_AddNumberToObject(o, "v_dc", sc->plant.dclink.v_source);
   cJSON_AddNumberToObject(o, "ts", sc->plant.ts);
   cJSON_AddNumberToObject(o, "dead_time", sc->plant.inverter.dead_time);
@@ -108,7 +109,7 @@ char *params_json(void) {
   cJSON *arr = cJSON_AddArrayToObject(o, "params");
   unsigned n;
   const drive_param_t *t = drive_params_table(&n);
-  static const char *const types[] = {"f32", "u16", "u32", "law", "mode", "pos_source"};
+  static const char *const types[] = {"f32", "u16", "u32", "law", "mode", "pos_source", "map"};
   static const char *const access[] = {"ro", "idle", "live"};
   for (unsigned i = 0; i < n; ++i) {
     cJSON *p = cJSON_CreateObject();

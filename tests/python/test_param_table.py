@@ -58,10 +58,27 @@ def test_tools_table_is_the_firmware_table():
     assert params.tables() == table(), "run: fluxdrive params --write"
 
 
+def map_crc24(path: Path) -> int:
+    blob = path.read_bytes()
+    return int.from_bytes(blob[-4:], "little") & 0xFFFFFF
+
+
 @pytest.mark.parametrize("p", table()["params"], ids=lambda p: p["name"])
 def test_every_parameter_through_its_scenario_key(p, tmp_path):
     t = table()
     key = p["scenario"]
+    if p["type"] == "map":  # a file, read as its blob's CRC (docs/flux-maps.md)
+        repo = Path(__file__).resolve().parents[2]
+        blob = repo / "maps" / "syr_1k1.fdmap"
+        r = run(scenario(tmp_path, key, str(blob)))
+        assert r.returncode == 0, (key, r.stderr)
+        cfg = json.loads(r.stdout)
+        assert cfg["controller"][p["name"]] == map_crc24(blob)
+        assert cfg["machine"]["kind"] == "flux_map"
+        for bad, why in ((1.0, "must be a file name"), ("no_such.fdmap", "cannot open")):
+            r = run(scenario(tmp_path, key, bad))
+            assert r.returncode == 2 and f"{key}: " in r.stderr and why in r.stderr, r.stderr
+        return
     if p["type"] in ENUMS:
         names = t[ENUMS[p["type"]]]
         for name in names:

@@ -7,6 +7,16 @@
  * forward from the measured currents. Voltage limit: circle of radius v_max,
  * d axis first (it sets the flux), q gets what is left; the PI integrators
  * are clamped against these limits (see pi_ctrl.c), so they never wind up.
+ *
+ * Saturated machine (flux map): the incremental self-inductances fall with
+ * the current (to half and less on a SyR machine at rated current), so a
+ * constant kp = wc L(0) would give a loop up to twice as fast as designed
+ * at load. The proportional gains follow the map's incremental inductance
+ * at the reference current, kp = wc l_dd(i*), wc l_qq(i*) (Varatharajan
+ * (25)), so the loop stays wc/s at every operating point; ki = wc Rs is
+ * kept (the PI zero follows Rs/l). The cross-saturation l_dq is not
+ * decoupled (its coupling is a disturbance the integrators remove). The
+ * feed-forward uses the map's flux at the measured current.
  */
 #include "control/current_ctrl.h"
 
@@ -41,8 +51,14 @@ dq_t current_ctrl_update(current_ctrl_t *cc, dq_t i_ref, dq_t i, float we, float
   if (!fd_isfinite(we)) {
     we = 0.0f;
   }
+  const machine_t *m = cc->cfg.machine;
+  if (m->kind == MACHINE_FLUX_MAP) {
+    const machine_ldq_t l = machine_inductance(m, i_ref);
+    cc->pi_d.kp = cc->cfg.bandwidth * l.dd;
+    cc->pi_q.kp = cc->cfg.bandwidth * l.qq;
+  }
   /* decoupling feed-forward: v = Rs i + L di/dt + we J lambda(i) */
-  const dq_t flux = machine_flux(cc->cfg.machine, i);
+  const dq_t flux = machine_flux(m, i);
   const float ff_d = -we * flux.q;
   const float ff_q = we * flux.d;
 

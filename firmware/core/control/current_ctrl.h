@@ -4,6 +4,8 @@
  * cancellation (kp = wc*L, ki = wc*Rs, closed loop ~ wc/(s+wc)), decoupling
  * feed-forward (-we*Lq*iq on d; +we*(Ld*id + lambda_m) on q), and a circular
  * voltage limit with d-axis priority; the integrators stop when limited.
+ * On a flux-map machine kp follows the incremental inductance at the
+ * reference (current_ctrl.c).
  */
 #ifndef FD_CONTROL_CURRENT_CTRL_H
 #define FD_CONTROL_CURRENT_CTRL_H

@@ -1,9 +1,11 @@
 /*
- * machine.c - the linear machine behind the machine_t interface.
+ * machine.c - the machine_t interface: the linear machine here, the
+ * flux-map machine by dispatch to flux_map.c.
  */
 #include "model/machine.h"
 
 #include <math.h>
+#include <stddef.h>
 
 #include "math/fd_math.h"
 
@@ -20,21 +22,40 @@ int machine_init_linear(machine_t *m, float pole_pairs, float rs, float ld, floa
         lambda_m >= 0.0f)) {
     return -1;
   }
-  *m = (machine_t){MACHINE_LINEAR, pole_pairs, rs, ld, lq, lambda_m};
+  *m = (machine_t){MACHINE_LINEAR, pole_pairs, rs, ld, lq, lambda_m, NULL};
+  return 0;
+}
+
+int machine_init_map(machine_t *m, float rs, const flux_map_t *map) {
+  if (map == NULL || !(fd_isfinite(rs) && rs > 0.0f)) {
+    return -1;
+  }
+  const flux_map_ldq_t l = flux_map_inductance(map, (dq_t){0.0f, 0.0f});
+  const dq_t l0 = flux_map_flux(map, (dq_t){0.0f, 0.0f});
+  *m = (machine_t){MACHINE_FLUX_MAP, map->pole_pairs, rs, l.dd, l.qq, fd_maxf(l0.d, 0.0f), map};
   return 0;
 }
 
 dq_t machine_flux(const machine_t *m, dq_t i) {
+  if (m->kind == MACHINE_FLUX_MAP) {
+    return flux_map_flux(m->map, i);
+  }
   return (dq_t){m->ld * i.d + m->lambda_m, m->lq * i.q};
 }
 
 dq_t machine_current(const machine_t *m, dq_t lambda) {
+  if (m->kind == MACHINE_FLUX_MAP) {
+    return flux_map_current(m->map, lambda);
+  }
   return (dq_t){(lambda.d - m->lambda_m) / m->ld, lambda.q / m->lq};
 }
 
 machine_ldq_t machine_inductance(const machine_t *m, dq_t i) {
-  (void)i; /* linear: independent of the operating point */
-  return (machine_ldq_t){m->ld, 0.0f, 0.0f, m->lq};
+  if (m->kind == MACHINE_FLUX_MAP) {
+    const flux_map_ldq_t l = flux_map_inductance(m->map, i);
+    return (machine_ldq_t){l.dd, l.dq, l.qd, l.qq};
+  }
+  return (machine_ldq_t){m->ld, 0.0f, 0.0f, m->lq}; /* linear: independent of i */
 }
 
 float machine_torque(const machine_t *m, dq_t i) {
@@ -47,7 +68,7 @@ float machine_pm_flux(const machine_t *m) {
 }
 
 int machine_is_isotropic(const machine_t *m, float rel_tol) {
-  return fabsf(m->lq - m->ld) <= rel_tol * m->ld;
+  return m->kind == MACHINE_LINEAR && fabsf(m->lq - m->ld) <= rel_tol * m->ld;
 }
 
 /* MTPA of the linear machine at current amplitude I (d lambda_d/d i_d = Ld,
@@ -63,6 +84,9 @@ static dq_t mtpa_at(const machine_t *m, float i_amp) {
 }
 
 float machine_mtpa_torque(const machine_t *m, float i_amp) {
+  if (m->kind == MACHINE_FLUX_MAP) {
+    return flux_map_mtpa_torque(m->map, fd_maxf(i_amp, 0.0f));
+  }
   return machine_torque(m, mtpa_at(m, fd_maxf(i_amp, 0.0f)));
 }
 
@@ -70,6 +94,9 @@ dq_t machine_mtpa_current(const machine_t *m, float t) {
   const float k = 1.5f * m->pole_pairs;
   const float dl = m->lq - m->ld;
   const float ta = fabsf(t);
+  if (m->kind == MACHINE_FLUX_MAP) {
+    return fd_isfinite(t) ? flux_map_mtpa_current(m->map, t) : (dq_t){0.0f, 0.0f};
+  }
   if (!fd_isfinite(t) || !(m->lambda_m > 0.0f || fabsf(dl) > 0.0f)) {
     return (dq_t){0.0f, 0.0f};
   }

@@ -11,17 +11,18 @@
  * the SyR literature's convention (d on the maximum inductance, PM on -q)
  * is converted once, at the edge where such data enters (docs/scenarios.md).
  *
- * Kinds: MACHINE_LINEAR (constant Ld, Lq, lambda_m) today. The kind tag and
- * the functions below are the interface a flux map (saturation,
- * cross-saturation) fills next: flux from current, current from flux,
- * incremental inductance, torque, MTPA.
+ * Kinds: MACHINE_LINEAR (constant Ld, Lq, lambda_m) and MACHINE_FLUX_MAP
+ * (saturation and cross-saturation: flux_map.h, docs/flux-maps.md) behind
+ * the same functions: flux from current, current from flux, incremental
+ * inductance, torque, MTPA.
  */
 #ifndef FD_MODEL_MACHINE_H
 #define FD_MODEL_MACHINE_H
 
 #include "math/frames.h"
+#include "model/flux_map.h"
 
-typedef enum { MACHINE_LINEAR = 0, MACHINE_KIND_COUNT } machine_kind_t;
+typedef enum { MACHINE_LINEAR = 0, MACHINE_FLUX_MAP, MACHINE_KIND_COUNT } machine_kind_t;
 
 /* Incremental inductance matrix d lambda_dq / d i_dq [H]. */
 typedef struct {
@@ -32,15 +33,23 @@ typedef struct {
   machine_kind_t kind;
   float pole_pairs;
   float rs; /* stator phase resistance [Ohm] */
-  /* MACHINE_LINEAR: lambda_dq = (Ld i_d + lambda_m, Lq i_q) */
-  float ld, lq;   /* [H] */
-  float lambda_m; /* PM flux linkage, peak per phase [Vs] */
+  /* MACHINE_LINEAR: lambda_dq = (Ld i_d + lambda_m, Lq i_q).
+   * MACHINE_FLUX_MAP: the incremental inductances at zero current (the
+   * unsaturated machine) and the map's flux at zero current, for the
+   * blocks that need one constant (gains); the model itself is `map`. */
+  float ld, lq;          /* [H] */
+  float lambda_m;        /* PM flux linkage, peak per phase [Vs] */
+  const flux_map_t *map; /* MACHINE_FLUX_MAP: the map (outlives the machine) */
 } machine_t;
 
 /* A linear machine; 0, or -1 when a constant is not finite or out of its
  * physical range (pole_pairs >= 1, rs > 0, ld, lq > 0, lambda_m >= 0). */
 int machine_init_linear(machine_t *m, float pole_pairs, float rs, float ld, float lq,
                         float lambda_m);
+
+/* A flux-map machine (map parsed by flux_map_parse); 0, or -1 when rs is
+ * not finite and positive or map is NULL. The pole pairs are the map's. */
+int machine_init_map(machine_t *m, float rs, const flux_map_t *map);
 
 /* lambda_dq(i_dq) [Vs] */
 dq_t machine_flux(const machine_t *m, dq_t i);
@@ -52,7 +61,7 @@ machine_ldq_t machine_inductance(const machine_t *m, dq_t i);
 float machine_torque(const machine_t *m, dq_t i);
 /* PM flux: lambda_d at zero current [Vs] (0 for SyR) */
 float machine_pm_flux(const machine_t *m);
-/* 1 when Ld and Lq agree within rel_tol of Ld (surface PM). */
+/* 1 when Ld and Lq agree within rel_tol of Ld (surface PM); 0 for a map. */
 int machine_is_isotropic(const machine_t *m, float rel_tol);
 /* The stator inductance L_s of an isotropic (SPM) machine: the d-axis
  * value. The SPM blocks of Rubino 2020 (flux observer, current predictor,

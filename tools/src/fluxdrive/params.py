@@ -156,6 +156,8 @@ def render_doc(t: dict) -> str:
         if enum:
             names = t[lists[p["type"]]]
             d, lo, hi = names[int(p["default"])], names[0], names[-1]
+        elif p["type"] == "map":
+            d, lo, hi = "none", "-", "-"
         else:
             d, lo, hi = _num(p["default"]), _num(p["min"]), _num(p["max"])
         out.append(f"| {p['id']} | `{p['name']}` | {p['type']} | {p['unit']} | {d} | {lo} | {hi} "

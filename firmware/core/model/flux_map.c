@@ -1,0 +1,160 @@
+/*
+ * flux_map.c - lookups on a parsed flux map (flux_map.h): flux, incremental
+ * inductance, inverse, torque and the MTPA / MTPV tables.
+ */
+#include "model/flux_map.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "math/fd_math.h"
+
+static inline float word_f32(const uint32_t *w, uint32_t i) {
+  float f;
+  memcpy(&f, &w[i], sizeof f);
+  return f;
+}
+
+/* The grid cell used for i: its first point (offset k nd + j, clamped so
+ * that the cell exists) and the position (u, v) inside it in steps, not
+ * clamped (linear extrapolation outside the grid). */
+typedef struct {
+  uint32_t o;
+  float u, v;
+} cell_t;
+
+static cell_t cell_of(const flux_map_t *m, dq_t i) {
+  const float x = (i.d - m->id0) * m->inv_did;
+  const float y = (i.q - m->iq0) * m->inv_diq;
+  const uint32_t j = (uint32_t)fd_clampf(x, 0.0f, (float)(m->nd - 2u)); /* >= 0: trunc = floor */
+  const uint32_t k = (uint32_t)fd_clampf(y, 0.0f, (float)(m->nq - 2u));
+  return (cell_t){k * m->nd + j, x - (float)j, y - (float)k};
+}
+
+/* The four corners of one table in a cell: f00 (j, k), f10 (j+1, k),
+ * f01 (j, k+1), f11 (j+1, k+1). */
+typedef struct {
+  float f00, f10, f01, f11;
+} corners_t;
+
+static corners_t corners(const flux_map_t *m, const uint32_t *t, uint32_t o) {
+  return (corners_t){word_f32(t, o), word_f32(t, o + 1u), word_f32(t, o + m->nd),
+                     word_f32(t, o + m->nd + 1u)};
+}
+
+static float bilinear(const corners_t *c, float u, float v) {
+  const float a = c->f00 + u * (c->f10 - c->f00);
+  const float b = c->f01 + u * (c->f11 - c->f01);
+  return a + v * (b - a);
+}
+
+dq_t flux_map_flux(const flux_map_t *m, dq_t i) {
+  const cell_t c = cell_of(m, i);
+  const corners_t d = corners(m, m->psi_d, c.o);
+  const corners_t q = corners(m, m->psi_q, c.o);
+  return (dq_t){bilinear(&d, c.u, c.v), bilinear(&q, c.u, c.v)};
+}
+
+flux_map_ldq_t flux_map_inductance(const flux_map_t *m, dq_t i) {
+  const float hd = 0.5f * m->did, hq = 0.5f * m->diq;
+  const dq_t dp = flux_map_flux(m, (dq_t){i.d + hd, i.q});
+  const dq_t dm = flux_map_flux(m, (dq_t){i.d - hd, i.q});
+  const dq_t qp = flux_map_flux(m, (dq_t){i.d, i.q + hq});
+  const dq_t qm = flux_map_flux(m, (dq_t){i.d, i.q - hq});
+  return (flux_map_ldq_t){(dp.d - dm.d) * m->inv_did, (qp.d - qm.d) * m->inv_diq,
+                          (dp.q - dm.q) * m->inv_did, (qp.q - qm.q) * m->inv_diq};
+}
+
+/* Flux and the bilinear interpolant's own Jacobian at i (Newton). */
+static dq_t flux_jac(const flux_map_t *m, dq_t i, flux_map_ldq_t *l) {
+  const cell_t c = cell_of(m, i);
+  const corners_t d = corners(m, m->psi_d, c.o);
+  const corners_t q = corners(m, m->psi_q, c.o);
+  const float u = c.u, v = c.v;
+  l->dd = ((1.0f - v) * (d.f10 - d.f00) + v * (d.f11 - d.f01)) * m->inv_did;
+  l->dq = ((1.0f - u) * (d.f01 - d.f00) + u * (d.f11 - d.f10)) * m->inv_diq;
+  l->qd = ((1.0f - v) * (q.f10 - q.f00) + v * (q.f11 - q.f01)) * m->inv_did;
+  l->qq = ((1.0f - u) * (q.f01 - q.f00) + u * (q.f11 - q.f10)) * m->inv_diq;
+  return (dq_t){bilinear(&d, u, v), bilinear(&q, u, v)};
+}
+
+/* x = L^-1 r; 0 when L is singular (no step). */
+static dq_t solve(const flux_map_ldq_t *l, dq_t r) {
+  const float det = l->dd * l->qq - l->dq * l->qd;
+  if (!(fabsf(det) > 0.0f)) {
+    return (dq_t){0.0f, 0.0f};
+  }
+  const float inv = 1.0f / det;
+  return (dq_t){(l->qq * r.d - l->dq * r.q) * inv, (l->dd * r.q - l->qd * r.d) * inv};
+}
+
+dq_t flux_map_current(const flux_map_t *m, dq_t lambda) {
+  flux_map_ldq_t l;
+  const dq_t l0 = flux_jac(m, (dq_t){0.0f, 0.0f}, &l);
+  dq_t i = solve(&l, (dq_t){lambda.d - l0.d, lambda.q - l0.q});
+  for (int n = 0; n < FLUX_MAP_NEWTON; ++n) {
+    const dq_t f = flux_jac(m, i, &l);
+    const dq_t s = solve(&l, (dq_t){lambda.d - f.d, lambda.q - f.q});
+    i.d += s.d;
+    i.q += s.q;
+  }
+  return i;
+}
+
+float flux_map_torque(const flux_map_t *m, float pole_pairs, dq_t i) {
+  const dq_t l = flux_map_flux(m, i);
+  return 1.5f * pole_pairs * (l.d * i.q - l.q * i.d);
+}
+
+/* Index and fraction of x (in table steps) on a table of n points, clamped
+ * to the table (no extrapolation). */
+static uint32_t lut_pos(float x, uint32_t n, float *frac) {
+  const float xc = fd_clampf(x, 0.0f, (float)(n - 1u));
+  uint32_t j = (uint32_t)xc;
+  j = j > n - 2u ? n - 2u : j;
+  *frac = xc - (float)j;
+  return j;
+}
+
+static float lut(const uint32_t *t, uint32_t j, float f) {
+  const float a = word_f32(t, j);
+  return a + f * (word_f32(t, j + 1u) - a);
+}
+
+dq_t flux_map_mtpa_current(const flux_map_t *m, float t) {
+  float f;
+  const uint32_t j = lut_pos(fabsf(t) * m->mtpa_inv, m->n_lut, &f);
+  const float iq = lut(m->mtpa_iq, j, f);
+  return (dq_t){lut(m->mtpa_id, j, f), t < 0.0f ? -iq : iq};
+}
+
+float flux_map_mtpa_flux(const flux_map_t *m, float t) {
+  float f;
+  const uint32_t j = lut_pos(fabsf(t) * m->mtpa_inv, m->n_lut, &f);
+  return lut(m->mtpa_flux, j, f);
+}
+
+static float mtpa_amp(const flux_map_t *m, uint32_t j) {
+  const float d = word_f32(m->mtpa_id, j), q = word_f32(m->mtpa_iq, j);
+  return sqrtf(d * d + q * q);
+}
+
+float flux_map_mtpa_torque(const flux_map_t *m, float i_amp) {
+  const float dt = m->mtpa_t_max / (float)(m->n_lut - 1u);
+  float a0 = mtpa_amp(m, 0u);
+  for (uint32_t j = 1u; j < m->n_lut; ++j) {
+    const float a1 = mtpa_amp(m, j);
+    if (a1 >= i_amp) {
+      const float f = a1 > a0 ? fd_clampf((i_amp - a0) / (a1 - a0), 0.0f, 1.0f) : 1.0f;
+      return ((float)(j - 1u) + f) * dt;
+    }
+    a0 = a1;
+  }
+  return m->mtpa_t_max;
+}
+
+float flux_map_mtpv_torque(const flux_map_t *m, float flux) {
+  float f;
+  const uint32_t j = lut_pos(flux * m->mtpv_inv, m->n_lut, &f);
+  return lut(m->mtpv_torque, j, f);
+}

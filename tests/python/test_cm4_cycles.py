@@ -249,6 +249,9 @@ def test_trace_parser_counts_and_cycles() -> None:
     assert res.counts == [25, 23]
     assert res.cycles == [CYC_NOT_TAKEN, CYC_TAKEN]
     assert res.funcs == [{"drive_isr": 20, "helper": 5}, {"drive_isr": 18, "helper": 5}]
+    # one call of helper per ISR, 5 instructions; drive_isr from entry to the end
+    assert res.calls == [{"helper": [1, 5], "drive_isr": [1, 25]},
+                         {"helper": [1, 5], "drive_isr": [1, 23]}]
     assert res.func_cycles == [{"drive_isr": CYC_NOT_TAKEN - HELPER_CYC, "helper": HELPER_CYC},
                                {"drive_isr": CYC_TAKEN - HELPER_CYC, "helper": HELPER_CYC}]
     assert not res.unknown_pcs

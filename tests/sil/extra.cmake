@@ -5,3 +5,5 @@ target_compile_definitions(sil_test_scenario_errors PRIVATE
 # interrupter thread that signals it): alone, ~20 s on 2 cores; beside
 # another test the interrupter waits for a time slice and the run crawls.
 set_tests_properties(sil/test_preempt PROPERTIES RUN_SERIAL TRUE TIMEOUT 600)
+target_compile_definitions(sil_test_syr_foc PRIVATE
+  FD_SYR_SCENARIO="${PROJECT_SOURCE_DIR}/sil/scenarios/syr_1k1_speed_load.json")

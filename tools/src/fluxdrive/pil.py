@@ -192,10 +192,32 @@ class TraceResult:
     funcs: list[dict[str, int]] = field(default_factory=list)  # per ISR
     cycles: list[int] = field(default_factory=list)  # per ISR: model cycles (cm4_cycles)
     func_cycles: list[dict[str, int]] = field(default_factory=list)  # per ISR
+    #: per ISR: function -> [calls, instructions from its entry to its return, callees included]
+    calls: list[dict[str, list[int]]] = field(default_factory=list)
     unknown_pcs: set[bytes] = field(default_factory=set)  # executed PCs not in the listing
 
 
 ISR_FUNC, ISR_CALLER = "drive_isr", "pil_step"
+
+
+def _entries(tab: dict) -> set[bytes]:
+    """The first PC of each function of a trace table (its entry)."""
+    first: dict[str, int] = {}
+    for k, e in tab.items():
+        a = int(k, 16)
+        if e[4] not in first or a < first[e[4]]:
+            first[e[4]] = a
+    return {b"%08x" % a for a in first.values()}
+
+
+def _book(stack: list, n: int, calls: dict, until=None) -> None:
+    """Pops the call stack down to the frame of ``until`` (all of it when
+    None), booking each popped call's inclusive instructions."""
+    while stack and stack[-1][0] is not until:
+        f, n_in = stack.pop()
+        c = calls.setdefault(f, [0, 0])
+        c[0] += 1
+        c[1] += n - n_in
 
 
 def _parse_trace(stream, res: TraceResult, tab: dict) -> None:
@@ -208,7 +230,10 @@ def _parse_trace(stream, res: TraceResult, tab: dict) -> None:
     costs its seq cycles when it is its predecessor's fall-through, else its
     jump cycles plus the predecessor's taken-branch penalty. Counts and
     cycles are running totals; per-function shares are booked when the
-    function changes (calls and returns), not per line."""
+    function changes (calls and returns), not per line. Calls: a change of
+    function at the new function's first PC is a call (pushed), any other
+    change a return to a caller on the stack (the frames above it popped,
+    each booked with its instructions from entry to return)."""
     in_isr = False
     prev = ""  # function of the previous line
     nxt = b""  # fall-through PC of the previous instruction
@@ -217,6 +242,9 @@ def _parse_trace(stream, res: TraceResult, tab: dict) -> None:
     n0 = c0 = fn0 = fc0 = 0  # at the ISR's entry / the current function's entry
     cur_n: dict[str, int] = {}
     cur_c: dict[str, int] = {}
+    entries = _entries(tab)
+    stack: list = []
+    cur_calls: dict[str, list[int]] = {}
     for line in stream:
         j = line.rfind(b"] ")
         if j < 0:
@@ -235,13 +263,20 @@ def _parse_trace(stream, res: TraceResult, tab: dict) -> None:
                 cur_c[prev] = cur_c.get(prev, 0) + cyc - fc0
                 if fn == ISR_CALLER:
                     in_isr = False
+                    _book(stack, n, cur_calls)
                     res.counts.append(n - n0)
                     res.cycles.append(cyc - c0)
                     res.funcs.append(cur_n)
                     res.func_cycles.append(cur_c)
+                    res.calls.append(cur_calls)
+                elif k in entries:
+                    stack.append((fn, n))
+                else:
+                    _book(stack, n, cur_calls, fn)
             elif fn == ISR_FUNC and prev == ISR_CALLER:
                 in_isr = True
                 n0, c0, cur_n, cur_c = n, cyc, {}, {}
+                stack, cur_calls = [(fn, n)], {}
             fn0, fc0, prev = n, cyc, fn
         n += 1
         cyc += sc
@@ -354,6 +389,8 @@ class Counts:
     cycles_worst_isr: int = 0
     block_cycles: dict[str, float] = field(default_factory=dict)  # mean per ISR
     func_cycles: dict[str, float] = field(default_factory=dict)
+    #: function -> (calls per ISR, instructions per call, callees included)
+    calls: dict[str, tuple[float, float]] = field(default_factory=dict)
     #: the image's replay-HAL functions the board replaces (cm4_cycles.stand_ins)
     stand_ins: frozenset = frozenset(cm4_cycles.BOARD_HAL)
 
@@ -397,6 +434,14 @@ def law_counts(tr: TraceResult, host: np.ndarray,
         out.cycles_mean, out.cycles_worst, out.cycles_worst_isr = float(y.mean()), int(y[wy]), \
             run[wy]
         out.block_cycles, out.func_cycles = _mean_by(run, tr.func_cycles)
+    if len(tr.calls) >= n:
+        tot: dict[str, list[int]] = {}
+        for j in run:
+            for f, (k, v) in tr.calls[j].items():
+                t = tot.setdefault(f, [0, 0])
+                t[0] += k
+                t[1] += v
+        out.calls = {f: (k / len(run), v / k) for f, (k, v) in tot.items() if k}
     return out
 
 
@@ -564,6 +609,9 @@ def format_report(runs: list[PilRun], isrs: int, cpi: float | None = None,
                 cpi_f = y / v if v else 0.0
                 lines.append(f"  {v:8.1f}  {100 * v / c.mean:5.1f} %  {y:9.1f}  {cpi_f:8.2f}   "
                              f"{f or '?'}")
+            lines.append("  calls/ISR  instr/call (callees included)  function")
+            for f, (k, v) in sorted(c.calls.items(), key=lambda kv: -kv[1][0] * kv[1][1]):
+                lines.append(f"  {k:9.2f}  {v:10.1f}                     {f or '?'}")
     return "\n".join(lines)
 
 

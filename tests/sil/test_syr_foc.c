@@ -1,0 +1,112 @@
+/*
+ * SIL: FOC on the saturated 1.1 kW SyR machine `syr_1k1` (Varatharajan
+ * 2022 Table I: p = 2, 2.3 A rms, 7.1 N m, 1500 rpm, J = 0.04 kg m^2)
+ * through its flux map, plant and drive on the same blob.
+ *  1. Rated torque at rated current: torque mode, T* = 7.1 N m (the
+ *     paper's rating), i_max = the rated 2.3 sqrt(2) A: the plant's torque
+ *     and current amplitude within 3 % of the rating (both sides).
+ *  2. The scenario sil/scenarios/syr_1k1_speed_load.json: speed step to
+ *     1500 rpm, rated load step; no fault, the speed within 1 % of the
+ *     reference before and after the step, the load met.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "sil_test_util.h"
+
+#define RPM      (3.14159265358979 / 30.0)
+#define T_RATED  7.1
+#define I_RATED  (2.3 * 1.4142135623730951)
+#define W_RATED  (1500.0 * RPM)
+
+static const char *rated_json =
+    "{\"name\": \"syr rated torque\", \"duration\": 0.4,"
+    " \"machine\": {\"preset\": \"syr_1k1\"},"
+    " \"mechanics\": {\"mode\": \"imposed\", \"speed\": {\"unit\": \"rpm\", \"terms\": [300]}},"
+    " \"sensors\": {\"i_noise\": 0.002, \"encoder_cpr\": 4096},"
+    " \"controller\": {\"law\": \"foc\", \"mode\": \"torque\", \"i_max\": 3.2526912,"
+    " \"torque_max\": 7.1},"
+    " \"references\": {\"torque\": [{\"type\": \"step\", \"t\": 0.05, \"value\": 7.1}]}}";
+
+static void rated_torque_at_rated_current(void **state) {
+  (void)state;
+  scenario_t sc;
+  trace_t tr;
+  sil_result_t res;
+  run_json(rated_json, &sc, &tr, &res);
+  double t = 0.0, i = 0.0;
+  const size_t k0 = idx_at(&tr, 0.3);
+  for (size_t k = k0; k < tr.n; ++k) {
+    t += tr.torque[k];
+    i += hypot(tr.id[k], tr.iq[k]);
+  }
+  t /= (double)(tr.n - k0);
+  i /= (double)(tr.n - k0);
+  printf("syr_1k1 FOC, T* = %.2f N m: torque %.4f N m (%+.2f %%), current %.4f A (%+.2f %% of the "
+         "rated %.4f A peak)\n",
+         T_RATED, t, 100.0 * (t / T_RATED - 1.0), i, 100.0 * (i / I_RATED - 1.0), I_RATED);
+  ASSERT_IN(t, 0.97 * T_RATED, 1.03 * T_RATED);
+  ASSERT_IN(i, 0.97 * I_RATED, 1.03 * I_RATED);
+  assert_int_equal(res.faults, 0);
+  trace_free(&tr);
+}
+
+static char *read_text(const char *path) {
+  FILE *f = fopen(path, "rb");
+  assert_non_null(f);
+  static char buf[16384];
+  const size_t n = fread(buf, 1, sizeof buf - 1, f);
+  fclose(f);
+  buf[n] = '\0';
+  return buf;
+}
+
+static void speed_step_and_rated_load(void **state) {
+  (void)state;
+  scenario_t sc;
+  trace_t tr;
+  sil_result_t res;
+  run_json(read_text(FD_SYR_SCENARIO), &sc, &tr, &res);
+  const double t_load = 1.8;
+  /* before the load step: at 1500 rpm within 1 % */
+  double err_pre = 0.0;
+  for (size_t k = idx_at(&tr, 1.6); k < idx_at(&tr, t_load); ++k) {
+    err_pre = fmax(err_pre, fabs(tr.speed[k] - W_RATED) / W_RATED);
+  }
+  /* after it: the dip, then back within 1 % and the load met */
+  double dip = 0.0, t_mean = 0.0, i_max = 0.0;
+  size_t k_rec = 0;
+  for (size_t k = idx_at(&tr, t_load); k < tr.n; ++k) {
+    dip = fmax(dip, (W_RATED - tr.speed[k]) / W_RATED);
+    if (fabs(tr.speed[k] - W_RATED) > 0.01 * W_RATED) {
+      k_rec = k + 1;
+    }
+    i_max = fmax(i_max, hypot(tr.id[k], tr.iq[k]));
+  }
+  const size_t k1 = idx_at(&tr, 2.4);
+  for (size_t k = k1; k < tr.n; ++k) {
+    t_mean += tr.torque[k];
+  }
+  t_mean /= (double)(tr.n - k1);
+  const double t_rec = tr.t[k_rec < tr.n ? k_rec : tr.n - 1] - t_load;
+  printf("syr_1k1 speed/load: speed error before the step %.3f %%, dip %.2f %%, back within 1 %% "
+         "after %.3f s, torque %.3f N m (load %.1f + friction), peak current %.3f A\n",
+         100.0 * err_pre, 100.0 * dip, t_rec, t_mean, T_RATED, i_max);
+  assert_true(err_pre < 0.01);
+  assert_true(dip > 0.0 && dip < 0.10);
+  assert_true(t_rec < 0.5);
+  ASSERT_IN(t_mean, T_RATED, T_RATED + 0.02 * T_RATED);
+  assert_true(i_max <= 1.5 * I_RATED * 1.001); /* the scenario's 50 % overload limit */
+  assert_int_equal(res.faults, 0);
+  trace_free(&tr);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {cmocka_unit_test(rated_torque_at_rated_current),
+                                     cmocka_unit_test(speed_step_and_rated_load)};
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -45,7 +45,9 @@ int plant_init(plant_t *pl, const plant_params_t *p, const char **field) {
   memset(pl, 0, sizeof *pl);
   pl->p = *p;
   plant_aux_t *a = &pl->aux;
-  a->mag = plant_mag_linear(p->machine.ld, p->machine.lq, p->machine.lambda_m);
+  a->mag = p->machine.map != NULL
+               ? plant_mag_map(p->machine.map)
+               : plant_mag_linear(p->machine.ld, p->machine.lq, p->machine.lambda_m);
   a->inv_j = 1.0 / p->mech.j;
   a->inv_r = p->dclink.kind == PLANT_DC_RC ? 1.0 / p->dclink.r : 0.0;
   a->inv_c = p->dclink.kind == PLANT_DC_RC ? 1.0 / p->dclink.c : 0.0;

@@ -24,6 +24,9 @@ typedef struct {
   double rs;       /* stator phase resistance [Ohm] */
   double ld, lq;   /* [H] */
   double lambda_m; /* PM flux linkage (peak, per phase) [Vs] */
+  /* NULL: linear (ld, lq, lambda_m); else the saturated machine's flux map
+   * (plant_fluxmap.h; ld, lq, lambda_m unused), owned by the caller */
+  const plant_fluxmap_t *map;
 } plant_machine_t;
 
 typedef enum { PLANT_INV_AVERAGE, PLANT_INV_SWITCHING } plant_inverter_model_t;

@@ -22,6 +22,8 @@ int plant_machine_check(const plant_machine_t *m, const char **field) {
     bad = "machine.pole_pairs";
   } else if (!plant_finite_pos(m->rs)) {
     bad = "machine.rs";
+  } else if (m->map != NULL) {
+    /* a flux map: validated and inverted by plant_fluxmap_create */
   } else if (!plant_finite_pos(m->ld)) {
     bad = "machine.ld";
   } else if (!plant_finite_pos(m->lq)) {

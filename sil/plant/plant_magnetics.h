@@ -10,28 +10,44 @@
  *   plant_mag_flux0     lambda_dq at zero current (the PM flux)
  *   plant_mag_l_min     the smallest incremental inductance (step sizing)
  * PLANT_MAG_LINEAR: lambda_d = Ld i_d + lambda_m, lambda_q = Lq i_q (d on
- * the magnet). A flux map (saturation, cross-saturation) is one more kind
- * behind the same four functions.
+ * the magnet), inline. PLANT_MAG_MAP: a flux map with saturation and
+ * cross-saturation, its inverse i(lambda) built at load time
+ * (plant_fluxmap.h), behind the same four functions.
  */
 #ifndef FD_PLANT_MAGNETICS_H
 #define FD_PLANT_MAGNETICS_H
 
-typedef enum { PLANT_MAG_LINEAR = 0 } plant_mag_kind_t;
+#include <stddef.h>
+
+#include "plant_fluxmap.h"
+
+typedef enum { PLANT_MAG_LINEAR = 0, PLANT_MAG_MAP } plant_mag_kind_t;
 
 typedef struct {
   plant_mag_kind_t kind;
-  double lambda_m;       /* lambda_d at zero current [Vs] */
-  double inv_ld, inv_lq; /* 1/Ld, 1/Lq [1/H] */
+  double lambda_m;            /* lambda_d at zero current [Vs] */
+  double inv_ld, inv_lq;      /* 1/Ld, 1/Lq [1/H] */
+  const plant_fluxmap_t *map; /* PLANT_MAG_MAP */
 } plant_mag_t;
 
 /* The model of a linear machine (ld, lq > 0). */
 static inline plant_mag_t plant_mag_linear(double ld, double lq, double lambda_m) {
-  plant_mag_t g = {PLANT_MAG_LINEAR, lambda_m, 1.0 / ld, 1.0 / lq};
+  plant_mag_t g = {PLANT_MAG_LINEAR, lambda_m, 1.0 / ld, 1.0 / lq, NULL};
+  return g;
+}
+
+/* The model of a flux-map machine. */
+static inline plant_mag_t plant_mag_map(const plant_fluxmap_t *map) {
+  plant_mag_t g = {PLANT_MAG_MAP, 0.0, 0.0, 0.0, map};
   return g;
 }
 
 static inline void plant_mag_current(const plant_mag_t *g, double lambda_d, double lambda_q,
                                      double *i_d, double *i_q) {
+  if (g->kind == PLANT_MAG_MAP) {
+    plant_fluxmap_current(g->map, lambda_d, lambda_q, i_d, i_q);
+    return;
+  }
   *i_d = (lambda_d - g->lambda_m) * g->inv_ld;
   *i_q = lambda_q * g->inv_lq;
 }
@@ -39,8 +55,10 @@ static inline void plant_mag_current(const plant_mag_t *g, double lambda_d, doub
 /* jac[r][c] = d i_r / d lambda_c, r, c in {d, q}. */
 static inline void plant_mag_jacobian(const plant_mag_t *g, double lambda_d, double lambda_q,
                                       double jac[2][2]) {
-  (void)lambda_d;
-  (void)lambda_q;
+  if (g->kind == PLANT_MAG_MAP) {
+    plant_fluxmap_jacobian(g->map, lambda_d, lambda_q, jac);
+    return;
+  }
   jac[0][0] = g->inv_ld;
   jac[0][1] = 0.0;
   jac[1][0] = 0.0;
@@ -48,11 +66,18 @@ static inline void plant_mag_jacobian(const plant_mag_t *g, double lambda_d, dou
 }
 
 static inline void plant_mag_flux0(const plant_mag_t *g, double *lambda_d, double *lambda_q) {
+  if (g->kind == PLANT_MAG_MAP) {
+    plant_fluxmap_flux0(g->map, lambda_d, lambda_q);
+    return;
+  }
   *lambda_d = g->lambda_m;
   *lambda_q = 0.0;
 }
 
 static inline double plant_mag_l_min(const plant_mag_t *g) {
+  if (g->kind == PLANT_MAG_MAP) {
+    return plant_fluxmap_l_min(g->map);
+  }
   const double gmax = g->inv_ld > g->inv_lq ? g->inv_ld : g->inv_lq;
   return 1.0 / gmax;
 }

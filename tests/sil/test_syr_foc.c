@@ -18,10 +18,19 @@
 
 #include "sil_test_util.h"
 
-#define RPM      (3.14159265358979 / 30.0)
-#define T_RATED  7.1
-#define I_RATED  (2.3 * 1.4142135623730951)
-#define W_RATED  (1500.0 * RPM)
+/* lo <= x <= hi, the values printed on failure */
+#define ASSERT_IN(x, lo, hi)                                                                       \
+  do {                                                                                             \
+    const double x_ = (x), l_ = (lo), h_ = (hi);                                                   \
+    if (!(x_ >= l_ && x_ <= h_)) {                                                                 \
+      fail_msg("%s = %.6g not in [%.6g, %.6g]", #x, x_, l_, h_);                                   \
+    }                                                                                              \
+  } while (0)
+
+#define RPM     (3.14159265358979 / 30.0)
+#define T_RATED 7.1
+#define I_RATED (2.3 * 1.4142135623730951)
+#define W_RATED (1500.0 * RPM)
 
 static const char *rated_json =
     "{\"name\": \"syr rated torque\", \"duration\": 0.4,"

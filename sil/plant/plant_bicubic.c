@@ -1,0 +1,150 @@
+/*
+ * plant_bicubic.c - bicubic Hermite patches (plant_bicubic.h).
+ */
+#include "plant_bicubic.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+/* Node slope of f along one axis by central differences (one-sided at the
+ * ends), per unit of the cell (the step is 1). */
+static double slope(const double *f, int i, int n, int stride) {
+  if (i == 0) {
+    return f[stride] - f[0];
+  }
+  if (i == n - 1) {
+    return f[0] - f[-stride];
+  }
+  return 0.5 * (f[stride] - f[-stride]);
+}
+
+/* The cross slope d2 f / du dv at node (j, k) from the u-slopes of the
+ * neighbouring rows. */
+static double cross(const double *f, int j, int k, int nx, int ny) {
+  const double *p = f + k * nx + j;
+  if (k == 0) {
+    return slope(p + nx, j, nx, 1) - slope(p, j, nx, 1);
+  }
+  if (k == ny - 1) {
+    return slope(p, j, nx, 1) - slope(p - nx, j, nx, 1);
+  }
+  return 0.5 * (slope(p + nx, j, nx, 1) - slope(p - nx, j, nx, 1));
+}
+
+/* Coefficients A = M F M^T of the patch (F: values, u-slopes, v-slopes and
+ * cross slopes at the corners), M the cubic Hermite matrix. */
+static void patch(const double *f, int j, int k, int nx, int ny, double a[16]) {
+  static const double M[4][4] = {{1, 0, 0, 0}, {0, 0, 1, 0}, {-3, 3, -2, -1}, {2, -2, 1, 1}};
+  double F[4][4];
+  for (int dj = 0; dj < 2; ++dj) {
+    for (int dk = 0; dk < 2; ++dk) {
+      const int jj = j + dj, kk = k + dk;
+      const double *p = f + kk * nx + jj;
+      F[dj][dk] = p[0];
+      F[2 + dj][dk] = slope(p, jj, nx, 1);
+      F[dj][2 + dk] = slope(p, kk, ny, nx);
+      F[2 + dj][2 + dk] = cross(f, jj, kk, nx, ny);
+    }
+  }
+  double T[4][4];
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) {
+      double s = 0.0;
+      for (int q = 0; q < 4; ++q) {
+        s += M[r][q] * F[q][c];
+      }
+      T[r][c] = s;
+    }
+  }
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) {
+      double s = 0.0;
+      for (int q = 0; q < 4; ++q) {
+        s += T[r][q] * M[c][q];
+      }
+      a[4 * r + c] = s; /* coefficient of u^r v^c */
+    }
+  }
+}
+
+int plant_bicubic_build(plant_bicubic_t *b, int nx, int ny, double x0, double dx, double y0,
+                        double dy, const double *f1, const double *f2) {
+  b->nx = nx;
+  b->ny = ny;
+  b->x0 = x0;
+  b->dx = dx;
+  b->y0 = y0;
+  b->dy = dy;
+  b->inv_dx = 1.0 / dx;
+  b->inv_dy = 1.0 / dy;
+  b->c = malloc((size_t)(nx - 1) * (size_t)(ny - 1) * 32u * sizeof *b->c);
+  if (b->c == NULL) {
+    return -1;
+  }
+  for (int k = 0; k + 1 < ny; ++k) {
+    for (int j = 0; j + 1 < nx; ++j) {
+      double *a = b->c + ((size_t)k * (size_t)(nx - 1) + (size_t)j) * 32u;
+      patch(f1, j, k, nx, ny, a);
+      patch(f2, j, k, nx, ny, a + 16);
+    }
+  }
+  return 0;
+}
+
+void plant_bicubic_free(plant_bicubic_t *b) {
+  free(b->c);
+  b->c = NULL;
+}
+
+static double clampd(double x, double lo, double hi) {
+  return x < lo ? lo : (x > hi ? hi : x);
+}
+
+/* Inside the box: Horner in v then u; derivatives of the same polynomial. */
+static void eval_in(const plant_bicubic_t *b, double x, double y, double f[2], double jac[2][2]) {
+  const double X = (x - b->x0) * b->inv_dx, Y = (y - b->y0) * b->inv_dy;
+  int j = (int)X, k = (int)Y;
+  j = j > b->nx - 2 ? b->nx - 2 : (j < 0 ? 0 : j);
+  k = k > b->ny - 2 ? b->ny - 2 : (k < 0 ? 0 : k);
+  const double u = X - j, v = Y - k;
+  const double *a = b->c + ((size_t)k * (size_t)(b->nx - 1) + (size_t)j) * 32u;
+  for (int c = 0; c < 2; ++c, a += 16) {
+    double bm[4], dbm[4];
+    for (int r = 0; r < 4; ++r) {
+      const double *ar = a + 4 * r;
+      bm[r] = ((ar[3] * v + ar[2]) * v + ar[1]) * v + ar[0];
+      dbm[r] = (3.0 * ar[3] * v + 2.0 * ar[2]) * v + ar[1];
+    }
+    f[c] = ((bm[3] * u + bm[2]) * u + bm[1]) * u + bm[0];
+    if (jac != NULL) {
+      jac[c][0] = ((3.0 * bm[3] * u + 2.0 * bm[2]) * u + bm[1]) * b->inv_dx;
+      jac[c][1] = (((dbm[3] * u + dbm[2]) * u + dbm[1]) * u + dbm[0]) * b->inv_dy;
+    }
+  }
+}
+
+void plant_bicubic_eval(const plant_bicubic_t *b, double x, double y, double f[2],
+                        double jac[2][2]) {
+  const double xe = b->x0 + (b->nx - 1) * b->dx, ye = b->y0 + (b->ny - 1) * b->dy;
+  if (isnan(x) || isnan(y)) {
+    f[0] = f[1] = NAN;
+    if (jac != NULL) {
+      jac[0][0] = jac[0][1] = jac[1][0] = jac[1][1] = NAN;
+    }
+    return;
+  }
+  if (x >= b->x0 && x <= xe && y >= b->y0 && y <= ye) {
+    eval_in(b, x, y, f, jac);
+    return;
+  }
+  const double xc = clampd(x, b->x0, xe), yc = clampd(y, b->y0, ye);
+  double J[2][2];
+  eval_in(b, xc, yc, f, J);
+  for (int c = 0; c < 2; ++c) {
+    f[c] += J[c][0] * (x - xc) + J[c][1] * (y - yc);
+    if (jac != NULL) {
+      jac[c][0] = J[c][0];
+      jac[c][1] = J[c][1];
+    }
+  }
+}

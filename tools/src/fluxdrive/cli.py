@@ -262,6 +262,9 @@ def build_parser() -> argparse.ArgumentParser:
                    "build/stm32g474/hal/stm32g4/fluxdrive-g474.elf")
     p.set_defaults(func=lambda a: __import__("fluxdrive.cm4_cycles").cm4_cycles.main_board(a))
     from fluxdrive.can.cli import add_parser as add_can_parser  # fluxdrive can ...
+    from fluxdrive.fluxmap.cli import add_parser as add_map_parser  # fluxdrive map ...
+
+    add_map_parser(sub)
 
     add_can_parser(sub)
     return parser

@@ -132,7 +132,7 @@ def _load_csv(file: str):
         k, j = (int(x[0]) for x in np.nonzero(~seen))
         raise FluxMapError(file, "missing operating point",
                            f"i_d = {i_d[j]:g} A, i_q = {i_q[k]:g} A",
-                           f"{int((~seen).sum())} grid point(s) missing")
+                           f"{int((~seen).sum())} grid point(s) missing in all")
     pp = meta.get("pole_pairs")
     try:
         pp = int(pp) if pp is not None else None

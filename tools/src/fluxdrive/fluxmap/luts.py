@@ -1,6 +1,7 @@
 """The reference tables of Varatharajan et al. 2022 from a map (fluxdrive
-frame), computed on the map's bilinear interpolant (the lookups the core
-makes, so that table and core agree):
+frame), computed on the map's bicubic (Catmull-Rom) interpolant
+(FluxMap.flux_smooth: an optimum of a bilinear surface sits on cell
+edges):
 
 * MTPA (maximum torque per ampere): for each current amplitude A the
   current angle of the largest torque (dense sweep of i_q >= 0, then a
@@ -45,18 +46,19 @@ class Tables:
 def _best_angle(m: FluxMap, a: float) -> tuple[float, float]:
     """Angle theta (i = a (cos, sin), sin >= 0) of the largest torque."""
     th = np.linspace(0.0, np.pi, 721)
-    t = m.torque(a * np.cos(th), a * np.sin(th))
+    t = m.torque_smooth(a * np.cos(th), a * np.sin(th))
     k = int(np.argmax(t))
     lo, hi = th[max(k - 1, 0)], th[min(k + 1, len(th) - 1)]
     g = 0.5 * (np.sqrt(5.0) - 1.0)
     for _ in range(40):
         x1, x2 = hi - g * (hi - lo), lo + g * (hi - lo)
-        if m.torque(a * np.cos(x1), a * np.sin(x1)) > m.torque(a * np.cos(x2), a * np.sin(x2)):
+        if (m.torque_smooth(a * np.cos(x1), a * np.sin(x1))
+                > m.torque_smooth(a * np.cos(x2), a * np.sin(x2))):
             hi = x2
         else:
             lo = x1
     x = 0.5 * (lo + hi)
-    return x, float(m.torque(a * np.cos(x), a * np.sin(x)))
+    return x, float(m.torque_smooth(a * np.cos(x), a * np.sin(x)))
 
 
 def mtpa_amp_max(m: FluxMap) -> float:
@@ -80,21 +82,54 @@ def tables(m: FluxMap, n: int = N_LUT) -> Tables:
     a_t = np.interp(tt, tor, amp)
     th_t = np.interp(a_t, amp, ang)
     m_id, m_iq = a_t * np.cos(th_t), a_t * np.sin(th_t)
-    pd, pq = m.flux(m_id, m_iq)
+    pd, pq = m.flux_smooth(m_id, m_iq)
     m_flux = np.maximum.accumulate(np.hypot(pd, pq))
-    # MTPV: largest torque at flux amplitude <= lambda
-    D, Q = np.meshgrid(np.linspace(m.i_d[0], m.i_d[-1], 401), np.linspace(0.0, m.i_q[-1], 201))
-    fd, fq = m.flux(D, Q)
-    lam = np.hypot(fd, fq).ravel()
-    tq = (1.5 * m.pole_pairs * (fd * Q - fq * D)).ravel()
+    # MTPV: the largest torque over the load angle at each flux amplitude
+    # (currents by Newton on the interpolant, inside the grid only), then
+    # the largest at flux <= lambda (monotone)
     l_max = float(np.hypot(m.psi_d, m.psi_q).max())
     ll = np.linspace(0.0, l_max, n)
-    order = np.argsort(lam)
-    best = np.maximum.accumulate(np.maximum(tq[order], 0.0))
-    idx = np.searchsorted(lam[order], ll, side="right") - 1
-    tv = np.where(idx >= 0, best[np.clip(idx, 0, None)], 0.0)
-    tv = np.maximum.accumulate(tv)
+    delta = np.linspace(0.0, np.pi, 361)
+    L, Dl = np.meshgrid(ll, delta, indexing="ij")
+    ld, lq = L * np.cos(Dl), L * np.sin(Dl)
+    i_d, i_q = current_smooth(m, ld, lq)
+    inside = ((i_d >= m.i_d[0]) & (i_d <= m.i_d[-1]) & (i_q >= 0.0) & (i_q <= m.i_q[-1])
+              & np.isfinite(i_d) & np.isfinite(i_q))
+    tq = np.where(inside, 1.5 * m.pole_pairs * (ld * i_q - lq * i_d), 0.0)
+    tv = np.maximum.accumulate(np.maximum(tq.max(axis=1), 0.0))
     return Tables(t_max, m_id, m_iq, m_flux, l_max, tv, amp, ad, aq, tor)
+
+
+def current_smooth(m: FluxMap, ld, lq, iters: int = 40):
+    """i(lambda) on the bicubic interpolant: Newton from the zero-current
+    linearisation, Jacobian by central differences (vectorised)."""
+    h = 1e-4 * max(m.did, m.diq)
+    l0 = m.inductance(0.0, 0.0)
+    f0 = m.flux_smooth(0.0, 0.0)
+    det0 = l0[0] * l0[3] - l0[1] * l0[2]
+    rd, rq = ld - f0[0], lq - f0[1]
+    i_d = (l0[3] * rd - l0[1] * rq) / det0
+    i_q = (l0[0] * rq - l0[2] * rd) / det0
+    for _ in range(iters):
+        i_d = np.clip(i_d, 2 * m.i_d[0], 2 * m.i_d[-1])
+        i_q = np.clip(i_q, 2 * m.i_q[0], 2 * m.i_q[-1])
+        fd, fq = m.flux_smooth(i_d, i_q)
+        a = m.flux_smooth(i_d + h, i_q)
+        b = m.flux_smooth(i_d - h, i_q)
+        c = m.flux_smooth(i_d, i_q + h)
+        e = m.flux_smooth(i_d, i_q - h)
+        jdd, jqd = (a[0] - b[0]) / (2 * h), (a[1] - b[1]) / (2 * h)
+        jdq, jqq = (c[0] - e[0]) / (2 * h), (c[1] - e[1]) / (2 * h)
+        det = jdd * jqq - jdq * jqd
+        rd, rq = ld - fd, lq - fq
+        with np.errstate(divide="ignore", invalid="ignore"):
+            i_d = i_d + (jqq * rd - jdq * rq) / det
+            i_q = i_q + (jdd * rq - jqd * rd) / det
+        i_d = np.where(np.isfinite(i_d), i_d, 0.0)  # a singular step: start again from 0
+        i_q = np.where(np.isfinite(i_q), i_q, 0.0)
+    fd, fq = m.flux_smooth(i_d, i_q)
+    bad = np.hypot(fd - ld, fq - lq) > 1e-6 * (1.0 + np.hypot(ld, lq))
+    return np.where(bad, np.nan, i_d), np.where(bad, np.nan, i_q)
 
 
 def lambda_max(k_v: float, v_dc: float, omega: float) -> float:

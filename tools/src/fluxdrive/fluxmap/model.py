@@ -54,6 +54,38 @@ class FluxMap:
             out.append(lo + v * (hi - lo))
         return out[0], out[1]
 
+    def flux_smooth(self, i_d, i_q):
+        """Bicubic (Catmull-Rom, C1) lambda_d, lambda_q inside the grid, for
+        the tables: the plant's interpolant is C1 too, and an optimum (MTPA,
+        MTPV) on a bilinear surface sits on cell edges."""
+        x = np.clip((np.asarray(i_d, float) - self.i_d[0]) / self.did, 0, self.nd - 1)
+        y = np.clip((np.asarray(i_q, float) - self.i_q[0]) / self.diq, 0, self.nq - 1)
+        j = np.clip(np.floor(x).astype(int), 0, self.nd - 2)
+        k = np.clip(np.floor(y).astype(int), 0, self.nq - 2)
+        u, v = x - j, y - k
+
+        def w(t):
+            return (0.5 * (-t + 2 * t * t - t ** 3), 0.5 * (2 - 5 * t * t + 3 * t ** 3),
+                    0.5 * (t + 4 * t * t - 3 * t ** 3), 0.5 * (-t * t + t ** 3))
+
+        wu, wv = w(u), w(v)
+        out = []
+        for a in (self.psi_d, self.psi_q):
+            acc = 0.0
+            for dk in range(4):
+                kk = np.clip(k + dk - 1, 0, self.nq - 1)
+                row = 0.0
+                for dj in range(4):
+                    jj = np.clip(j + dj - 1, 0, self.nd - 1)
+                    row = row + wu[dj] * a[kk, jj]
+                acc = acc + wv[dk] * row
+            out.append(acc)
+        return out[0], out[1]
+
+    def torque_smooth(self, i_d, i_q):
+        pd, pq = self.flux_smooth(i_d, i_q)
+        return 1.5 * self.pole_pairs * (pd * np.asarray(i_q) - pq * np.asarray(i_d))
+
     def torque(self, i_d, i_q):
         """T = 3/2 p (lambda_d i_q - lambda_q i_d), Varatharajan (4)."""
         pd, pq = self.flux(i_d, i_q)

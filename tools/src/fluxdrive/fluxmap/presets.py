@@ -12,9 +12,9 @@ rated line voltage 340 V rms at 1500 rpm), k by bisection so that MTPA at
 the rated 2.3 sqrt(2) A gives 7.1 N m (SYR_K). The figures the fit gives
 are printed by `fluxdrive map check preset:syr_1k1` and in the docs page.
 
-ipm_sat: an interior-PM machine (p = 4, 0.08 Vs PM flux, L_d 0.8 mH,
-L_q 2 mH unsaturated; about 10 N m at 14 A) with self- and
-cross-saturation. pmasyr: a PM-assisted SyR machine (p = 2, 0.12 Vs), the
+ipm_sat: an interior-PM machine (p = 4, 0.08 Vs PM flux, L_d 3.3 mH,
+L_q 8 mH unsaturated, characteristic current about 24 A inside the
+40 A grid, so that MTPV is on the map) with self- and cross-saturation. pmasyr: a PM-assisted SyR machine (p = 2, 0.12 Vs), the
 source of the map-file preset maps/pmasyr_file.{npz,csv} (stored in the
 SyR convention, complex arrays).
 """
@@ -41,8 +41,8 @@ def _scaled(k: float, c: float, r: float, psi_pm: float = 0.0) -> Hinkkanen:
 # name: (model, pole pairs, grid half-width in A, points per axis)
 MODELS = {
     "syr_1k1": (_scaled(SYR_K, SYR_C, SYR_R), 2, 8.0, 33),
-    "ipm_sat": (Hinkkanen(a_d0=500.0, a_dd=2.0e6, S=4, a_q0=1250.0, a_qq=1.0e3, T=1,
-                          a_dq=5.0e5, U=1, V=0, psi_pm=0.08), 4, 40.0, 41),
+    "ipm_sat": (Hinkkanen(a_d0=125.0, a_dd=4.0e5, S=4, a_q0=300.0, a_qq=1.0e3, T=1,
+                          a_dq=2.0e5, U=1, V=0, psi_pm=0.08), 4, 40.0, 41),
     "pmasyr": (_scaled(0.3, 1.5, 3.0, psi_pm=0.12), 2, 10.0, 41),
 }
 

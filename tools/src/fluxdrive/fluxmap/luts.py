@@ -41,24 +41,28 @@ class Tables:
     amp_id: np.ndarray
     amp_iq: np.ndarray
     amp_t: np.ndarray
+    # the MTPV trajectory (plots): the current of the largest torque at each flux
+    mtpv_id: np.ndarray | None = None
+    mtpv_iq: np.ndarray | None = None
 
 
-def _best_angle(m: FluxMap, a: float) -> tuple[float, float]:
-    """Angle theta (i = a (cos, sin), sin >= 0) of the largest torque."""
+def _best_angles(m: FluxMap, amp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Angle theta (i = a (cos, sin), sin >= 0) of the largest torque at each
+    amplitude: a dense sweep, then golden-section refinement (vectorised)."""
     th = np.linspace(0.0, np.pi, 721)
-    t = m.torque_smooth(a * np.cos(th), a * np.sin(th))
-    k = int(np.argmax(t))
-    lo, hi = th[max(k - 1, 0)], th[min(k + 1, len(th) - 1)]
+    A, TH = np.meshgrid(amp, th, indexing="ij")
+    t = m.torque_smooth(A * np.cos(TH), A * np.sin(TH))
+    k = np.argmax(t, axis=1)
+    lo, hi = th[np.maximum(k - 1, 0)], th[np.minimum(k + 1, len(th) - 1)]
     g = 0.5 * (np.sqrt(5.0) - 1.0)
     for _ in range(40):
         x1, x2 = hi - g * (hi - lo), lo + g * (hi - lo)
-        if (m.torque_smooth(a * np.cos(x1), a * np.sin(x1))
-                > m.torque_smooth(a * np.cos(x2), a * np.sin(x2))):
-            hi = x2
-        else:
-            lo = x1
+        first = (m.torque_smooth(amp * np.cos(x1), amp * np.sin(x1))
+                 > m.torque_smooth(amp * np.cos(x2), amp * np.sin(x2)))
+        hi = np.where(first, x2, hi)
+        lo = np.where(first, lo, x1)
     x = 0.5 * (lo + hi)
-    return x, float(m.torque_smooth(a * np.cos(x), a * np.sin(x)))
+    return x, m.torque_smooth(amp * np.cos(x), amp * np.sin(x))
 
 
 def mtpa_amp_max(m: FluxMap) -> float:
@@ -69,11 +73,8 @@ def mtpa_amp_max(m: FluxMap) -> float:
 def tables(m: FluxMap, n: int = N_LUT) -> Tables:
     amax = mtpa_amp_max(m)
     amp = np.linspace(0.0, amax, 161)
-    ang = np.zeros_like(amp)
-    tor = np.zeros_like(amp)
-    for k, a in enumerate(amp[1:], 1):
-        ang[k], tor[k] = _best_angle(m, a)
-    ang[0] = ang[1]
+    ang, tor = _best_angles(m, amp)
+    ang[0], tor[0] = ang[1], 0.0
     tor = np.maximum.accumulate(tor)
     ad, aq = amp * np.cos(ang), amp * np.sin(ang)
     t_max = float(tor[-1])
@@ -96,11 +97,14 @@ def tables(m: FluxMap, n: int = N_LUT) -> Tables:
     inside = ((i_d >= m.i_d[0]) & (i_d <= m.i_d[-1]) & (i_q >= 0.0) & (i_q <= m.i_q[-1])
               & np.isfinite(i_d) & np.isfinite(i_q))
     tq = np.where(inside, 1.5 * m.pole_pairs * (ld * i_q - lq * i_d), 0.0)
+    best = tq.argmax(axis=1)
+    rows = np.arange(n)
+    v_id, v_iq = i_d[rows, best], i_q[rows, best]
     tv = np.maximum.accumulate(np.maximum(tq.max(axis=1), 0.0))
-    return Tables(t_max, m_id, m_iq, m_flux, l_max, tv, amp, ad, aq, tor)
+    return Tables(t_max, m_id, m_iq, m_flux, l_max, tv, amp, ad, aq, tor, v_id, v_iq)
 
 
-def current_smooth(m: FluxMap, ld, lq, iters: int = 40):
+def current_smooth(m: FluxMap, ld, lq, iters: int = 16):
     """i(lambda) on the bicubic interpolant: Newton from the zero-current
     linearisation, Jacobian by central differences (vectorised)."""
     h = 1e-4 * max(m.did, m.diq)

@@ -6,63 +6,92 @@
 #include <math.h>
 #include <stdlib.h>
 
-/* Node slope of f along one axis by central differences (one-sided at the
- * ends), per unit of the cell (the step is 1). */
-static double slope(const double *f, int i, int n, int stride) {
-  if (i == 0) {
-    return f[stride] - f[0];
+/* Slopes (per unit step) of the natural cubic spline through n values
+ * f[0], f[s], ..., f[(n-1) s], into m[0], m[s], ...: the tridiagonal system
+ * m[i-1] + 4 m[i] + m[i+1] = 3 (f[i+1] - f[i-1]), 2 m[0] + m[1] = 3 (f[1] - f[0])
+ * and its mirror at the end (Thomas algorithm; w: n scratch values). */
+static void spline_slopes(const double *f, double *m, int n, int s, double *w) {
+  if (n == 2) {
+    m[0] = m[s] = f[s] - f[0];
+    return;
   }
-  if (i == n - 1) {
-    return f[0] - f[-stride];
+  /* forward sweep: w holds the modified super-diagonal */
+  double b = 2.0;
+  w[0] = 1.0 / b;
+  m[0] = 3.0 * (f[s] - f[0]) / b;
+  for (int i = 1; i < n; ++i) {
+    const double diag = i == n - 1 ? 2.0 : 4.0;
+    const double rhs =
+        i == n - 1 ? 3.0 * (f[i * s] - f[(i - 1) * s]) : 3.0 * (f[(i + 1) * s] - f[(i - 1) * s]);
+    b = diag - w[i - 1];
+    w[i] = 1.0 / b;
+    m[i * s] = (rhs - m[(i - 1) * s]) / b;
   }
-  return 0.5 * (f[stride] - f[-stride]);
+  for (int i = n - 2; i >= 0; --i) {
+    m[i * s] -= w[i] * m[(i + 1) * s];
+  }
 }
 
-/* The cross slope d2 f / du dv at node (j, k) from the u-slopes of the
- * neighbouring rows. */
-static double cross(const double *f, int j, int k, int nx, int ny) {
-  const double *p = f + k * nx + j;
-  if (k == 0) {
-    return slope(p + nx, j, nx, 1) - slope(p, j, nx, 1);
+/* Values, x slopes, y slopes and cross slopes of the tensor-product
+ * natural cubic spline at every node (per unit step). */
+typedef struct {
+  double *fx, *fy, *fxy;
+} slopes_t;
+
+static int node_slopes(const double *f, int nx, int ny, slopes_t *o) {
+  const size_t n = (size_t)nx * (size_t)ny;
+  o->fx = malloc(3 * n * sizeof *o->fx);
+  double *w = malloc((size_t)(nx > ny ? nx : ny) * sizeof *w);
+  if (o->fx == NULL || w == NULL) {
+    free(o->fx);
+    free(w);
+    return -1;
   }
-  if (k == ny - 1) {
-    return slope(p, j, nx, 1) - slope(p - nx, j, nx, 1);
+  o->fy = o->fx + n;
+  o->fxy = o->fy + n;
+  for (int k = 0; k < ny; ++k) {
+    spline_slopes(f + k * nx, o->fx + k * nx, nx, 1, w);
   }
-  return 0.5 * (slope(p + nx, j, nx, 1) - slope(p - nx, j, nx, 1));
+  for (int j = 0; j < nx; ++j) {
+    spline_slopes(f + j, o->fy + j, ny, nx, w);
+    spline_slopes(o->fx + j, o->fxy + j, ny, nx, w);
+  }
+  free(w);
+  return 0;
 }
 
 /* Coefficients A = M F M^T of the patch (F: values, u-slopes, v-slopes and
- * cross slopes at the corners), M the cubic Hermite matrix. */
-static void patch(const double *f, int j, int k, int nx, int ny, double a[16]) {
+ * cross slopes at the corners), M the cubic Hermite matrix: with the
+ * spline's node slopes the patches are the bicubic spline itself (C2). */
+static void patch(const double *f, const slopes_t *sl, int j, int k, int nx, double a[16]) {
   static const double M[4][4] = {{1, 0, 0, 0}, {0, 0, 1, 0}, {-3, 3, -2, -1}, {2, -2, 1, 1}};
   double F[4][4];
   for (int dj = 0; dj < 2; ++dj) {
     for (int dk = 0; dk < 2; ++dk) {
-      const int jj = j + dj, kk = k + dk;
-      const double *p = f + kk * nx + jj;
-      F[dj][dk] = p[0];
-      F[2 + dj][dk] = slope(p, jj, nx, 1);
-      F[dj][2 + dk] = slope(p, kk, ny, nx);
-      F[2 + dj][2 + dk] = cross(f, jj, kk, nx, ny);
+      const int o = (k + dk) * nx + j + dj;
+      F[dj][dk] = f[o];
+      F[2 + dj][dk] = sl->fx[o];
+      F[dj][2 + dk] = sl->fy[o];
+      F[2 + dj][2 + dk] = sl->fxy[o];
     }
   }
   double T[4][4];
   for (int r = 0; r < 4; ++r) {
     for (int c = 0; c < 4; ++c) {
-      double s = 0.0;
+      double t = 0.0;
       for (int q = 0; q < 4; ++q) {
-        s += M[r][q] * F[q][c];
+        t += M[r][q] * F[q][c];
       }
-      T[r][c] = s;
+      T[r][c] = t;
     }
   }
   for (int r = 0; r < 4; ++r) {
     for (int c = 0; c < 4; ++c) {
-      double s = 0.0;
+      double t = 0.0;
       for (int q = 0; q < 4; ++q) {
-        s += T[r][q] * M[c][q];
+        t += T[r][q] * M[c][q];
       }
-      a[4 * r + c] = s; /* coefficient of u^r v^c */
+      a[4 * r + c] = t; /* coefficient of u^r v^c */
     }
   }
 }
@@ -81,13 +110,25 @@ int plant_bicubic_build(plant_bicubic_t *b, int nx, int ny, double x0, double dx
   if (b->c == NULL) {
     return -1;
   }
+  slopes_t s1, s2;
+  if (node_slopes(f1, nx, ny, &s1) != 0) {
+    plant_bicubic_free(b);
+    return -1;
+  }
+  if (node_slopes(f2, nx, ny, &s2) != 0) {
+    free(s1.fx);
+    plant_bicubic_free(b);
+    return -1;
+  }
   for (int k = 0; k + 1 < ny; ++k) {
     for (int j = 0; j + 1 < nx; ++j) {
       double *a = b->c + ((size_t)k * (size_t)(nx - 1) + (size_t)j) * 32u;
-      patch(f1, j, k, nx, ny, a);
-      patch(f2, j, k, nx, ny, a + 16);
+      patch(f1, &s1, j, k, nx, a);
+      patch(f2, &s2, j, k, nx, a + 16);
     }
   }
+  free(s1.fx);
+  free(s2.fx);
   return 0;
 }
 

@@ -1,8 +1,8 @@
 /*
  * plant_bicubic.h - a smooth two-valued function of two variables on a
- * regular grid for the plant's flux maps: piecewise bicubic Hermite
- * patches (node slopes and cross slopes by central differences, one-sided
- * at the edges), C1 across cells, stored as the 16 polynomial coefficients
+ * regular grid for the plant's flux maps: the tensor-product natural cubic
+ * spline (C2 across cells; node slopes and cross slopes from the spline's
+ * tridiagonal systems), stored as the 16 polynomial coefficients
  * of each cell and component so that an evaluation is one cell lookup and
  * a Horner scheme. Outside the grid the function continues linearly from
  * the nearest point of the grid's box with the Jacobian there (continuous,

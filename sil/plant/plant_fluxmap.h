@@ -5,13 +5,13 @@
  * integration (flux linkages are the state) gets the currents i(lambda)
  * and their Jacobian d i / d lambda from one smooth interpolant.
  *
- * Forward map: bicubic Hermite patches through the grid values
- * (plant_bicubic.h, C1). Inverse: on a flux grid of PLANT_FLUXMAP_REFINE
+ * Forward map: the bicubic natural spline through the grid values
+ * (plant_bicubic.h, C2). Inverse: on a flux grid of PLANT_FLUXMAP_REFINE
  * times the current grid's points per axis (at most PLANT_FLUXMAP_INV_MAX),
  * covering the image of the current grid, each node solved by Newton on
  * the forward patches (continuation from the neighbouring node), then
- * bicubic Hermite patches through those currents: i(lambda) is C1 and its
- * Jacobian is the patches' own derivative (consistent with the currents:
+ * the bicubic spline through those currents: i(lambda) is C2 and its
+ * Jacobian is the spline's own derivative (consistent with the currents:
  * the diode projection and the energy balance rely on it). Measured error
  * of the inverse against the forward patches, and of both against a
  * closed-form machine: tests/plant/test_fluxmap.c prints them.

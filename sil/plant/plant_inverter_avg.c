@@ -41,6 +41,7 @@ static inline double eff_duty(double d, double kd, double i_norm) {
  * period). */
 typedef struct {
   double th, c, s;
+  const double *i_known; /* currents of the first stage's state, or NULL */
 } angle_ref_t;
 
 static inline void stage_cos_sin(const angle_ref_t *r, double th, double *c, double *s) {
@@ -72,9 +73,15 @@ typedef struct {
  * angle. The same expressions as plant_internal.h's inline mechanics and
  * DC link, with the parameters hoisted. */
 static inline void avg_deriv(const avg_k_t *restrict k, int ideal, int imposed, double c, double s,
-                             const double *restrict x, double m, double *restrict dx) {
+                             const double *restrict x, double m, double *restrict dx,
+                             const double *i_known) {
   double id, iq;
-  plant_mag_current(&k->mag, x[X_LD], x[X_LQ], &id, &iq);
+  if (i_known != NULL) { /* the state's currents, already computed (the plant's cache) */
+    id = i_known[0];
+    iq = i_known[1];
+  } else {
+    plant_mag_current(&k->mag, x[X_LD], x[X_LQ], &id, &iq);
+  }
   const double ial = id * c - iq * s, ibe = id * s + iq * c;
   const double ia = ial, ib = -0.5 * ial + PLANT_SQRT3_2 * ibe, ic = -ia - ib;
   const double vdc = ideal ? k->vsrc : (x[X_VC] > 0.0 ? x[X_VC] : 0.0);
@@ -137,22 +144,22 @@ static AVG_ALWAYS_INLINE void avg_rk4(const plant_t *pl, const avg_k_t *restrict
       ar->c = c;
       ar->s = s;
     }
-    avg_deriv(k, ideal, imposed, ar->c, ar->s, x, m0, k1);
+    avg_deriv(k, ideal, imposed, ar->c, ar->s, x, m0, k1, j == 0 ? ar->i_known : NULL);
     for (int i = 0; i < X_VA; i++) { /* the integrals X_VA.. are not read */
       xs[i] = x[i] + h2 * k1[i];
     }
     stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
-    avg_deriv(k, ideal, imposed, c, s, xs, m1, k2);
+    avg_deriv(k, ideal, imposed, c, s, xs, m1, k2, NULL);
     for (int i = 0; i < X_VA; i++) {
       xs[i] = x[i] + h2 * k2[i];
     }
     stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
-    avg_deriv(k, ideal, imposed, c, s, xs, m1, k3);
+    avg_deriv(k, ideal, imposed, c, s, xs, m1, k3, NULL);
     for (int i = 0; i < X_VA; i++) {
       xs[i] = x[i] + h * k3[i];
     }
     stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
-    avg_deriv(k, ideal, imposed, c, s, xs, m2, k4);
+    avg_deriv(k, ideal, imposed, c, s, xs, m2, k4, NULL);
     for (int i = 0; i < X_N; i++) {
       if ((ideal && i == X_VC) || (imposed && i == X_W)) {
         continue;
@@ -198,10 +205,15 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
     ar.th = cc->th_e;
     ar.c = cc->c;
     ar.s = cc->s;
+    /* the cache is keyed on this very state (flux linkages included): its
+     * currents are the first stage's, bit for bit (a map's evaluation is
+     * not free) */
+    ar.i_known = cc->i_dq;
   } else {
     ar.th = k.pp * x[X_TH];
     ar.c = cos(ar.th);
     ar.s = sin(ar.th);
+    ar.i_known = NULL;
   }
   if (k.ideal && !k.imposed) {
     avg_rk4(pl, &k, 1, 0, &ar, x, cs_end); /* the usual case */

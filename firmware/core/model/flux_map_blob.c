@@ -32,13 +32,19 @@ static float word_f32(const uint32_t *w, uint32_t i) {
   return f;
 }
 
+/* CRC-32, reflected polynomial 0xEDB88320, four bits a step from a 16-entry
+ * table (64 bytes of flash; a bit at a time cost 0.6 M instructions on a
+ * 10 KB blob, this a quarter of that). */
 uint32_t flux_map_crc32(const uint32_t *words, uint32_t n_bytes) {
+  static const uint32_t nib[16] = {0x00000000u, 0x1DB71064u, 0x3B6E20C8u, 0x26D930ACu,
+                                   0x76DC4190u, 0x6B6B51F4u, 0x4DB26158u, 0x5005713Cu,
+                                   0xEDB88320u, 0xF00F9344u, 0xD6D6A3E8u, 0xCB61B38Cu,
+                                   0x9B64C2B0u, 0x86D3D2D4u, 0xA00AE278u, 0xBDBDF21Cu};
   uint32_t crc = 0xFFFFFFFFu;
   for (uint32_t b = 0u; b < n_bytes; ++b) {
     crc ^= (words[b >> 2u] >> (8u * (b & 3u))) & 0xFFu; /* little-endian byte order */
-    for (int k = 0; k < 8; ++k) {
-      crc = (crc >> 1u) ^ (0xEDB88320u & (0u - (crc & 1u)));
-    }
+    crc = (crc >> 4u) ^ nib[crc & 15u];
+    crc = (crc >> 4u) ^ nib[crc & 15u];
   }
   return ~crc;
 }

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # PIL test (docs/pil.md): cross-builds the PIL image (preset cortex-m4f, the
 # board's MinSizeRel flags, -Werror) into BUILD_DIR, then `fluxdrive pil`
-# replays the two PIL scenarios with every law on QEMU mps2-an386 and traces
+# replays the two PIL scenarios with every law (and FOC on the flux-map
+# machine syr_1k1) on QEMU mps2-an386 and traces
 # every ISR of both (--isrs all: the whole flux-weakening ramp, current
 # limit, voltage limit and MTPV included). Outputs must agree with this host
 # build's within the stated tolerance; the DB-DFVC worst case must stay
@@ -24,3 +25,9 @@ export PYTHONPATH="$src/tools/src${PYTHONPATH:+:$PYTHONPATH}"
   "$src/sil/scenarios/pil_fw_ramp.json" --law foc,pi_dfvc,db_dfvc --isrs all \
   --sil "$sil" --elf "$build/cross/pil/fluxdrive-pil.elf" --out "$build/work" \
   --markdown "$build/benchmarks.md" --check-worst 3000 --check-cycles 50
+# FOC on the saturated syr_1k1 (flux map in the stream): agreement, counts,
+# calls and instructions per call of the map lookup and the incremental
+# inductance (docs/benchmarks.md, "Flux maps").
+"$python" -m fluxdrive pil "$src/sil/scenarios/pil_syr_foc.json" --law foc --isrs all \
+  --functions --sil "$sil" --elf "$build/cross/pil/fluxdrive-pil.elf" --out "$build/work" \
+  --markdown "$build/benchmarks-map.md"

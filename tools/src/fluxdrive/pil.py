@@ -233,7 +233,9 @@ def _parse_trace(stream, res: TraceResult, tab: dict) -> None:
     function changes (calls and returns), not per line. Calls: a change of
     function at the new function's first PC is a call (pushed), any other
     change a return to a caller on the stack (the frames above it popped,
-    each booked with its instructions from entry to return)."""
+    each booked with its instructions from entry to return); a change into
+    a function not on the stack at another PC (a branch into its body)
+    counts as a call too."""
     in_isr = False
     prev = ""  # function of the previous line
     nxt = b""  # fall-through PC of the previous instruction
@@ -269,8 +271,8 @@ def _parse_trace(stream, res: TraceResult, tab: dict) -> None:
                     res.funcs.append(cur_n)
                     res.func_cycles.append(cur_c)
                     res.calls.append(cur_calls)
-                elif k in entries:
-                    stack.append((fn, n))
+                elif k in entries or not any(f is fn for f, _ in stack):
+                    stack.append((fn, n))  # a call (or a branch into a function's body)
                 else:
                     _book(stack, n, cur_calls, fn)
             elif fn == ISR_FUNC and prev == ISR_CALLER:

@@ -8,6 +8,12 @@
  *  2. The scenario sil/scenarios/syr_1k1_speed_load.json: speed step to
  *     1500 rpm, rated load step; no fault, the speed within 1 % of the
  *     reference before and after the step, the load met.
+ *  3. The current loop keeps its design bandwidth on the saturated map:
+ *     small d and q steps at a light and at the rated operating point reach
+ *     63 % of the step after 1/current_bw plus the loop's delay (1.5 Ts),
+ *     +-25 %. The incremental inductance at rated current is a quarter of
+ *     the unsaturated one: constant gains would make the loop up to 4x
+ *     faster there, gains from the wrong axis up to 7x slower.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -117,8 +123,57 @@ static void speed_step_and_rated_load(void **state) {
   trace_free(&tr);
 }
 
+/* Time from t0 until x crosses 63 % of its step from x0 to x1. */
+static double t63(const trace_t *tr, const double *x, double t0, double x0, double x1) {
+  const double lvl = x0 + 0.632 * (x1 - x0);
+  for (size_t k = idx_at(tr, t0); k < tr->n; ++k) {
+    if ((x1 > x0 && x[k] >= lvl) || (x1 < x0 && x[k] <= lvl)) {
+      return tr->t[k] - t0;
+    }
+  }
+  return 1e9;
+}
+
+static void current_loop_bandwidth(void **state) {
+  (void)state;
+  /* operating points (i_d, i_q): light load, rated MTPA */
+  const double op[2][2] = {{-0.6, 0.4}, {-2.8, 1.66}};
+  const double bw = 2000.0, ts = 62.5e-6, expect = 1.0 / bw + 1.5 * ts, step = 0.1;
+  for (int n = 0; n < 2; ++n) {
+    char json[1024];
+    snprintf(json, sizeof json,
+             "{\"name\": \"syr current steps\", \"duration\": 0.08,"
+             " \"machine\": {\"preset\": \"syr_1k1\"}, \"dc_link\": {\"voltage\": 650},"
+             " \"mechanics\": {\"mode\": \"imposed\", \"speed\": {\"unit\": \"rpm\","
+             " \"terms\": [{\"type\": \"const\", \"value\": 300}]}},"
+             " \"sensors\": {\"v_full_scale\": 1000, \"encoder_cpr\": 4096},"
+             " \"controller\": {\"law\": \"foc\", \"mode\": \"current\", \"current_bw\": %g,"
+             " \"v_dc_max\": 800, \"i_max\": 4.879},"
+             " \"references\": {\"id\": [{\"type\": \"const\", \"value\": %g},"
+             " {\"type\": \"step\", \"t\": 0.06, \"value\": %g}],"
+             " \"iq\": [{\"type\": \"const\", \"value\": %g},"
+             " {\"type\": \"step\", \"t\": 0.04, \"value\": %g}]}}",
+             bw, op[n][0], -step, op[n][1], step);
+    scenario_t sc;
+    trace_t tr;
+    sil_result_t res;
+    run_json(json, &sc, &tr, &res);
+    const size_t kq = idx_at(&tr, 0.04), kd = idx_at(&tr, 0.06);
+    const double tq = t63(&tr, tr.iq, 0.04, tr.iq[kq - 1], op[n][1] + step);
+    const double td = t63(&tr, tr.id, 0.06, tr.id[kd - 1], op[n][0] - step);
+    printf("syr_1k1 current loop at (%.2f, %.2f) A: 63 %% of a %.1f A step after %.3f ms (q), "
+           "%.3f ms (d); design 1/bw + 1.5 Ts = %.3f ms\n",
+           op[n][0], op[n][1], step, 1e3 * tq, 1e3 * td, 1e3 * expect);
+    ASSERT_IN(tq, 0.75 * expect, 1.25 * expect);
+    ASSERT_IN(td, 0.75 * expect, 1.25 * expect);
+    assert_int_equal(res.faults, 0);
+    trace_free(&tr);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {cmocka_unit_test(rated_torque_at_rated_current),
-                                     cmocka_unit_test(speed_step_and_rated_load)};
+                                     cmocka_unit_test(speed_step_and_rated_load),
+                                     cmocka_unit_test(current_loop_bandwidth)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -243,6 +243,7 @@ static int use_map(ctx_t *c, const char *key, const char *file, scenario_t *sc) 
     return fail(c, key, "%s", why);
   }
   sc->plant.machine.map = e->plant;
+  snprintf(sc->map_file, sizeof sc->map_file, "%s", e->path);
   sc->plant.machine.pole_pairs = (int)e->map.pole_pairs;
   sc->drive.machine_map = e->words;
   return 0;

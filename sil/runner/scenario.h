@@ -35,6 +35,7 @@ typedef struct {
   profile_t main_stall;      /* the main loop does not run (hung) */
   profile_t isr_stall;       /* the PWM-period interrupt does not run */
   int log_decimation;        /* log every n-th sample */
+  char map_file[512];        /* the flux map's file as resolved ("" for a linear machine) */
 } scenario_t;
 
 /* Loads a scenario from JSON text; `origin` prefixes error messages (the

@@ -83,6 +83,9 @@ char *config_json(const scenario_t *sc) {
   cJSON_AddNumberToObject(pm, "lambda_m", m->lambda_m);
   cJSON_AddNumberToObject(pm, "j", sc->plant.mech.j);
   cJSON_AddStringToObject(pm, "kind", d->machine_map != NULL ? "flux_map" : "linear");
+  if (d->machine_map != NULL) {
+    cJSON_AddStringToObject(pm, "map", sc->map_file);
+  }
   cJSON_AddNumberToObject(o, "v_dc", sc->plant.dclink.v_source);
   cJSON_AddNumberToObject(o, "ts", sc->plant.ts);
   cJSON_AddNumberToObject(o, "dead_time", sc->plant.inverter.dead_time);

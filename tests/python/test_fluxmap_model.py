@@ -122,3 +122,22 @@ def test_mtpv_table_against_a_load_angle_sweep(name):
         assert abs(r) < 0.01, r
         checked += 1
     assert checked >= 2
+
+
+def test_capability_on_the_map():
+    """At low speed the capability is the MTPA torque at i_max; it falls
+    with speed under the voltage limit (never rises); at the 340 V link of
+    Table I the rated 7.1 N m is not available at the rated 1500 rpm."""
+    from fluxdrive.fluxmap.capability import map_capability
+
+    m = preset_map("syr_1k1")
+    i_n = 2.3 * np.sqrt(2)
+    rpm = np.array([100, 500, 1000, 1500, 2000, 3000])
+    rows = map_capability(m, 6.8, i_n, 340.0, 0.95, 1e9, rpm * np.pi / 30)
+    t = np.array([r[0] for r in rows])
+    print("syr_1k1 at 340 V:", dict(zip(rpm.tolist(), np.round(t, 3).tolist())))
+    assert t[0] == pytest.approx(7.1, rel=0.01)
+    assert np.all(np.diff(t) <= 1e-9)
+    assert t[3] < 0.8 * 7.1
+    rows = map_capability(m, 6.8, i_n, 650.0, 0.95, 1e9, rpm * np.pi / 30)
+    assert rows[3][0] == pytest.approx(7.1, rel=0.01)  # the scenario's 650 V link

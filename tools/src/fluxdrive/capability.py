@@ -135,13 +135,32 @@ def corner_speeds(cap: Capability, m: Machine, lim: Limits) -> dict:
             "mtpv_speed": first(delta >= lim.delta_max - np.radians(0.1))}
 
 
+def _map_table(cfg: dict, rpm: np.ndarray) -> int:
+    """The capability of a flux-map machine (fluxmap/capability.py)."""
+    from .fluxmap.cli import _load
+    from .fluxmap.capability import map_capability
+
+    m, c = cfg["machine"], cfg["controller"]
+    fm = _load(None, m["map"])
+    rows = map_capability(fm, m["rs"], c["i_max"], cfg["v_dc"], c["v_margin"], c["torque_max"],
+                          rpm * np.pi / 30.0)
+    print(f"flux map {m['map']} ({fm.pole_pairs} pole pairs), i_max {c['i_max']:.3f} A, "
+          f"v_dc {cfg['v_dc']:g} V, v_margin {c['v_margin']:g}")
+    print(f"{'speed rpm':>10} {'torque N m':>11} {'power W':>9} {'i_d A':>7} {'i_q A':>7}  limit")
+    for r, (t, d, q, l) in zip(rpm, rows):
+        print(f"{r:10.0f} {t:11.3f} {t * r * np.pi / 30:9.1f} {d:7.3f} {q:7.3f}  {l}")
+    return 0
+
+
 def main_capability(args) -> int:
     """`fluxdrive capability SCENARIO`: print the capability table."""
     from .sil import locate_sil
 
     cfg = load_config(str(locate_sil(args.sil)), args.scenario)
-    m, lim = from_config(cfg)
     rpm = np.linspace(args.min_rpm, args.max_rpm, args.points)
+    if cfg["machine"].get("kind") == "flux_map":
+        return _map_table(cfg, rpm)
+    m, lim = from_config(cfg)
     cap = capability(m, lim, rpm * np.pi / 30.0)
     print(f"{'speed rpm':>10} {'torque N m':>11} {'power W':>9} {'i_d A':>7} {'i_q A':>7}  limit")
     for r, t, p, d, q, l in zip(rpm, cap.torque, cap.power, cap.i_d, cap.i_q, cap.limit):

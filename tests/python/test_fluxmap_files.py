@@ -190,3 +190,11 @@ def test_convert_cli_error_format(tmp_path):
                          str(REPO / "maps" / "pmasyr_file.npz"), "-o", str(tmp_path / "y.fdmap")],
                         capture_output=True, text=True, timeout=120)
     assert ok.returncode == 0 and ok.stdout == "" and (tmp_path / "y.fdmap").is_file()
+
+
+def test_doc_page_is_what_the_command_writes():
+    """docs/flux-maps.md's generated part (numbers of every preset) equals
+    what `fluxdrive map doc --write` would write."""
+    r = subprocess.run([sys.executable, "-m", "fluxdrive", "map", "doc", "--check"], cwd=REPO,
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stdout + r.stderr

@@ -4,13 +4,14 @@
 #include "plant_bicubic.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 
 /* Slopes (per unit step) of the natural cubic spline through n values
  * f[0], f[s], ..., f[(n-1) s], into m[0], m[s], ...: the tridiagonal system
  * m[i-1] + 4 m[i] + m[i+1] = 3 (f[i+1] - f[i-1]), 2 m[0] + m[1] = 3 (f[1] - f[0])
  * and its mirror at the end (Thomas algorithm; w: n scratch values). */
-static void spline_slopes(const double *f, double *m, int n, int s, double *w) {
+static void spline_slopes(const double *f, double *m, ptrdiff_t n, ptrdiff_t s, double *w) {
   if (n == 2) {
     m[0] = m[s] = f[s] - f[0];
     return;
@@ -19,7 +20,7 @@ static void spline_slopes(const double *f, double *m, int n, int s, double *w) {
   double b = 2.0;
   w[0] = 1.0 / b;
   m[0] = 3.0 * (f[s] - f[0]) / b;
-  for (int i = 1; i < n; ++i) {
+  for (ptrdiff_t i = 1; i < n; ++i) {
     const double diag = i == n - 1 ? 2.0 : 4.0;
     const double rhs =
         i == n - 1 ? 3.0 * (f[i * s] - f[(i - 1) * s]) : 3.0 * (f[(i + 1) * s] - f[(i - 1) * s]);
@@ -27,7 +28,7 @@ static void spline_slopes(const double *f, double *m, int n, int s, double *w) {
     w[i] = 1.0 / b;
     m[i * s] = (rhs - m[(i - 1) * s]) / b;
   }
-  for (int i = n - 2; i >= 0; --i) {
+  for (ptrdiff_t i = n - 2; i >= 0; --i) {
     m[i * s] -= w[i] * m[(i + 1) * s];
   }
 }
@@ -49,7 +50,7 @@ static int node_slopes(const double *f, int nx, int ny, slopes_t *o) {
   }
   o->fy = o->fx + n;
   o->fxy = o->fy + n;
-  for (int k = 0; k < ny; ++k) {
+  for (ptrdiff_t k = 0; k < ny; ++k) {
     spline_slopes(f + k * nx, o->fx + k * nx, nx, 1, w);
   }
   for (int j = 0; j < nx; ++j) {
@@ -156,14 +157,16 @@ static void eval_in(const plant_bicubic_t *b, double x, double y, double f[2], d
   for (int c = 0; c < 2; ++c, a += 16) {
     double t[4];
     for (int r = 0; r < 4; ++r) {
-      t[r] = a[4 * r] + a[4 * r + 1] * V[1] + a[4 * r + 2] * V[2] + a[4 * r + 3] * V[3];
+      const double *ar = a + (ptrdiff_t)4 * r;
+      t[r] = ar[0] + ar[1] * V[1] + ar[2] * V[2] + ar[3] * V[3];
     }
     f[c] = t[0] + U[1] * t[1] + U[2] * t[2] + U[3] * t[3];
     if (jac != NULL) {
       const double dV[4] = {0.0, 1.0, 2.0 * v, 3.0 * v * v};
       double tv = 0.0;
       for (int r = 0; r < 4; ++r) {
-        tv += U[r] * (a[4 * r + 1] * dV[1] + a[4 * r + 2] * dV[2] + a[4 * r + 3] * dV[3]);
+        const double *ar = a + (ptrdiff_t)4 * r;
+        tv += U[r] * (ar[1] * dV[1] + ar[2] * dV[2] + ar[3] * dV[3]);
       }
       jac[c][0] = (t[1] + 2.0 * u * t[2] + 3.0 * u * u * t[3]) * b->inv_dx;
       jac[c][1] = tv * b->inv_dy;

@@ -503,6 +503,17 @@ static int parse_controller(ctx_t *c, const cJSON *o, scenario_t *sc) {
         get_num(c, e, E, "lambda_m_scale", 0.1, 10.0, &lm)) {
       return -1;
     }
+    if (sc->plant.machine.map != NULL) {
+      /* a map machine's model is its map: these factors would act on
+       * nothing (scaling the controller's map comes with the decoupled DFVC) */
+      for (int k = 1; ekeys[k] != NULL; ++k) {
+        if (cJSON_GetObjectItemCaseSensitive(e, ekeys[k]) != NULL) {
+          char key[64];
+          snprintf(key, sizeof key, "%s.%s", E, ekeys[k]);
+          return fail(c, key, "a flux-map machine's model is its map (only rs_scale applies)");
+        }
+      }
+    }
     d->rs = (float)(sc->plant.machine.rs * rs);
     d->ld = (float)(sc->plant.machine.ld * ld * ls);
     d->lq = (float)(sc->plant.machine.lq * lq * ls);

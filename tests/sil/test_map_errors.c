@@ -107,6 +107,13 @@ static void refused_maps(void **state) {
                      "maps.json", &sc, err, sizeof err),
       0);
   assert_non_null(strstr(err, "machine.ld: a flux-map machine takes"));
+  /* detuning factors that would act on nothing */
+  assert_int_not_equal(scenario_parse("{\"duration\": 0.01, \"machine\": {\"map\": "
+                                      "\"map_ok2.fdmap\"}, \"controller\": {\"estimates\": "
+                                      "{\"ld_scale\": 1.2}}}",
+                                      "maps.json", &sc, err, sizeof err),
+                       0);
+  assert_non_null(strstr(err, "controller.estimates.ld_scale: a flux-map machine's model"));
   /* pole pairs other than the map's */
   assert_int_not_equal(scenario_parse("{\"duration\": 0.01, \"machine\": {\"map\": "
                                       "\"map_ok2.fdmap\", \"pole_pairs\": 3}}",

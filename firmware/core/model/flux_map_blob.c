@@ -4,6 +4,7 @@
  * wrote the blob (tools/src/fluxdrive/fluxmap/) where a wrong blob would
  * make a wrong machine: a blob may come from elsewhere than the tool.
  */
+#include <stddef.h>
 #include <string.h>
 
 #include "math/fd_math.h"
@@ -131,7 +132,7 @@ static int check_tables(const flux_map_t *m, flux_map_status_t *st) {
 }
 
 int flux_map_parse(flux_map_t *m, const uint32_t *w, uint32_t size, flux_map_status_t *st) {
-  flux_map_status_t dummy;
+  flux_map_status_t dummy = {FLUX_MAP_OK, -1, -1};
   st = st != NULL ? st : &dummy;
   *st = (flux_map_status_t){FLUX_MAP_OK, -1, -1};
   if (w == NULL || m == NULL) {
@@ -192,13 +193,13 @@ int flux_map_parse(flux_map_t *m, const uint32_t *w, uint32_t size, flux_map_sta
   t.inv_did = 1.0f / did;
   t.inv_diq = 1.0f / diq;
   t.psi_d = p;
-  t.psi_q = p + nd * nq;
-  p += 2u * nd * nq;
+  t.psi_q = p + (size_t)nd * nq;
+  p += (size_t)2u * nd * nq;
   t.mtpa_t_max = word_f32(p, 0u);
   t.mtpa_id = p + 1u;
   t.mtpa_iq = p + 1u + nl;
-  t.mtpa_flux = p + 1u + 2u * nl;
-  p += 1u + 3u * nl;
+  t.mtpa_flux = p + 1u + (size_t)2u * nl;
+  p += 1u + (size_t)3u * nl;
   t.mtpv_flux_max = word_f32(p, 0u);
   t.mtpv_torque = p + 1u;
   if (!(t.mtpa_t_max > 0.0f && t.mtpv_flux_max > 0.0f && fd_isfinite(t.mtpa_t_max) &&

@@ -6,8 +6,8 @@
 # every ISR of both (--isrs all: the whole flux-weakening ramp, current
 # limit, voltage limit and MTPV included). Outputs must agree with this host
 # build's within the stated tolerance; the DB-DFVC worst case must stay
-# below 3000 instructions (measured 2907, whole ramp) and at or below 50 %
-# of the 10625-cycle budget in estimated Cortex-M4 cycles (measured 46.2 %;
+# below 3000 instructions (measured 2821, whole ramp) and at or below 50 %
+# of the 10625-cycle budget in estimated Cortex-M4 cycles (measured 44.5 %;
 # why 50 %: docs/pil.md, "Scenarios and checks"). Prints the report and writes its
 # markdown section to BUILD_DIR/benchmarks.md.
 # Usage: run_pil.sh SRC_DIR BUILD_DIR PYTHON FLUXDRIVE_SIL

@@ -198,3 +198,17 @@ def test_doc_page_is_what_the_command_writes():
     r = subprocess.run([sys.executable, "-m", "fluxdrive", "map", "doc", "--check"], cwd=REPO,
                        capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stdout + r.stderr
+
+
+def test_board_table_is_the_sil_blob(tmp_path):
+    """The board's C table (map ctable) holds the very bytes the SIL loads
+    (map convert) for the same map file: one generator path."""
+    src = str(REPO / "maps" / "pmasyr_file.npz")
+    run = [sys.executable, "-m", "fluxdrive", "map"]
+    subprocess.run(run + ["convert", src, "-o", str(tmp_path / "m.fdmap")], check=True,
+                   timeout=120)
+    subprocess.run(run + ["ctable", src, "-o", str(tmp_path / "m.c")], check=True, timeout=120)
+    words = [int(w[2:-2], 16) for w in (tmp_path / "m.c").read_text().split()
+             if w.startswith("0x") and w.endswith("u,")]
+    blob_bytes = (tmp_path / "m.fdmap").read_bytes()
+    assert b"".join(w.to_bytes(4, "little") for w in words) == blob_bytes

@@ -1,19 +1,3 @@
 # tests/dfvc/extra.cmake - Eigen (double) reference checks of the DFVC core
-# (Rubino 2020 discretisation and MPE). Included from tests/CMakeLists.txt
-# inside fd_add_cmocka_tests(), where CMAKE_CURRENT_SOURCE_DIR is tests/
-# (which enables CXX).
-find_path(FD_EIGEN3_INCLUDE Eigen/Core PATHS /usr/include/eigen3 NO_DEFAULT_PATH)
-if(NOT FD_EIGEN3_INCLUDE)
-  message(FATAL_ERROR "Eigen3 not found (Debian: libeigen3-dev)")
-endif()
-
-foreach(ref ref_discretisation)
-  set(exe dfvc_${ref})
-  add_executable(${exe} ${CMAKE_CURRENT_SOURCE_DIR}/dfvc/${ref}.cpp)
-  set_target_properties(${exe} PROPERTIES CXX_STANDARD 17 CXX_STANDARD_REQUIRED ON)
-  target_include_directories(${exe} PRIVATE ${CMOCKA_INCLUDE} ${FD_EIGEN3_INCLUDE})
-  target_link_libraries(${exe} PRIVATE fd_core ${CMOCKA_LIB} m)
-  target_compile_options(${exe} PRIVATE -Wall -Wextra -Werror)
-  add_test(NAME dfvc/${ref} COMMAND ${exe})
-  set_tests_properties(dfvc/${ref} PROPERTIES LABELS dfvc TIMEOUT 300)
-endforeach()
+# (Rubino 2020 discretisation and MPE): tests/dfvc/ref_*.cpp.
+fd_add_eigen_refs(dfvc)

@@ -19,6 +19,7 @@
 #include "control/current_ctrl.h"
 #include "control/deadtime_comp.h"
 #include "control/dfvc.h"
+#include "control/dfvc_sat.h"
 #include "drive_config.h"
 #include "math/frames.h"
 #include "model/machine.h"
@@ -33,6 +34,13 @@ typedef struct {
   float i_qs_ref;
   float torque;  /* torque estimate [N m] */
   float obs_err; /* |observer flux - current-model flux| [Vs] (flux laws) */
+  /* decoupled DFVC (Varatharajan 2022) */
+  float flux_mtpa;   /* MTPA flux, table (29) or adapted (32) [Vs] */
+  float torque_mtpv; /* MTPV torque limit, (31) or (34) [N m] */
+  float gain_a;      /* a_hat of the transformation (23) [1/H] */
+  float gain_b;      /* b_hat [1/H] */
+  float mtpa_angle;  /* phase of lambda^a from i (7), on the line [rad] */
+  float mtpv_angle;  /* phase of i^a from lambda (10), on the line [rad] */
 } ctrl_telemetry_t;
 
 typedef struct {
@@ -75,11 +83,13 @@ typedef struct {
 typedef union {
   ctrl_foc_t foc;
   dfvc_t dfvc;
+  dfvc_sat_t dfvc_sat;
 } ctrl_state_t;
 
 enum {
   CTRL_CAP_CURRENT = 1u << 0, /* runs DRIVE_MODE_CURRENT */
   CTRL_CAP_FLUX = 1u << 1,    /* takes a flux reference, reports flux and load angle */
+  CTRL_CAP_DELTA = 1u << 2,   /* keeps the load angle within delta_max (SPM laws) */
 };
 
 typedef struct {

@@ -324,7 +324,11 @@ static void drive_monitor(drive_t *drv, const ctrl_in_t *in, const ctrl_out_t *o
     }
   }
   if ((drv->ctrl.impl->caps & CTRL_CAP_FLUX) != 0u) {
-    if (fabsf(out->tm.delta) > c->delta_max + c->lc_delta) {
+    /* the SPM laws' load-angle limit (the decoupled DFVC's MTPV limit is
+     * its torque margin k_T: its load angle from d is near 90 deg on a
+     * reluctance machine) */
+    if ((drv->ctrl.impl->caps & CTRL_CAP_DELTA) != 0u &&
+        fabsf(out->tm.delta) > c->delta_max + c->lc_delta) {
       cond |= DRIVE_LC_DELTA;
     }
     if (fabsf(out->tm.flux - out->tm.flux_ref) > c->lc_track * out->tm.flux_ref) {

@@ -14,7 +14,9 @@
 #define DRIVE_LAW_LIST(X)                                                                  \
   X(FOC, foc, "rotor-frame PI current control; torque mode on the MTPA trajectory")       \
   X(PI_DFVC, pi_dfvc, "PI direct flux vector control of SPM machines (Rubino 2020, IV.7)") \
-  X(DB_DFVC, db_dfvc, "deadbeat direct flux vector control of SPM machines (Rubino 2020)")
+  X(DB_DFVC, db_dfvc, "deadbeat direct flux vector control of SPM machines (Rubino 2020)") \
+  X(DFVC_DECOUPLED, dfvc_decoupled,                                                         \
+    "decoupled DFVC of saturated machines, online MTPA/MTPV (Varatharajan 2022)")
 
 /* Control modes: X(ENUM, name, doc). */
 #define DRIVE_MODE_LIST(X)                                                    \

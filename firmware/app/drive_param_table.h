@@ -97,6 +97,24 @@
     "PI-DFVC flux-loop bandwidth")                                                                          \
   X(36, dfvc_iqs_bw,    F32,  "rad/s",  6283.1853f,  1.0f,    1e5f,     IDLE, "controller.dfvc_iqs_bw",    \
     "PI-DFVC i_qs-loop bandwidth")                                                                          \
+  X(52, dfvc_sat_bw,    F32,  "rad/s",  628.31853f,  1.0f,    1e5f,     IDLE, "controller.dfvc_sat_bw",    \
+    "decoupled DFVC: bandwidth Omega of both loops, k_p = 2 Omega, k_i = Omega^2 (Varatharajan 2022 (28))") \
+  X(53, dfvc_sat_gains, U16,  "",       0.0f,        0.0f,    2.0f,     IDLE, "controller.dfvc_sat_gains", \
+    "decoupled DFVC gain set: 0 proposed (a, b) (22), 1 state of the art (a', b') (17), 2 constant-gain PI (26)") \
+  X(54, dfvc_sat_refs,  U16,  "",       1.0f,        0.0f,    1.0f,     IDLE, "controller.dfvc_sat_refs",  \
+    "decoupled DFVC references: 0 the flux map's MTPA/MTPV tables (29)-(31), 1 online (32), (34)")       \
+  X(55, sat_obs_g,      F32,  "rad/s",  31.415927f,  0.0f,    1e5f,     IDLE, "controller.sat_obs_g",      \
+    "decoupled DFVC: hybrid flux observer gain g (Varatharajan 2022 (24))")                                \
+  X(56, k_a,            F32,  "1/(A s)", 60.0f,      0.0f,    1e4f,     IDLE, "controller.k_a",            \
+    "decoupled DFVC: online MTPA adaptation gain (32)")                                                    \
+  X(57, k_t,            F32,  "",       0.9f,        0.1f,    1.0f,     IDLE, "controller.k_t",            \
+    "decoupled DFVC: torque margin from the MTPV limit (31), (34)")                                        \
+  X(58, k_v,            F32,  "",       0.9f,        0.1f,    1.0f,     IDLE, "controller.k_v",            \
+    "decoupled DFVC: voltage margin of the maximum flux (30)")                                             \
+  X(59, cm_scale_d,     F32,  "",       1.0f,        0.1f,    10.0f,    LIVE, "controller.cm_scale_d",     \
+    "decoupled DFVC: factor on the controller's map lambda_d (current-model error; 1 = the map)")         \
+  X(60, cm_scale_q,     F32,  "",       1.0f,        0.1f,    10.0f,    LIVE, "controller.cm_scale_q",     \
+    "decoupled DFVC: factor on the controller's map lambda_q (current-model error; 1 = the map)")         \
   X(37, enc_offset,     F32,  "rad",    0.0f,        -7.0f,   7.0f,     IDLE, "controller.enc_offset",     \
     "electrical angle at encoder zero (found by the alignment when align_time > 0)")                        \
   X(38, pos_source,     POS,  "",       0.0f,        0.0f,    0.0f,     IDLE, "controller.pos_source",     \

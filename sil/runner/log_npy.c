@@ -8,11 +8,13 @@
 
 /* Signal names, in column order. Units in docs/log-format.md. */
 static const char *const signals[] = {
-    "t",           "speed", "speed_est", "speed_ref", "torque",      "torque_ref", "torque_est",
-    "load_torque", "i_a",   "i_b",       "i_c",       "i_a_meas",    "i_b_meas",   "i_c_meas",
-    "i_d",         "i_q",   "i_ds",      "i_qs",      "i_qs_ref",    "flux",       "flux_ref",
-    "flux_est",    "delta", "delta_est", "v_dc",      "duty_a",      "duty_b",     "duty_c",
-    "gates",       "state", "faults",    "theta_e",   "theta_e_est", "lc_cause"};
+    "t",           "speed",       "speed_est",   "speed_ref",  "torque",     "torque_ref",
+    "torque_est",  "load_torque", "i_a",         "i_b",        "i_c",        "i_a_meas",
+    "i_b_meas",    "i_c_meas",    "i_d",         "i_q",        "i_ds",       "i_qs",
+    "i_qs_ref",    "flux",        "flux_ref",    "flux_est",   "delta",      "delta_est",
+    "v_dc",        "duty_a",      "duty_b",      "duty_c",     "gates",      "state",
+    "faults",      "theta_e",     "theta_e_est", "lc_cause",   "torque_max", "flux_mtpa",
+    "torque_mtpv", "gain_a",      "gain_b",      "mtpa_angle", "mtpv_angle"};
 enum { NSIG = sizeof signals / sizeof signals[0], HEADER_LEN = 2048 };
 
 static void fill_row(const sil_step_t *st, double *r) {
@@ -57,7 +59,14 @@ static void fill_row(const sil_step_t *st, double *r) {
                     (double)tm->faults,
                     p->theta_e,
                     tm->theta_e,
-                    (double)tm->lc_cause};
+                    (double)tm->lc_cause,
+                    st->drive->torque_max_avail,
+                    tm->law_tm.flux_mtpa,
+                    tm->law_tm.torque_mtpv,
+                    tm->law_tm.gain_a,
+                    tm->law_tm.gain_b,
+                    tm->law_tm.mtpa_angle,
+                    tm->law_tm.mtpv_angle};
   memcpy(r, v, sizeof v);
 }
 

@@ -538,12 +538,14 @@ static int parse_references(ctx_t *c, const cJSON *o, scenario_t *sc) {
 
 static int parse_inject(ctx_t *c, const cJSON *o, scenario_t *sc) {
   static const char *const keys[] = {"encoder_error", "encoder_invalid", "main_stall", "isr_stall",
-                                     NULL};
+                                     "cm_scale_d",    "cm_scale_q",      NULL};
   const char *P = "inject";
   if (check_keys(c, o, P, keys) || get_profile(c, o, P, "encoder_error", &sc->encoder_error) ||
       get_profile(c, o, P, "encoder_invalid", &sc->encoder_invalid) ||
       get_profile(c, o, P, "main_stall", &sc->main_stall) ||
-      get_profile(c, o, P, "isr_stall", &sc->isr_stall)) {
+      get_profile(c, o, P, "isr_stall", &sc->isr_stall) ||
+      get_profile(c, o, P, "cm_scale_d", &sc->cm_scale_d) ||
+      get_profile(c, o, P, "cm_scale_q", &sc->cm_scale_q)) {
     return -1;
   }
   return 0;

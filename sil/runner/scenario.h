@@ -34,8 +34,11 @@ typedef struct {
   profile_t encoder_invalid; /* the encoder reports an error */
   profile_t main_stall;      /* the main loop does not run (hung) */
   profile_t isr_stall;       /* the PWM-period interrupt does not run */
-  int log_decimation;        /* log every n-th sample */
-  char map_file[512];        /* the flux map's file as resolved ("" for a linear machine) */
+  /* the controller's flux-map error (LIVE parameters cm_scale_d, cm_scale_q,
+   * written by the main loop as over CAN when the profile changes) */
+  profile_t cm_scale_d, cm_scale_q;
+  int log_decimation; /* log every n-th sample */
+  char map_file[512]; /* the flux map's file as resolved ("" for a linear machine) */
 } scenario_t;
 
 /* Loads a scenario from JSON text; `origin` prefixes error messages (the

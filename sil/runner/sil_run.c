@@ -45,6 +45,19 @@ void sil_command_references(drive_t *drv, const scenario_t *sc, double t) {
   drive_cmd_speed(drv, (float)profile_eval(&sc->ref.speed, t));
   drive_cmd_current(drv, (float)profile_eval(&sc->ref.id, t), (float)profile_eval(&sc->ref.iq, t));
   drive_cmd_flux(drv, (float)profile_eval(&sc->ref.flux, t));
+  /* the controller's map error: a parameter write when the profile changes */
+  if (sc->cm_scale_d.n > 0 || sc->cm_scale_q.n > 0) {
+    drive_config_t cfg = *drive_requested_config(drv);
+    const float sd =
+        sc->cm_scale_d.n > 0 ? (float)profile_eval(&sc->cm_scale_d, t) : cfg.cm_scale_d;
+    const float sq =
+        sc->cm_scale_q.n > 0 ? (float)profile_eval(&sc->cm_scale_q, t) : cfg.cm_scale_q;
+    if (sd < cfg.cm_scale_d || sd > cfg.cm_scale_d || sq < cfg.cm_scale_q || sq > cfg.cm_scale_q) {
+      cfg.cm_scale_d = sd;
+      cfg.cm_scale_q = sq;
+      (void)drive_request_config(drv, &cfg, NULL); /* out of range: refused, the last holds */
+    }
+  }
 }
 
 static void sleep_s(double s) {

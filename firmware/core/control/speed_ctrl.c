@@ -52,6 +52,10 @@ float speed_ctrl_update(speed_ctrl_t *sc, float w_ref, float w, float t_min, flo
   pi_ctrl_set_limits(&sc->pi, lo, hi);
   /* Acceleration feed-forward J dw_ref/dt: the PI integral need not carry the
    * ramp's torque, so it does not overshoot when the ramp ends. */
-  const float t_acc = sc->cfg.j_ff * (sc->w_ref_ramped - w_prev) / sc->cfg.ts;
+  /* Clamped to the limits in force: an infeasible ramp (a speed step) would
+   * otherwise ask for J dw/dt far beyond them and the anti-windup park the
+   * integral at limit - FF (-4000 N m for a 2625 rpm step), reversing the
+   * torque when the ramp ends. */
+  const float t_acc = fd_clampf(sc->cfg.j_ff * (sc->w_ref_ramped - w_prev) / sc->cfg.ts, lo, hi);
   return pi_ctrl_update(&sc->pi, sc->w_ref_ramped - w, t_acc);
 }

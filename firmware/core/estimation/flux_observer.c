@@ -52,14 +52,19 @@ void flux_observer_update(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, float
 
 void flux_observer_update_sc(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, float theta_r,
                              sincos_t scr, float omega_r, flux_observer_out_t *out) {
-  const flux_observer_cfg_t *c = &o->cfg;
-  const machine_t *m = c->machine;
-
+  const machine_t *m = o->cfg.machine;
   /* current model, Rubino 2020, eq. (2) in (alpha, beta) */
   const float ls = machine_ls(m);
   ab_t lcm;
   lcm.alpha = ls * i.alpha + m->lambda_m * scr.c;
   lcm.beta = ls * i.beta + m->lambda_m * scr.s;
+  flux_observer_update_cm(o, i, i_next, v, lcm, theta_r, omega_r, out);
+}
+
+void flux_observer_update_cm(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, ab_t lcm,
+                             float theta_r, float omega_r, flux_observer_out_t *out) {
+  const flux_observer_cfg_t *c = &o->cfg;
+  const machine_t *m = c->machine;
   if (!o->started) {
     o->lambda_hat = lcm;
   }

@@ -77,5 +77,13 @@ void flux_observer_update(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, float
 /* The same with sc_r = (sin, cos) of theta_r given by the caller. */
 void flux_observer_update_sc(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, float theta_r,
                              sincos_t sc_r, float omega_r, flux_observer_out_t *out);
+/* The same with the current model lambda_cm = Lambda(i) in (alpha, beta)
+ * given by the caller: eq. (24) of Varatharajan 2022, s lambda_hat = v -
+ * Rs i + e^{J theta} G (lambda^i_dq - lambda_hat_dq) with G = g I, is this
+ * observer with omega_c = g and the flux map (or any machine model) as the
+ * current model (the rotation e^{J theta} of a diagonal G commutes with the
+ * difference). The SPM model of update_sc is one such current model. */
+void flux_observer_update_cm(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, ab_t lambda_cm,
+                             float theta_r, float omega_r, flux_observer_out_t *out);
 
 #endif

@@ -220,6 +220,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--doc", metavar="MD", help="markdown file whose results table is replaced")
     p.set_defaults(func=_cmd_rubino)
 
+    p = sub.add_parser("varatharajan2022",
+                       help="reproduce Varatharajan 2022 (decoupled DFVC) in SIL: figures + tables")
+    p.add_argument("--sil", metavar="PATH", help=sil_help)
+    p.add_argument("--out", metavar="DIR", help="logs (default: out/varatharajan2022)")
+    p.add_argument("--figures", metavar="DIR", help="figures (default: docs/figures)")
+    p.add_argument("--doc", metavar="MD", help="markdown file whose results tables are replaced")
+    p.set_defaults(func=_cmd_varatharajan)
+
     p = sub.add_parser("pil", help="PIL: replay a scenario's ISRs on QEMU, compare, count")
     p.add_argument("scenario", nargs="+", metavar="SCENARIO", help="scenario JSON file(s)")
     p.add_argument("--law", metavar="LAWS", help="foc,pi_dfvc,db_dfvc (default: the scenario's)")
@@ -280,6 +288,12 @@ def _cmd_rubino(args: argparse.Namespace) -> int:
     from fluxdrive.rubino2020 import main_rubino
 
     return main_rubino(args)
+
+
+def _cmd_varatharajan(args: argparse.Namespace) -> int:
+    from fluxdrive.varatharajan2022 import main_varatharajan
+
+    return main_varatharajan(args)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,0 +1,252 @@
+/*
+ * dfvc_sat.c - decoupled DFVC of saturated machines with LUT or online
+ * MTPA / MTPV references, Varatharajan 2022, Figs. 1, 7, 8.
+ */
+#include "control/dfvc_sat.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "math/fast_trig.h"
+#include "math/fd_math.h"
+
+#define DFVC_SAT_2PI       6.28318530717959f
+#define DFVC_SAT_I_APP_MIN 0.05f /* below: apparent inductance from the unsaturated one [A] */
+
+void dfvc_sat_cfg_defaults(dfvc_sat_cfg_t *cfg, const machine_t *machine) {
+  memset(cfg, 0, sizeof(*cfg));
+  cfg->machine = machine;
+  cfg->ts = 2e-4f;                    /* Varatharajan 2022, section VI: 5 kHz */
+  cfg->g = DFVC_SAT_2PI * 5.0f;       /* section VI */
+  cfg->omega = DFVC_SAT_2PI * 100.0f; /* section VI.A: 2 pi 100 and 2 pi 200 */
+  cfg->k_a = 60.0f;                   /* section VI */
+  cfg->k_v = 0.9f;                    /* section V.A: ~10 % margins */
+  cfg->k_t = 0.9f;
+  /* open in the paper */
+  cfg->v_f_max = 1e4f;
+  cfg->rot_advance = 0.5f;
+  cfg->b_floor_frac = 0.1f;
+  cfg->gains = DFVC_SAT_GAINS_PROPOSED;
+  cfg->refs_mode = DFVC_SAT_REFS_ONLINE;
+  cfg->i_max = 1.0f;
+  cfg->lambda_min = 0.1f;
+}
+
+/* The model quantities with the controller's map scaled (dfvc_sat.h) at the
+ * current-model flux li and inductances l. */
+static void dfvc_sat_model_at(const machine_t *m, dq_t s, dq_t lambda, dq_t i, dq_t li,
+                              machine_ldq_t l, dfvc_sat_model_t *q) {
+  q->lambda_i = li;
+  q->l = l;
+  const float l2 = lambda.d * lambda.d + lambda.q * lambda.q;
+  const dq_t la = sfo_aux_flux(lambda, i, l);    /* (6) */
+  const dq_t ia = sfo_aux_current(lambda, i, l); /* (9) */
+  q->mtpa_cross = sfo_mtpa_cross(la, i);         /* (7) */
+  q->mtpv_cross = sfo_mtpv_cross(lambda, ia);    /* (10) */
+  q->mtpa_angle = sfo_line_angle(i, la);
+  q->mtpv_angle = sfo_line_angle(lambda, ia);
+  q->prop.a = sfo_gain_a(lambda, l); /* (22) */
+  q->prop.b = (l2 > 1e-12f) ? q->mtpv_cross / l2 : 0.0f;
+  float lad;
+  float laq;
+  sfo_apparent(li, i, machine_pm_flux(m) * s.d, DFVC_SAT_I_APP_MIN, m->ld * s.d, m->lq * s.q, &lad,
+               &laq);
+  const float lam = sqrtf(l2);
+  const sincos_t scd =
+      (lam > 1e-6f) ? (sincos_t){lambda.q / lam, lambda.d / lam} : (sincos_t){0.0f, 1.0f};
+  q->sota = sfo_gains_sota(lam, scd, lad, laq, machine_pm_flux(m) * s.d); /* (17) */
+}
+
+/* The controller's map at i: flux and L_d (25), rows scaled by s */
+static void dfvc_sat_map(const machine_t *m, dq_t s, dq_t i, dq_t *li, machine_ldq_t *l) {
+  const dq_t f = machine_flux(m, i);
+  const machine_ldq_t k = machine_inductance(m, i);
+  *li = (dq_t){s.d * f.d, s.q * f.q};
+  *l = (machine_ldq_t){s.d * k.dd, s.d * k.dq, s.q * k.qd, s.q * k.qq};
+}
+
+void dfvc_sat_model(const machine_t *m, dq_t cm_scale, dq_t lambda, dq_t i, dfvc_sat_model_t *q) {
+  dq_t li;
+  machine_ldq_t l;
+  dfvc_sat_map(m, cm_scale, i, &li, &l);
+  dfvc_sat_model_at(m, cm_scale, lambda, i, li, l, q);
+}
+
+int dfvc_sat_init(dfvc_sat_t *c, const dfvc_sat_cfg_t *cfg) {
+  memset(c, 0, sizeof(*c));
+  c->cfg = *cfg;
+  const dfvc_sat_cfg_t *k = cfg;
+  if (!(k->machine != NULL && fd_isfinite(k->rot_advance) && k->rot_advance >= 0.0f &&
+        k->rot_advance <= 1.0f && fd_isfinite(k->b_floor_frac) && k->b_floor_frac > 0.0f &&
+        k->b_floor_frac < 1.0f && (unsigned)k->gains < (unsigned)DFVC_SAT_GAINS_COUNT)) {
+    return -1;
+  }
+  const flux_observer_cfg_t oc = {k->machine, k->ts, k->g, 1000.0f};
+  /* the magnetising axis (the larger unsaturated inductance, or the PM's) */
+  const machine_t *m = k->machine;
+  const dq_t mag =
+      (m->lq > m->ld && !(m->lambda_m > 0.0f)) ? (dq_t){0.0f, 1.0f} : (dq_t){1.0f, 0.0f};
+  const dq_t f0 = machine_flux(m, (dq_t){0.0f, 0.0f});
+  /* the largest flux amplitude on the current-limit circle (bounded loop) */
+  float cap2 = 0.0f;
+  for (int n = 0; n < 32; ++n) {
+    const sincos_t sc = frames_sincos(0.19634954f * (float)n); /* 2 pi / 32 */
+    const dq_t f = machine_flux(m, (dq_t){k->i_max * sc.c, k->i_max * sc.s});
+    cap2 = fd_maxf(cap2, f.d * f.d + f.q * f.q);
+  }
+  const dfvc_sat_refs_cfg_t rc = {.machine = m,
+                                  .mode = k->refs_mode,
+                                  .ts = k->ts,
+                                  .i_max = k->i_max,
+                                  .lambda_min = k->lambda_min,
+                                  .k_v = k->k_v,
+                                  .k_t = k->k_t,
+                                  .k_a = k->k_a,
+                                  .lambda_0 = sqrtf(f0.d * f0.d + f0.q * f0.q),
+                                  .lambda_cap = sqrtf(cap2)};
+  const dfvc_sat_pi_cfg_t pc = {k->ts, k->omega, k->v_f_max};
+  if (flux_observer_init(&c->obs, &oc) != 0 || dfvc_sat_refs_init(&c->refs, &rc) != 0 ||
+      dfvc_sat_pi_init(&c->pi, &pc) != 0) {
+    return -1;
+  }
+  /* the design point of the constant-gain law and of the floor of b_hat:
+   * MTPA at half the current limit */
+  const dq_t i0 = machine_mtpa_current(m, machine_mtpa_torque(m, 0.5f * k->i_max));
+  dfvc_sat_model_t q;
+  dfvc_sat_model(m, (dq_t){1.0f, 1.0f}, machine_flux(m, i0), i0, &q);
+  c->b0 = q.prop.b;
+  if (!(fd_isfinite(c->b0) && c->b0 > 0.0f)) {
+    return -1;
+  }
+  c->b_floor = k->b_floor_frac * c->b0;
+  c->seed = 0.01f * k->lambda_min;
+  c->seed_dq = (dq_t){c->seed * mag.d, c->seed * mag.q};
+  return 0;
+}
+
+void dfvc_sat_reset(dfvc_sat_t *c) {
+  flux_observer_reset(&c->obs);
+  dfvc_sat_refs_reset(&c->refs);
+  dfvc_sat_pi_reset(&c->pi);
+}
+
+static inline float dfvc_sat_zf(ab_t x) {
+  return fd_zero_if_finite(x.alpha) + fd_zero_if_finite(x.beta);
+}
+
+void dfvc_sat_step(dfvc_sat_t *c, const dfvc_sat_in_t *in, dfvc_sat_out_t *out) {
+  const dfvc_sat_cfg_t *k = &c->cfg;
+  const machine_t *m = k->machine;
+  const float zin = dfvc_sat_zf(in->i_ab) + dfvc_sat_zf(in->v_ab_applied) +
+                    fd_zero_if_finite(in->theta_r) + fd_zero_if_finite(in->omega_r) +
+                    fd_zero_if_finite(in->v_lin) + fd_zero_if_finite(in->torque_ref) +
+                    fd_zero_if_finite(in->lambda_ref) + fd_zero_if_finite(in->cm_scale.d) +
+                    fd_zero_if_finite(in->cm_scale.q);
+  if (!fd_isfinite(zin) || !(in->cm_scale.d > 0.0f) || !(in->cm_scale.q > 0.0f)) {
+    memset(out, 0, sizeof(*out));
+    out->fault = DFVC_SAT_FAULT_INPUT;
+    return;
+  }
+  const sincos_t scr = frames_sincos(in->theta_r);
+  const dq_t i = frames_park(in->i_ab, scr);
+
+  /* the current model lambda^i = Lambda(i) and L_d (25) of the controller's map */
+  dq_t li;
+  machine_ldq_t l;
+  dfvc_sat_map(m, in->cm_scale, i, &li, &l);
+
+  /* hybrid observer, Varatharajan 2022, eq. (24) (the paper's resistive
+   * drop at tau: i_next = i) */
+  ab_t lcm = frames_park_inv(li, scr);
+  if (!c->obs.started && li.d * li.d + li.q * li.q < c->seed * c->seed) {
+    /* start-up of an unmagnetised machine (no PM flux): the observer starts
+     * from a small flux along the magnetising axis (the larger unsaturated
+     * inductance), so that the flux is built there and not on the other
+     * axis, where b < 0 (beyond MTPV: the reluctance torque is unstable) */
+    const ab_t sd = frames_park_inv(c->seed_dq, scr);
+    lcm.alpha += sd.alpha;
+    lcm.beta += sd.beta;
+  }
+  flux_observer_out_t o;
+  flux_observer_update_cm(&c->obs, in->i_ab, in->i_ab, in->v_ab_applied, lcm, in->theta_r,
+                          in->omega_r, &o);
+  const dq_t lam = frames_park(o.lambda, scr);
+
+  /* (6), (7), (9), (10), (17), (22) with the observed flux */
+  dfvc_sat_model_t q;
+  dfvc_sat_model_at(m, in->cm_scale, lam, i, li, l, &q);
+  sfo_gains_t g;
+  switch (k->gains) {
+  case DFVC_SAT_GAINS_SOTA:
+    g = q.sota;
+    break;
+  case DFVC_SAT_GAINS_CONSTANT:
+    g = (sfo_gains_t){0.0f, c->b0};
+    break;
+  default:
+    g = q.prop;
+    break;
+  }
+  if (!(g.b >= c->b_floor)) {
+    g.b = c->b_floor; /* the MTPV singularity b = 0 (also a NaN b) */
+  }
+
+  /* references, (29)-(34) */
+  const dfvc_sat_refs_in_t ri = {.torque_ref = in->torque_ref,
+                                 .lambda_override = in->lambda_ref,
+                                 .omega_r = in->omega_r,
+                                 .v_lin = in->v_lin,
+                                 .i_f = o.i_dqs.d,
+                                 .i_tau = o.i_dqs.q,
+                                 .i_amp = sqrtf(i.d * i.d + i.q * i.q),
+                                 .lambda_hat = o.lambda_s,
+                                 .torque_est = o.torque,
+                                 .mtpa_cross = q.mtpa_cross,
+                                 .mtpv_cross = q.mtpv_cross,
+                                 .mtpv_angle = q.mtpv_angle,
+                                 .adapt = 1};
+  dfvc_sat_refs_out_t r;
+  dfvc_sat_refs_update(&c->refs, &ri, &r);
+
+  /* regulators (26)-(28) */
+  const dfvc_sat_pi_in_t pin = {r.lambda_ref, r.itau_ref, o.lambda_s_next, o.i_dqs, in->omega_r,
+                                m->rs,        g,          in->v_lin};
+  dfvc_sat_pi_out_t po;
+  dfvc_sat_pi_step(&c->pi, &pin, &po);
+
+  /* (f, tau) -> (alpha, beta) at the predicted flux angle, advanced into
+   * the interval the voltage acts (dfvc.h, rot_advance) */
+  const sincos_t adv = frames_sincos(k->rot_advance * in->omega_r * k->ts);
+  const sincos_t scv = frames_sincos_add(o.sc_s_next, adv);
+  const ab_t v_ab = frames_park_inv(po.v_ft, scv);
+
+  const float z = dfvc_sat_zf(v_ab) + fd_zero_if_finite(r.lambda_ref) +
+                  fd_zero_if_finite(r.itau_ref) + dfvc_sat_zf(o.lambda_next);
+  if (!fd_isfinite(z)) {
+    dfvc_sat_reset(c);
+    memset(out, 0, sizeof(*out));
+    out->fault = DFVC_SAT_FAULT_STATE;
+    return;
+  }
+  out->v_ab_ref = v_ab;
+  out->i_ab_mid = frames_park_inv((dq_t){o.i_dqs.d, po.itau_pred}, scv);
+  out->i_dq = i;
+  out->lambda_s = o.lambda_s;
+  out->delta = o.delta;
+  out->i_ft = o.i_dqs;
+  out->torque = o.torque;
+  {
+    const float ea = o.lambda.alpha - o.lambda_cm.alpha;
+    const float eb = o.lambda.beta - o.lambda_cm.beta;
+    out->obs_err = sqrtf(ea * ea + eb * eb);
+  }
+  out->r = r;
+  out->g_used = g;
+  out->g_prop = q.prop;
+  out->g_sota = q.sota;
+  out->mtpa_angle = q.mtpa_angle;
+  out->mtpv_angle = q.mtpv_angle;
+  out->v_ft = po.v_ft;
+  out->sat = po.sat;
+  out->fault = 0u;
+}

@@ -1,0 +1,87 @@
+/*
+ * sfo_model.c - stator-flux-frame quantities of a saturated machine,
+ * Varatharajan 2022 eqs. (6), (7), (9), (10), (17), (22), (23).
+ */
+#include "model/sfo_model.h"
+
+#include <math.h>
+
+#include "math/fast_trig.h"
+
+dq_t sfo_aux_flux(dq_t lambda, dq_t i, machine_ldq_t l) {
+  /* Varatharajan 2022, eq. (6) */
+  const dq_t ji = sfo_j(i);
+  const dq_t jl = sfo_j(lambda);
+  return (dq_t){jl.d - (l.dd * ji.d + l.dq * ji.q), jl.q - (l.qd * ji.d + l.qq * ji.q)};
+}
+
+float sfo_mtpa_cross(dq_t lambda_a, dq_t i) {
+  return sfo_cross(lambda_a, i); /* eq. (7) */
+}
+
+dq_t sfo_aux_current(dq_t lambda, dq_t i, machine_ldq_t l) {
+  const float det = l.dd * l.qq - l.dq * l.qd;
+  if (!(det > 0.0f)) {
+    return (dq_t){0.0f, 0.0f};
+  }
+  /* Varatharajan 2022, eq. (9): J i - L^-1 J lambda */
+  const dq_t ji = sfo_j(i);
+  const dq_t jl = sfo_j(lambda);
+  const float inv = 1.0f / det;
+  return (dq_t){ji.d - inv * (l.qq * jl.d - l.dq * jl.q), ji.q - inv * (l.dd * jl.q - l.qd * jl.d)};
+}
+
+float sfo_mtpv_cross(dq_t lambda, dq_t i_a) {
+  return sfo_cross(lambda, i_a); /* eq. (10) */
+}
+
+float sfo_line_angle(dq_t x, dq_t y) {
+  const float c = x.d * y.q - x.q * y.d; /* |x||y| sin */
+  const float d = x.d * y.d + x.q * y.q; /* |x||y| cos */
+  return fd_atan2f(fabsf(c), fabsf(d));
+}
+
+float sfo_gain_a(dq_t lambda, machine_ldq_t l) {
+  const float l2 = lambda.d * lambda.d + lambda.q * lambda.q;
+  const float ldq = 0.5f * (l.dq + l.qd);
+  const float det = l.dd * l.qq - ldq * ldq;
+  if (!(l2 > 1e-12f) || !(det > 0.0f)) {
+    return 0.0f;
+  }
+  /* sin 2delta, cos 2delta from the flux components */
+  const float s2 = 2.0f * lambda.d * lambda.q / l2;
+  const float c2 = (lambda.d * lambda.d - lambda.q * lambda.q) / l2;
+  const float l_delta = 0.5f * (l.dd - l.qq);
+  /* Varatharajan 2022, eq. (22), a */
+  return (l_delta * s2 - ldq * c2) / det;
+}
+
+sfo_gains_t sfo_gains(dq_t lambda, dq_t i, machine_ldq_t l) {
+  const float l2 = lambda.d * lambda.d + lambda.q * lambda.q;
+  if (!(l2 > 1e-12f)) {
+    return (sfo_gains_t){0.0f, 0.0f};
+  }
+  /* Varatharajan 2022, eq. (22), b = lambda^T J i^a / lambda^2 */
+  return (sfo_gains_t){sfo_gain_a(lambda, l),
+                       sfo_mtpv_cross(lambda, sfo_aux_current(lambda, i, l)) / l2};
+}
+
+sfo_gains_t sfo_gains_sota(float lambda, sincos_t sc_delta, float l_app_d, float l_app_q,
+                           float lambda_m) {
+  const float k = (l_app_d - l_app_q) / (l_app_d * l_app_q);
+  const float s2 = 2.0f * sc_delta.s * sc_delta.c;
+  const float c2 = sc_delta.c * sc_delta.c - sc_delta.s * sc_delta.s;
+  sfo_gains_t g;
+  /* Varatharajan 2022, eq. (17), PM on +d (sfo_model.h): the PM term
+   * -sin(delta) lambda_m / (lambda L_q) becomes cos(delta) lambda_m / (lambda L_d) */
+  g.a = 0.5f * s2 * k;
+  g.b = c2 * k + ((lambda > 1e-9f) ? sc_delta.c * lambda_m / (lambda * l_app_d) : 0.0f);
+  return g;
+}
+
+void sfo_apparent(dq_t lambda_i, dq_t i, float lambda_m, float i_min, float l0_d, float l0_q,
+                  float *l_d, float *l_q) {
+  /* eq. (3): lambda = L(i) i + lambda_m */
+  *l_d = (fabsf(i.d) > i_min) ? (lambda_i.d - lambda_m) / i.d : l0_d;
+  *l_q = (fabsf(i.q) > i_min) ? lambda_i.q / i.q : l0_q;
+}

@@ -39,7 +39,7 @@ typedef struct {
   float torque_mtpv; /* MTPV torque limit, (31) or (34) [N m] */
   float gain_a;      /* a_hat of the transformation (23) [1/H] */
   float gain_b;      /* b_hat [1/H] */
-  float mtpa_angle;  /* phase of lambda^a from i (7), on the line [rad] */
+  float mtpa_angle;  /* sine of the phase of lambda^a from i (7), on the line */
   float mtpv_angle;  /* phase of i^a from lambda (10), on the line [rad] */
 } ctrl_telemetry_t;
 

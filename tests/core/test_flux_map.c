@@ -162,6 +162,36 @@ static void test_inductance(void **state) {
   assert_true(l5.qq < 0.5f * l0.qq);
 }
 
+/* flux_map_flux_inductance (one cell and its neighbours) is the flux
+ * lookup and the centred (25) of flux_map_inductance, on a dense sweep over
+ * the grid, its edges and beyond (extrapolation), including points on cell
+ * edges and at the half-step where the window changes cell. */
+static void test_flux_inductance_combined(void **state) {
+  (void)state;
+  const flux_map_t fm = parsed(&FX_PM);
+  float worst_l = 0.0f;
+  float worst_f = 0.0f;
+  const float q = (float)(0.25 * 2.0 * FX_I / (FX_N - 1)); /* a quarter of a grid step */
+  for (int a = -56; a <= 56; ++a) {                        /* +-7 A: the grid's +-6 A and beyond */
+    for (int b = -56; b <= 56; ++b) {                      /* edges and half-steps included */
+      const dq_t i = {q * (float)a, q * (float)b};
+      flux_map_ldq_t l;
+      const dq_t f = flux_map_flux_inductance(&fm, i, &l);
+      const dq_t f0 = flux_map_flux(&fm, i);
+      const flux_map_ldq_t l0 = flux_map_inductance(&fm, i);
+      const float sc = fabsf(l0.dd) + fabsf(l0.qq);
+      worst_f = fmaxf(worst_f, fmaxf(fabsf(f.d - f0.d), fabsf(f.q - f0.q)));
+      worst_l = fmaxf(worst_l, fmaxf(fmaxf(fabsf(l.dd - l0.dd), fabsf(l.qq - l0.qq)),
+                                     fmaxf(fabsf(l.dq - l0.dq), fabsf(l.qd - l0.qd))) /
+                                   sc);
+    }
+  }
+  print_message("combined lookup: flux %.2e Vs, inductance %.2e (relative) from the five lookups\n",
+                (double)worst_f, (double)worst_l);
+  assert_true(worst_f == 0.0f);
+  assert_true(worst_l < 3e-5f); /* float rounding of two summation orders */
+}
+
 /* The inverse: flux(current(lambda)) = lambda to float resolution over the
  * grid, including strongly saturated points. */
 static void test_inverse(void **state) {
@@ -242,6 +272,7 @@ int main(void) {
       cmocka_unit_test(test_refusals),
       cmocka_unit_test(test_flux),
       cmocka_unit_test(test_inductance),
+      cmocka_unit_test(test_flux_inductance_combined),
       cmocka_unit_test(test_inverse),
       cmocka_unit_test(test_torque_mtpa_mtpv),
       cmocka_unit_test(test_machine_dispatch),

@@ -82,8 +82,9 @@ typedef struct {
   sfo_gains_t g_used; /* the gains of T_hat (after the floor) */
   sfo_gains_t g_prop; /* (a, b) (22) */
   sfo_gains_t g_sota; /* (a', b') (17) */
-  float mtpa_angle;   /* phase of lambda^a from i, on the line [rad] (7) */
-  float mtpv_angle;   /* phase of i^a from lambda, on the line [rad] (10) */
+  float mtpa_angle;   /* sine of the phase of lambda^a from i (7) (telemetry) */
+  float mtpv_angle;   /* phase of i^a from lambda on the line [rad] (10); 0
+                       * unless the references are online (34) */
   dq_t v_ft;          /* [V] */
   uint32_t sat;       /* DFVC_SAT_PI_SAT_* */
   uint32_t fault;     /* DFVC_SAT_FAULT_* */

@@ -43,6 +43,7 @@ void flux_observer_reset(flux_observer_t *o) {
   o->theta_s_prev = 0.0f;
   o->omega_s = 0.0f;
   o->started = 0;
+  o->angles_started = 0;
 }
 
 void flux_observer_update(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, float theta_r,
@@ -58,11 +59,12 @@ void flux_observer_update_sc(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, fl
   ab_t lcm;
   lcm.alpha = ls * i.alpha + m->lambda_m * scr.c;
   lcm.beta = ls * i.beta + m->lambda_m * scr.s;
-  flux_observer_update_cm(o, i, i_next, v, lcm, theta_r, omega_r, out);
+  flux_observer_update_cm(o, i, i_next, v, lcm, out);
+  flux_observer_angles(o, theta_r, omega_r, out);
 }
 
 void flux_observer_update_cm(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, ab_t lcm,
-                             float theta_r, float omega_r, flux_observer_out_t *out) {
+                             flux_observer_out_t *out) {
   const flux_observer_cfg_t *c = &o->cfg;
   const machine_t *m = c->machine;
   if (!o->started) {
@@ -73,7 +75,6 @@ void flux_observer_update_cm(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, ab
   out->lambda = lh;
   out->lambda_cm = lcm;
   out->lambda_s = flux_observer_polar(lh, &out->sc_s);
-  out->theta_s = fd_atan2f(out->sc_s.s, out->sc_s.c);
 
   /* Fig. 3: back-EMF (resistive drop averaged over the period) plus the
    * current-model correction omega_c (lambda_cm - lambda_hat), then the one-step
@@ -87,24 +88,35 @@ void flux_observer_update_cm(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, ab
   ln.beta = lh.beta + c->ts * e.beta;
   out->lambda_next = ln;
   out->lambda_s_next = flux_observer_polar(ln, &out->sc_s_next);
-  out->theta_s_next = fd_atan2f(out->sc_s_next.s, out->sc_s_next.c);
 
+  /* stator-flux frame currents and torque, eq. (16) */
+  out->i_dqs = frames_park(i, out->sc_s);
+  out->torque = 1.5f * m->pole_pairs * out->lambda_s * out->i_dqs.q;
+  /* the angles: flux_observer_angles() */
+  out->theta_s = 0.0f;
+  out->theta_s_next = 0.0f;
+  out->omega_s = 0.0f;
+  out->delta = 0.0f;
+
+  o->lambda_hat = ln;
+  o->started = 1;
+}
+
+void flux_observer_angles(flux_observer_t *o, float theta_r, float omega_r,
+                          flux_observer_out_t *out) {
+  const flux_observer_cfg_t *c = &o->cfg;
+  out->theta_s = fd_atan2f(out->sc_s.s, out->sc_s.c);
+  out->theta_s_next = fd_atan2f(out->sc_s_next.s, out->sc_s_next.c);
   /* flux-frame speed: filtered derivative of theta_s */
-  if (!o->started) {
+  if (!o->angles_started) {
     o->omega_s = fd_isfinite(omega_r) ? omega_r : 0.0f;
   } else {
     const float raw = frames_wrap_pi(out->theta_s - o->theta_s_prev) / c->ts;
     o->omega_s += o->alpha_s * (raw - o->omega_s);
   }
+  o->angles_started = 1;
   o->theta_s_prev = out->theta_s;
   out->omega_s = o->omega_s;
-
   /* load angle, Rubino 2020, eq. (9)-c */
   out->delta = frames_wrap_pi(out->theta_s - theta_r);
-  /* stator-flux frame currents and torque, eq. (16) */
-  out->i_dqs = frames_park(i, out->sc_s);
-  out->torque = 1.5f * m->pole_pairs * out->lambda_s * out->i_dqs.q;
-
-  o->lambda_hat = ln;
-  o->started = 1;
 }

@@ -45,8 +45,9 @@ typedef struct {
   float alpha_s;   /* 1 - exp(-omega_s_bw Ts) */
   ab_t lambda_hat; /* estimate at the next update's sample [Vs] */
   float theta_s_prev;
-  float omega_s; /* filtered flux-frame speed [rad/s] */
-  int started;   /* 0 until the first update */
+  float omega_s;      /* filtered flux-frame speed [rad/s] */
+  int started;        /* 0 until the first update */
+  int angles_started; /* 0 until the first flux_observer_angles() */
 } flux_observer_t;
 
 typedef struct {
@@ -77,13 +78,19 @@ void flux_observer_update(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, float
 /* The same with sc_r = (sin, cos) of theta_r given by the caller. */
 void flux_observer_update_sc(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, float theta_r,
                              sincos_t sc_r, float omega_r, flux_observer_out_t *out);
-/* The same with the current model lambda_cm = Lambda(i) in (alpha, beta)
- * given by the caller: eq. (24) of Varatharajan 2022, s lambda_hat = v -
- * Rs i + e^{J theta} G (lambda^i_dq - lambda_hat_dq) with G = g I, is this
- * observer with omega_c = g and the flux map (or any machine model) as the
- * current model (the rotation e^{J theta} of a diagonal G commutes with the
- * difference). The SPM model of update_sc is one such current model. */
+/* The estimate with the current model lambda_cm = Lambda(i) in (alpha,
+ * beta) given by the caller: eq. (24) of Varatharajan 2022, s lambda_hat =
+ * v - Rs i + e^{J theta} G (lambda^i_dq - lambda_hat_dq) with G = g I, is
+ * this observer with omega_c = g and the flux map (or any machine model) as
+ * the current model (the rotation e^{J theta} of a diagonal G commutes with
+ * the difference). The SPM model of update_sc is one such current model.
+ * Fills every field but the angles (theta_s, theta_s_next, omega_s, delta:
+ * 0), which cost two atan2 a period: flux_observer_angles(). */
 void flux_observer_update_cm(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, ab_t lambda_cm,
-                             float theta_r, float omega_r, flux_observer_out_t *out);
+                             flux_observer_out_t *out);
+/* The angles of out (after update_cm): theta_s, theta_s_next, the filtered
+ * omega_s and the load angle delta = theta_s - theta_r. */
+void flux_observer_angles(flux_observer_t *o, float theta_r, float omega_r,
+                          flux_observer_out_t *out);
 
 #endif

@@ -73,6 +73,55 @@ flux_map_ldq_t flux_map_inductance(const flux_map_t *m, dq_t i) {
                           (dp.q - dm.q) * m->inv_did, (qp.q - qm.q) * m->inv_diq};
 }
 
+/* Slope along d of table t in the cell column starting at offset o, at the
+ * q fraction v (per step); along q at the d fraction u. */
+FM_INLINE float slope_d(const flux_map_t *m, const uint32_t *t, uint32_t o, float v) {
+  return (1.0f - v) * (word_f32(t, o + 1u) - word_f32(t, o)) +
+         v * (word_f32(t, o + m->nd + 1u) - word_f32(t, o + m->nd));
+}
+FM_INLINE float slope_q(const flux_map_t *m, const uint32_t *t, uint32_t o, float u) {
+  return (1.0f - u) * (word_f32(t, o + m->nd) - word_f32(t, o)) +
+         u * (word_f32(t, o + m->nd + 1u) - word_f32(t, o + 1u));
+}
+
+/* The centred (25) over one step of table t at cell c (flux_map.h), with
+ * the cell's corners f: the window [x - 1/2, x + 1/2] (steps) covers this
+ * cell and the one after (fraction >= 1/2) or before it; at the grid's
+ * edge the cell's plane continues (the neighbour is the cell itself). */
+FM_INLINE void centred(const flux_map_t *m, const uint32_t *t, const cell_t *c, const corners_t *f,
+                       uint32_t j, uint32_t k, float *l_d, float *l_q) {
+  const float sd = (1.0f - c->v) * (f->f10 - f->f00) + c->v * (f->f11 - f->f01);
+  const float sq = (1.0f - c->u) * (f->f01 - f->f00) + c->u * (f->f11 - f->f10);
+  float w = c->u - 0.5f;
+  uint32_t on = c->o;
+  if (w >= 0.0f) {
+    on = (j + 1u <= m->nd - 2u) ? c->o + 1u : c->o;
+  } else {
+    on = (j >= 1u) ? c->o - 1u : c->o;
+    w = -w;
+  }
+  *l_d = (sd + w * (slope_d(m, t, on, c->v) - sd)) * m->inv_did;
+  float z = c->v - 0.5f;
+  if (z >= 0.0f) {
+    on = (k + 1u <= m->nq - 2u) ? c->o + m->nd : c->o;
+  } else {
+    on = (k >= 1u) ? c->o - m->nd : c->o;
+    z = -z;
+  }
+  *l_q = (sq + z * (slope_q(m, t, on, c->u) - sq)) * m->inv_diq;
+}
+
+dq_t flux_map_flux_inductance(const flux_map_t *m, dq_t i, flux_map_ldq_t *l) {
+  const cell_t c = cell_of(m, i);
+  const uint32_t k = c.o / m->nd;
+  const uint32_t j = c.o - k * m->nd;
+  const corners_t d = corners(m, m->psi_d, c.o);
+  const corners_t q = corners(m, m->psi_q, c.o);
+  centred(m, m->psi_d, &c, &d, j, k, &l->dd, &l->dq);
+  centred(m, m->psi_q, &c, &q, j, k, &l->qd, &l->qq);
+  return (dq_t){bilinear(&d, c.u, c.v), bilinear(&q, c.u, c.v)};
+}
+
 /* Flux and the bilinear interpolant's own Jacobian at i (Newton). */
 static dq_t flux_jac(const flux_map_t *m, dq_t i, flux_map_ldq_t *l) {
   const cell_t c = cell_of(m, i);

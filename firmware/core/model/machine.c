@@ -58,6 +58,17 @@ machine_ldq_t machine_inductance(const machine_t *m, dq_t i) {
   return (machine_ldq_t){m->ld, 0.0f, 0.0f, m->lq}; /* linear: independent of i */
 }
 
+dq_t machine_flux_inductance(const machine_t *m, dq_t i, machine_ldq_t *l) {
+  if (m->kind == MACHINE_FLUX_MAP) {
+    flux_map_ldq_t k;
+    const dq_t f = flux_map_flux_inductance(m->map, i, &k);
+    *l = (machine_ldq_t){k.dd, k.dq, k.qd, k.qq};
+    return f;
+  }
+  *l = (machine_ldq_t){m->ld, 0.0f, 0.0f, m->lq};
+  return (dq_t){m->ld * i.d + m->lambda_m, m->lq * i.q};
+}
+
 float machine_torque(const machine_t *m, dq_t i) {
   const dq_t l = machine_flux(m, i);
   return 1.5f * m->pole_pairs * (l.d * i.q - l.q * i.d);

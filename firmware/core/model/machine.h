@@ -57,6 +57,9 @@ dq_t machine_flux(const machine_t *m, dq_t i);
 dq_t machine_current(const machine_t *m, dq_t lambda);
 /* d lambda / d i at i [H] */
 machine_ldq_t machine_inductance(const machine_t *m, dq_t i);
+/* machine_flux(m, i) and, in *l, machine_inductance(m, i) in one call
+ * (a map: flux_map_flux_inductance, one cell and its neighbours) */
+dq_t machine_flux_inductance(const machine_t *m, dq_t i, machine_ldq_t *l);
 /* T = 3/2 p (lambda_d i_q - lambda_q i_d) [N m] */
 float machine_torque(const machine_t *m, dq_t i);
 /* PM flux: lambda_d at zero current [Vs] (0 for SyR) */

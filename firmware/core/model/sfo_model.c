@@ -8,17 +8,6 @@
 
 #include "math/fast_trig.h"
 
-dq_t sfo_aux_flux(dq_t lambda, dq_t i, machine_ldq_t l) {
-  /* Varatharajan 2022, eq. (6) */
-  const dq_t ji = sfo_j(i);
-  const dq_t jl = sfo_j(lambda);
-  return (dq_t){jl.d - (l.dd * ji.d + l.dq * ji.q), jl.q - (l.qd * ji.d + l.qq * ji.q)};
-}
-
-float sfo_mtpa_cross(dq_t lambda_a, dq_t i) {
-  return sfo_cross(lambda_a, i); /* eq. (7) */
-}
-
 dq_t sfo_aux_current(dq_t lambda, dq_t i, machine_ldq_t l) {
   const float det = l.dd * l.qq - l.dq * l.qd;
   if (!(det > 0.0f)) {
@@ -29,10 +18,6 @@ dq_t sfo_aux_current(dq_t lambda, dq_t i, machine_ldq_t l) {
   const dq_t jl = sfo_j(lambda);
   const float inv = 1.0f / det;
   return (dq_t){ji.d - inv * (l.qq * jl.d - l.dq * jl.q), ji.q - inv * (l.dd * jl.q - l.qd * jl.d)};
-}
-
-float sfo_mtpv_cross(dq_t lambda, dq_t i_a) {
-  return sfo_cross(lambda, i_a); /* eq. (10) */
 }
 
 float sfo_line_angle(dq_t x, dq_t y) {

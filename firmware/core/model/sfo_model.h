@@ -54,16 +54,24 @@ static inline float sfo_cross(dq_t x, dq_t y) {
 }
 
 /* Auxiliary-flux vector (6): lambda^a = J lambda - L_d J i [Vs]. */
-dq_t sfo_aux_flux(dq_t lambda, dq_t i, machine_ldq_t l);
+static inline dq_t sfo_aux_flux(dq_t lambda, dq_t i, machine_ldq_t l) {
+  const dq_t ji = sfo_j(i);
+  const dq_t jl = sfo_j(lambda);
+  return (dq_t){jl.d - (l.dd * ji.d + l.dq * ji.q), jl.q - (l.qd * ji.d + l.qq * ji.q)};
+}
 /* MTPA condition (7): (lambda^a)^T J i, zero on the MTPA trajectory; the
  * torque derivative dT/dgamma of (5) is 3p/2 times it [Vs A]. */
-float sfo_mtpa_cross(dq_t lambda_a, dq_t i);
+static inline float sfo_mtpa_cross(dq_t lambda_a, dq_t i) {
+  return sfo_cross(lambda_a, i);
+}
 /* Auxiliary-current vector (9): i^a = J i - L_d^-1 J lambda [A]; a singular
  * L_d (det <= 0) gives (0, 0). */
 dq_t sfo_aux_current(dq_t lambda, dq_t i, machine_ldq_t l);
 /* MTPV condition (10): lambda^T J i^a, zero on the MTPV trajectory; dT/ddelta
  * of (8) is 3p/2 times it [Vs A]. */
-float sfo_mtpv_cross(dq_t lambda, dq_t i_a);
+static inline float sfo_mtpv_cross(dq_t lambda, dq_t i_a) {
+  return sfo_cross(lambda, i_a);
+}
 /* Angle between the lines of x and y, in [0, pi/2] [rad]: |angle(y) - angle(x)|
  * modulo pi (the phase error of (7) with x = i, y = lambda^a; of (33), (34)
  * with x = lambda, y = i^a). */

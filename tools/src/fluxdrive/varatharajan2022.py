@@ -229,12 +229,18 @@ class StepFit:
     r: float  # fitted loop-gain ratio b/b_hat at the design Omega
     delay: float  # fitted dead time [s]
     rms: float  # residual of the Omega fit, of the unit step
+    gain: float  # the step the response settles to / the reference's step
+    omega_ref: float  # bandwidth fitted with the final value held at the reference
 
 
 def fit_step(t, y, ref, t_step: float, omega_design: float, window: float = 8.0) -> StepFit:
-    """Fits the true response y to the reference step (both full rate):
-    normalised by the reference's step, the pre-step offset kept. Omega (with
-    r = 1) and r (with Omega = design) are fitted, each with a dead time."""
+    """Fits the true response y to the reference step (both full rate),
+    normalised by the reference's step with the pre-step offset removed:
+    the loop's model (Omega with r = 1; r with Omega = design; a dead time
+    each) plus the observer's slow mode 1 - e^{-g t}, their weights by least
+    squares; gain is where the two settle against the reference (the
+    static error, which the observer's and the map's accuracy set, not the
+    loop); omega_ref is the loop model alone held at the reference."""
     t = np.asarray(t, float)
     k0 = int(np.searchsorted(t, t_step))
     ks = k0 + int(np.argmax(np.abs(np.diff(ref[k0:k0 + 400])) > 0)) + 1  # the step in the log
@@ -245,24 +251,36 @@ def fit_step(t, y, ref, t_step: float, omega_design: float, window: float = 8.0)
     m = (t >= te) & (t <= te + window / omega_design)
     tt, z = t[m] - te, (y[m] - y0) / (r1 - r0)
 
-    def sse(w, r, d):
-        return float(np.mean((step_model(tt - d, w, r) - z) ** 2))
+    # the observer's own mode: after a change of operating point its
+    # estimate (the current model weighs g / omega) settles with 1/g, which
+    # the true i_tau shows as a slow tail on top of the loop's response
+    tail = np.where(tt > 0.0, -np.expm1(-PAPER.g * tt), 0.0)
+
+    def sse(w, r, d, free=True):
+        mdl = step_model(tt - d, w, r)
+        if not free:
+            return float(np.mean((mdl - z) ** 2)), 1.0
+        a = np.stack([mdl, tail], axis=1)
+        (k, c), *_ = np.linalg.lstsq(a, z, rcond=None)
+        return float(np.mean((a @ np.array([k, c]) - z) ** 2)), float(k + c * tail[-1])
 
     ts = float(t[1] - t[0])
-    best = None
-    for d in np.linspace(0.0, 3.0 * ts, 13):
-        w = _golden(lambda w_: sse(w_, 1.0, d), 0.3 * omega_design, 3.0 * omega_design)
-        e = sse(w, 1.0, d)
-        if best is None or e < best[0]:
-            best = (e, w, d)
-    e_w, w_fit, d_fit = best
-    best_r = None
-    for d in np.linspace(0.0, 3.0 * ts, 13):
-        r = _golden(lambda r_: sse(omega_design, r_, d), 0.2, 5.0)
-        e = sse(omega_design, r, d)
-        if best_r is None or e < best_r[0]:
-            best_r = (e, r)
-    return StepFit(w_fit, best_r[1], d_fit, float(np.sqrt(e_w)))
+
+    def best_of(param, lo, hi, free):
+        best = None
+        for d in np.linspace(0.0, 3.0 * ts, 13):
+            f = (lambda x: sse(x, 1.0, d, free)[0]) if param == "w" else \
+                (lambda x: sse(omega_design, x, d, free)[0])
+            x = _golden(f, lo, hi)
+            e, k = sse(x, 1.0, d, free) if param == "w" else sse(omega_design, x, d, free)
+            if best is None or e < best[0]:
+                best = (e, x, d, k)
+        return best
+
+    e_w, w_fit, d_fit, k_fit = best_of("w", 0.3 * omega_design, 3.0 * omega_design, True)
+    r_fit = best_of("r", 0.2, 5.0, True)[1]
+    w_ref = best_of("w", 0.3 * omega_design, 3.0 * omega_design, False)[1]
+    return StepFit(w_fit, r_fit, d_fit, float(np.sqrt(e_w)), k_fit, w_ref)
 
 
 # ------------------------------------------------------------- experiments
@@ -291,6 +309,7 @@ class BwPoint:
     flux: StepFit
     itau: StepFit
     b_ratio_pred: float  # b / b_hat at the point (b from the true map and state)
+    cross: StepFit  # i_tau through the flux step (decoupling)
 
 
 def bandwidth_point(sil, root, out, tab, fs, omega, gains, speed, load) -> BwPoint:
@@ -318,13 +337,16 @@ def bandwidth_point(sil, root, out, tab, fs, omega, gains, speed, load) -> BwPoi
         raise RuntimeError(f"{name}: faults {r.summary['faults_seen']}")
     f_fit = fit_step(lg["t"], lg["flux"], lg["flux_ref"], 0.3, omega)
     i_fit = fit_step(lg["t"], lg["i_qs"], lg["i_qs_ref"], 0.4, omega)
+    # decoupling: i_tau through the flux step (its reference moves by -2 %
+    # with 1/lambda*); a wrong a shows as a bump the i_tau model cannot fit
+    x_fit = fit_step(lg["t"], lg["i_qs"], lg["i_qs_ref"], 0.3, omega)
     # b / b_hat at the point, before the i_tau step
     m = (lg["t"] > 0.38) & (lg["t"] < 0.4)
     lam_d = lg["flux"][m] * np.cos(lg["delta"][m])
     lam_q = lg["flux"][m] * np.sin(lg["delta"][m])
     _, b_true, _, _ = sfo_gains(tab.fm, lg["i_d"][m], lg["i_q"][m], lam_d, lam_q)
     ratio = float(np.mean(b_true) / np.mean(lg["gain_b"][m]))
-    return BwPoint(fs, omega, gains, speed, load, t_op, f_fit, i_fit, ratio)
+    return BwPoint(fs, omega, gains, speed, load, t_op, f_fit, i_fit, ratio, x_fit)
 
 
 def bandwidth_map(sil, root, out, tab, fss=(5000.0, 16000.0)) -> list:
@@ -589,13 +611,6 @@ def run_all(sil, root, out, fss=(5000.0, 16000.0)) -> Results:
     return Results(tab, bw, robust, step, mtpv, sine, sine_var, others, a_comparison(tab))
 
 
-def bw_worst(res: Results, gains: int) -> tuple:
-    """Largest |Omega_fit / Omega - 1| of the flux and the i_tau loops."""
-    pts = [p for p in res.bw if p.gains == gains]
-    return (max(abs(p.flux.omega / p.omega - 1) for p in pts),
-            max(abs(p.itau.omega / p.omega - 1) for p in pts))
-
-
 def _hz(w):
     return w / TWO_PI
 
@@ -610,12 +625,16 @@ def _poles(r: float, omega: float) -> str:
 def report(res: Results) -> str:
     P = PAPER
     L = []
-    wf0, wi0 = bw_worst(res, 0)
     s = res.step
     L += ["| experiment | paper | fluxdrive |", "|---|---|---|"]
-    L.append(f"| bandwidth map, (a, b): worst deviation of the fitted bandwidth from Omega, "
-             f"{len([p for p in res.bw if p.gains == 0])} steps of each loop | uniform "
-             f"(Figs. 10b, 11b) | flux {100 * wf0:.1f} %, i_tau {100 * wi0:.1f} % (bound 10 %) |")
+    for fs in sorted({p.fs for p in res.bw}):
+        q = [p for p in res.bw if p.gains == 0 and p.fs == fs]
+        fl = [p.flux.omega / p.omega for p in q]
+        it = [p.itau.omega / p.omega for p in q]
+        L.append(f"| bandwidth map at {fs / 1000:g} kHz, (a, b): fitted bandwidth / Omega over "
+                 f"{len(q)} steps of each loop (3 speeds x 3 loads x 2 Omega) | uniform "
+                 f"(Figs. 10b, 11b) | flux {min(fl):.3f} .. {max(fl):.3f}, i_tau {min(it):.3f} .. "
+                 f"{max(it):.3f} (bound 0.9 .. 1.1) |")
     for fs in sorted({p.fs for p in res.bw}):
         for om in P.omegas:
             rs = [p.itau.r for p in res.bw if p.gains == 1 and p.fs == fs and p.omega == om
@@ -660,13 +679,18 @@ def report(res: Results) -> str:
                  f"{o.t_fw:.3f} s, MTPV "
                  f"{'binding from %.2f s' % o.t_mtpv if o.t_mtpv >= 0 else 'not reached'}, final "
                  f"{o.final_rpm:.0f} rpm, faults: {', '.join(o.run.summary['faults_seen']) or 'none'} |")
-    L += ["", "### Bandwidth map (fitted Omega / design; i_tau: fitted b/b_hat for (a', b'))", "",
-          "| f_s | Omega / 2 pi | gains | speed rpm | load | T N m | flux | i_tau | i_tau: r fit | "
-          "b/b_hat of the map |", "|---|---|---|---|---|---|---|---|---|---|"]
+    L += ["", "### Bandwidth map", "",
+          "Fitted bandwidth / Omega of each loop; where the i_tau response settles against the "
+          "reference (the step = 1); for (a', b') the fitted b/b_hat beside the map's; the "
+          "residual of i_tau through the flux step (decoupling).", "",
+          "| f_s | Omega / 2 pi | gains | speed rpm | load | T N m | flux | i_tau | i_tau settles | "
+          "i_tau: r fit | b/b_hat of the map | i_tau through the flux step (residual) |",
+          "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for p in res.bw:
         L.append(f"| {p.fs / 1000:g} kHz | {_hz(p.omega):.0f} Hz | {GAIN_LBL[p.gains]} "
                  f"| {p.speed_rpm:.0f} | {p.load} | {p.torque:.2f} | {p.flux.omega / p.omega:.3f} | "
-                 f"{p.itau.omega / p.omega:.3f} | {p.itau.r:.2f} | {p.b_ratio_pred:.2f} |")
+                 f"{p.itau.omega / p.omega:.3f} | {p.itau.gain:.3f} | {p.itau.r:.2f} | "
+                 f"{p.b_ratio_pred:.2f} | {p.cross.rms:.3f} |")
     L += ["", "### Robustness (Fig. 14): per 0.5 s segment", "",
           "| f_s | gains | lambda_d^i / lambda_d | torque mean N m | ripple rms N m | ripple p-p N m | "
           "b / b_hat | tau-loop poles |", "|---|---|---|---|---|---|---|---|"]

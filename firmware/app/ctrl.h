@@ -34,13 +34,6 @@ typedef struct {
   float i_qs_ref;
   float torque;  /* torque estimate [N m] */
   float obs_err; /* |observer flux - current-model flux| [Vs] (flux laws) */
-  /* decoupled DFVC (Varatharajan 2022) */
-  float flux_mtpa;   /* MTPA flux, table (29) or adapted (32) [Vs] */
-  float torque_mtpv; /* MTPV torque limit, (31) or (34) [N m] */
-  float gain_a;      /* a_hat of the transformation (23) [1/H] */
-  float gain_b;      /* b_hat [1/H] */
-  float mtpa_angle;  /* sine of the phase of lambda^a from i (7), on the line */
-  float mtpv_angle;  /* phase of i^a from lambda (10), on the line [rad] */
 } ctrl_telemetry_t;
 
 typedef struct {

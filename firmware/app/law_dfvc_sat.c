@@ -74,13 +74,7 @@ static void dfvc_sat_law_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctr
                                .i_qs = d.i_ft.q,
                                .i_qs_ref = d.r.itau_ref,
                                .torque = d.torque,
-                               .obs_err = d.obs_err,
-                               .flux_mtpa = d.r.lambda_mtpa,
-                               .torque_mtpv = d.r.torque_mtpv,
-                               .gain_a = d.g_used.a,
-                               .gain_b = d.g_used.b,
-                               .mtpa_angle = d.mtpa_angle,
-                               .mtpv_angle = d.mtpv_angle};
+                               .obs_err = d.obs_err};
 }
 
 const ctrl_law_t ctrl_law_dfvc_decoupled = {"dfvc_decoupled",   CTRL_CAP_FLUX,

@@ -20,6 +20,11 @@ enum { NSIG = sizeof signals / sizeof signals[0], HEADER_LEN = 2048 };
 static void fill_row(const sil_step_t *st, double *r) {
   const plant_state_t *p = st->plant;
   const drive_telemetry_t *tm = &st->drive->tm; /* lock-step: the ISR's own telemetry */
+  /* the decoupled DFVC's own telemetry, in its state (lock-step: the ISR
+   * has returned) */
+  const dfvc_sat_tm_t sat = st->drive->ctrl.law == DRIVE_LAW_DFVC_DECOUPLED
+                                ? st->drive->ctrl.st.dfvc_sat.tm
+                                : (dfvc_sat_tm_t){0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
   double ld = p->lambda_dq[0], lq = p->lambda_dq[1];
   double flux = hypot(ld, lq);
   /* True stator-flux frame currents: projection of i on lambda_s and its
@@ -61,12 +66,12 @@ static void fill_row(const sil_step_t *st, double *r) {
                     tm->theta_e,
                     (double)tm->lc_cause,
                     st->drive->torque_max_avail,
-                    tm->law_tm.flux_mtpa,
-                    tm->law_tm.torque_mtpv,
-                    tm->law_tm.gain_a,
-                    tm->law_tm.gain_b,
-                    tm->law_tm.mtpa_angle,
-                    tm->law_tm.mtpv_angle};
+                    sat.flux_mtpa,
+                    sat.torque_mtpv,
+                    sat.gain_a,
+                    sat.gain_b,
+                    sat.mtpa_angle,
+                    sat.mtpv_angle};
   memcpy(r, v, sizeof v);
 }
 

@@ -272,4 +272,5 @@ void dfvc_sat_step(dfvc_sat_t *c, const dfvc_sat_in_t *in, dfvc_sat_out_t *out) 
   out->v_ft = po.v_ft;
   out->sat = po.sat;
   out->fault = 0u;
+  c->tm = (dfvc_sat_tm_t){r.lambda_mtpa, r.torque_mtpv, g.a, g.b, q.mtpa_angle, q.mtpv_angle};
 }

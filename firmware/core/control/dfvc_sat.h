@@ -90,6 +90,17 @@ typedef struct {
   uint32_t fault;     /* DFVC_SAT_FAULT_* */
 } dfvc_sat_out_t;
 
+/* What the last step found beyond dfvc_sat_out_t's telemetry, kept in the
+ * state for the SIL's log (read in lock-step after the ISR). */
+typedef struct {
+  float flux_mtpa;   /* (29) or (32) [Vs] */
+  float torque_mtpv; /* (31) or (34) [N m] */
+  float gain_a;      /* a_hat in use [1/H] */
+  float gain_b;      /* b_hat in use [1/H] */
+  float mtpa_angle;  /* sine of the MTPA phase error */
+  float mtpv_angle;  /* MTPV angle of (34) [rad] (online references) */
+} dfvc_sat_tm_t;
+
 typedef struct {
   dfvc_sat_cfg_t cfg;
   flux_observer_t obs;
@@ -99,6 +110,7 @@ typedef struct {
   float b_floor; /* [1/H] */
   float seed;    /* start-up flux of an unmagnetised machine, 1 % of lambda_min [Vs] */
   dq_t seed_dq;  /* along the magnetising axis [Vs] */
+  dfvc_sat_tm_t tm;
 } dfvc_sat_t;
 
 void dfvc_sat_cfg_defaults(dfvc_sat_cfg_t *cfg, const machine_t *machine);

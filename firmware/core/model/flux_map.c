@@ -93,7 +93,7 @@ FM_INLINE void centred(const flux_map_t *m, const uint32_t *t, const cell_t *c, 
   const float sd = (1.0f - c->v) * (f->f10 - f->f00) + c->v * (f->f11 - f->f01);
   const float sq = (1.0f - c->u) * (f->f01 - f->f00) + c->u * (f->f11 - f->f10);
   float w = c->u - 0.5f;
-  uint32_t on = c->o;
+  uint32_t on;
   if (w >= 0.0f) {
     on = (j + 1u <= m->nd - 2u) ? c->o + 1u : c->o;
   } else {

@@ -242,6 +242,8 @@ def build_parser() -> argparse.ArgumentParser:
                    "(e.g. docs/benchmarks.md)")
     p.add_argument("--check-worst", type=_positive_int, metavar="N",
                    help="fail when the DB-DFVC worst case reaches N instructions")
+    p.add_argument("--check-mean", type=_positive_int, metavar="N",
+                   help="fail when a run's mean reaches N instructions per law ISR")
     p.add_argument("--check-cycles", type=_percent, metavar="PCT",
                    help="fail when the DB-DFVC worst case's estimated cycles exceed PCT %% of "
                    "the 10625-cycle budget (170 MHz / 16 kHz)")

@@ -95,6 +95,12 @@ BLOCKS = [
     ("DFVC references (MTPA/FW/MTPV)", ("dfvc_refs_",)),
     ("DB-DFVC law", ("dfvc_deadbeat_",)),
     ("PI-DFVC law", ("dfvc_pi_",)),
+    ("decoupled DFVC step (dfvc_sat)", ("dfvc_sat_step", "dfvc_sat_reset", "dfvc_sat_law_",
+                                        "dfvc_sat_map", "dfvc_sat_model_at")),
+    ("decoupled DFVC references (dfvc_sat_refs)", ("dfvc_sat_refs_",)),
+    ("decoupled DFVC regulators (dfvc_sat_pi)", ("dfvc_sat_pi_",)),
+    ("stator-flux-frame model (sfo_model)", ("sfo_",)),
+    ("flux map lookups (flux_map)", ("flux_map_", "flux_jac")),
     ("PI controllers (pi_ctrl)", ("pi_ctrl_",)),
     ("FOC current control", ("current_ctrl_", "pmsm_")),
     ("modulation", ("modulation_",)),
@@ -760,13 +766,16 @@ def main(args) -> int:
     if args.markdown:
         update_markdown(Path(args.markdown), md)
         print(f"markdown: {args.markdown} (section '{SECTION[3:]}')")
-    return check_runs(runs, args.check_worst, getattr(args, "check_cycles", None))
+    return check_runs(runs, args.check_worst, getattr(args, "check_cycles", None),
+                      getattr(args, "check_mean", None))
 
 
-def check_runs(runs: list[PilRun], worst_instr: int | None, worst_pct: float | None) -> int:
+def check_runs(runs: list[PilRun], worst_instr: int | None, worst_pct: float | None,
+               mean_instr: int | None = None) -> int:
     """Agreement and exact trace for every run; with limits, the DB-DFVC
     worst case: fewer than ``worst_instr`` instructions and at most
-    ``worst_pct`` % of the cycle budget (estimated). Prints; 1 on failure."""
+    ``worst_pct`` % of the cycle budget (estimated); every run's mean below
+    ``mean_instr``. Prints; 1 on failure."""
     rc = 0
     for r in runs:
         name = f"{r.scenario}/{r.law}"
@@ -776,6 +785,11 @@ def check_runs(runs: list[PilRun], worst_instr: int | None, worst_pct: float | N
         if not r.trace_exact:
             print(f"FAIL: {name}: traced replay differs from the untraced one")
             rc = 1
+        if mean_instr:
+            ok = r.counts.mean < mean_instr
+            print(f"{'check' if ok else 'FAIL'}: {name}: mean {r.counts.mean:.0f} instructions, "
+                  f"limit {mean_instr}")
+            rc |= 0 if ok else 1
         if r.law != "db_dfvc":
             continue
         c = r.counts

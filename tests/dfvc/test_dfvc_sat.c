@@ -232,10 +232,17 @@ static void test_refs_lut(void **st) {
   dfvc_sat_refs_update(&r, &in, &o);
   assert_float_equal(o.lambda_ref, flux_map_mtpa_flux(&map, 3.0f), 1e-6f);
   assert_float_equal(o.itau_ref, 3.0f / (1.5f * map.pole_pairs * o.lambda_ref), 1e-5f);
-  /* flux weakening: (30) with the resistive drop */
+  /* flux weakening: (30) with the resistive drop, its current low-passed
+   * (10 ms): one period after a step of |i| it has moved by 2 %, after
+   * 0.2 s (twenty time constants) it is there */
   in.omega_r = 1000.0f;
   in.i_amp = 2.0f;
   dfvc_sat_refs_update(&r, &in, &o);
+  assert_float_equal(o.lambda_ref, (0.9f * 200.0f - 1.0f * 2.0f * 2e-4f / 0.0102f) / 1000.0f,
+                     1e-6f);
+  for (int k = 0; k < 1000; ++k) {
+    dfvc_sat_refs_update(&r, &in, &o);
+  }
   assert_float_equal(o.lambda_ref, (0.9f * 200.0f - 1.0f * 2.0f) / 1000.0f, 1e-6f);
   assert_true(o.limits & DFVC_SAT_REFS_FLUX_VLIM);
   assert_float_equal(o.torque_mtpv, 0.9f * flux_map_mtpv_torque(&map, o.lambda_ref), 1e-5f);

@@ -35,9 +35,9 @@ def _bw_check(res, fs):
         # the fits describe the responses (unit-step residual)
         assert p.flux.rms < 0.05 and p.itau.rms < 0.05, tag
         # decoupled: through the flux step i_tau follows its own reference
-        # (-2 % with 1/lambda*) as the i_tau loop would; without the a term
-        # of (23) the residual of that fit was 0.16 .. 0.20 at rated and
-        # limit loads (a u_f is small against the 2 % step at light load)
+        # (-5 % with 1/lambda*) as the i_tau loop would; without the a term
+        # of (23) the residual of that fit is several times larger at rated
+        # and limit loads (mutant dfvc_sat_no_decoupling_a, docs/mutation.md)
         if p.load != "light":
             assert p.cross.rms < 0.08, tag
         # static: where the response settles against the reference
@@ -52,24 +52,9 @@ def test_bandwidth_uniform_with_proposed_gains_16khz(res):
     _bw_check(res, 16000.0)
 
 
-@pytest.mark.xfail(strict=True, reason="known: at 5 kHz the i_tau loop is up to 12 % slower than "
-                   "Omega at rated and limit loads (docs/results-varatharajan2022.md)")
 def test_bandwidth_uniform_with_proposed_gains_5khz(res):
     """Acceptance 1 at the paper's 5 kHz, the same bounds."""
     _bw_check(res, 5000.0)
-
-
-def test_bandwidth_5khz_flux_loop_and_light_load(res):
-    """What holds at 5 kHz: the flux loop everywhere, both loops at light
-    load, and the i_tau loop within 15 % everywhere."""
-    for p in res.bw:
-        if p.gains != 0 or p.fs != 5000.0:
-            continue
-        tag = f"{p.omega / vr.TWO_PI:.0f} Hz, {p.speed_rpm:.0f} rpm, {p.load}"
-        assert abs(p.flux.omega / p.omega - 1) <= P.bw_tol, tag
-        assert abs(p.itau.omega / p.omega - 1) <= 0.15, tag
-        if p.load == "light":
-            assert abs(p.itau.omega / p.omega - 1) <= P.bw_tol, tag
 
 
 def test_state_of_the_art_gains_shift_the_poles(res):
@@ -110,6 +95,10 @@ def test_robustness_to_map_error(res):
         assert sota[-1].torque_std > prop[-1].torque_std
         # the under-compensation grows as the map's d flux is underestimated
         assert prop[-1].b_ratio > prop[0].b_ratio and sota[-1].b_ratio > sota[0].b_ratio
+        # the error reaches the observer's current model: at 300 rpm (g / omega
+        # = 0.5) the torque delivered for 7.1 N m moves with it, by more than
+        # 10 % of the rated torque over the sweep
+        assert prop[-1].torque_mean - prop[0].torque_mean > 0.1 * P.torque_rated
 
 
 def test_speed_step_mtpa_fw_mtpv(res):

@@ -264,11 +264,6 @@ void dfvc_sat_step(dfvc_sat_t *c, const dfvc_sat_in_t *in, dfvc_sat_out_t *out) 
     out->obs_err = sqrtf(ea * ea + eb * eb);
   }
   out->r = r;
-  out->g_used = g;
-  out->g_prop = q.prop;
-  out->g_sota = q.sota;
-  out->mtpa_angle = q.mtpa_angle;
-  out->mtpv_angle = q.mtpv_angle;
   out->v_ft = po.v_ft;
   out->sat = po.sat;
   out->fault = 0u;

@@ -79,15 +79,9 @@ typedef struct {
   float torque;   /* 3/2 p lambda_hat i_tau [N m] */
   float obs_err;  /* |lambda_hat - lambda^i| [Vs] */
   dfvc_sat_refs_out_t r;
-  sfo_gains_t g_used; /* the gains of T_hat (after the floor) */
-  sfo_gains_t g_prop; /* (a, b) (22) */
-  sfo_gains_t g_sota; /* (a', b') (17) */
-  float mtpa_angle;   /* sine of the phase of lambda^a from i (7) (telemetry) */
-  float mtpv_angle;   /* phase of i^a from lambda on the line [rad] (10); 0
-                       * unless the references are online (34) */
-  dq_t v_ft;          /* [V] */
-  uint32_t sat;       /* DFVC_SAT_PI_SAT_* */
-  uint32_t fault;     /* DFVC_SAT_FAULT_* */
+  dq_t v_ft;      /* [V] */
+  uint32_t sat;   /* DFVC_SAT_PI_SAT_* */
+  uint32_t fault; /* DFVC_SAT_FAULT_* */
 } dfvc_sat_out_t;
 
 /* What the last step found beyond dfvc_sat_out_t's telemetry, kept in the

@@ -19,7 +19,9 @@
 #ifndef DFVC_SAT_REFS_SETTLED
 #define DFVC_SAT_REFS_SETTLED 0.05f
 #endif
-#define DFVC_SAT_REFS_W_MIN 1.0f /* floor of |omega_r| in (30) [rad/s] */
+/* time constant of the current amplitude in the resistive drop of (30) [s] */
+#define DFVC_SAT_REFS_IDROP_TAU 0.01f
+#define DFVC_SAT_REFS_W_MIN     1.0f /* floor of |omega_r| in (30) [rad/s] */
 
 static int dfvc_sat_refs_frac(float x) {
   return fd_isfinite(x) && x > 0.0f && x <= 1.0f;
@@ -46,6 +48,8 @@ int dfvc_sat_refs_init(dfvc_sat_refs_t *r, const dfvc_sat_refs_cfg_t *cfg) {
 void dfvc_sat_refs_reset(dfvc_sat_refs_t *r) {
   r->lambda_mtpa = fd_maxf(r->cfg.lambda_min, r->cfg.lambda_0);
   r->lambda_ref = r->lambda_mtpa;
+  r->i_amp_f = 0.0f;
+  r->i_alpha = r->cfg.ts / (r->cfg.ts + DFVC_SAT_REFS_IDROP_TAU);
 }
 
 void dfvc_sat_refs_update(dfvc_sat_refs_t *r, const dfvc_sat_refs_in_t *in,
@@ -53,10 +57,12 @@ void dfvc_sat_refs_update(dfvc_sat_refs_t *r, const dfvc_sat_refs_in_t *in,
   const dfvc_sat_refs_cfg_t *c = &r->cfg;
   const float kt = 1.5f * c->machine->pole_pairs;
   unsigned lim = 0u;
-  /* Varatharajan 2022, eq. (30) */
-  /* Varatharajan 2022, eq. (30), less the resistive drop (see the header) */
-  const float lmax = fd_maxf(c->k_v * fd_maxf(in->v_lin, 0.0f) - c->machine->rs * in->i_amp, 0.0f) /
-                     fd_maxf(fabsf(in->omega_r), DFVC_SAT_REFS_W_MIN);
+  /* Varatharajan 2022, eq. (30), less the resistive drop at the filtered
+   * current amplitude (see the header) */
+  r->i_amp_f += r->i_alpha * (in->i_amp - r->i_amp_f);
+  const float lmax =
+      fd_maxf(c->k_v * fd_maxf(in->v_lin, 0.0f) - c->machine->rs * r->i_amp_f, 0.0f) /
+      fd_maxf(fabsf(in->omega_r), DFVC_SAT_REFS_W_MIN);
   float lmtpa;
   if (in->lambda_override > 0.0f) {
     lmtpa = in->lambda_override;

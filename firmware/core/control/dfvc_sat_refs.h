@@ -10,7 +10,10 @@
  *                 implementation's: on the 1.1 kW SyR (6.8 Ohm) Rs i_max is
  *                 33 V, 17 % of the 196 V a 340 V link gives, more than the
  *                 margin k_v = 0.9 leaves, and without it the tau axis
- *                 saturated in flux weakening (torque 7.0 for 12.0 N m)
+ *                 saturated in flux weakening (torque 7.0 for 12.0 N m);
+ *                 |i| low-passed with 10 ms: taken at each sample it
+ *                 closed a loop |i| -> lambda_max -> flux -> |i| that swung
+ *                 the current 2.4 .. 5.1 A at 500 Hz near MTPV (Fig. 12)
  *   lambda*     = max(min(lambda_MTPA, lambda_max), lambda_min)
  *   T_max       = k_T f_T(lambda*)                    (31) flux_map_mtpv_torque
  * Online (Fig. 8):
@@ -78,6 +81,8 @@ typedef struct {
   dfvc_sat_refs_cfg_t cfg;
   float lambda_mtpa; /* online: the integrator of (32) [Vs] */
   float lambda_ref;  /* lambda* of the last update [Vs] */
+  float i_amp_f;     /* current amplitude, low-passed (10 ms), for (30) [A] */
+  float i_alpha;     /* its filter's gain per period */
 } dfvc_sat_refs_t;
 
 typedef struct {

@@ -150,6 +150,19 @@ def test_other_machines(res):
         assert abs(o.final_rpm / vr.OTHER_MACHINES[p]["speed_rpm"] - 1) < 0.01, p
 
 
+def test_linear_machine(tmp_path):
+    """What to build 2: the law (observer (24) included) on a linear machine
+    model: the SPM of Rubino 2020 gives 10 N m within 1 % on its MTPA
+    (i_d = 0) with the online references, no fault."""
+    r = vr.linear_machine(REAL_SIL, REPO_ROOT, tmp_path)
+    lg = r.log
+    assert r.summary["faults_seen"] == []
+    m = lg["t"] > 0.3
+    assert abs(np.mean(lg["torque"][m]) / 10.0 - 1) < 0.01
+    i_amp = np.hypot(lg["i_d"][m], lg["i_q"][m])
+    assert np.max(np.abs(lg["i_d"][m])) < 0.02 * np.mean(i_amp)
+
+
 def test_step_model_fits_known_responses():
     """The fit recovers Omega and r from model responses (with a dead time)."""
     t = np.arange(0.0, 0.05, 2e-4)

@@ -19,6 +19,7 @@ import subprocess
 import numpy as np
 
 from . import capability as capmod
+from .paper_report import replace_table, stacked_axes
 
 RPM = np.pi / 30.0
 
@@ -364,17 +365,8 @@ def speed_metrics(r: Run, target_rpm: float = 1200.0, t_step: float = 0.05) -> S
 
 
 # ------------------------------------------------------------------- plots
-def _fig(rows: int, title: str):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(rows, 1, figsize=(8, 2.2 * rows), sharex=True)
-    fig.suptitle(title, fontsize=10)
-    return plt, fig, np.atleast_1d(ax)
-
-
 def plot_steps(runs: dict, keys: list, t_step: float, path: Path, title: str) -> None:
-    plt, fig, ax = _fig(3, title)
+    plt, fig, ax = stacked_axes(3, title)
     for key in keys:
         log = runs[key].log
         m = (log["t"] > t_step - 0.0015) & (log["t"] < t_step + 0.004)
@@ -396,7 +388,7 @@ def plot_steps(runs: dict, keys: list, t_step: float, path: Path, title: str) ->
 
 
 def plot_ramp(runs: dict, metrics: dict, path: Path) -> None:
-    plt, fig, ax = _fig(4, "Rubino 2020 Figs. 14, 19, 20: rated torque, 100 -> 1200 rpm at 400 rpm/s")
+    plt, fig, ax = stacked_axes(4, "Rubino 2020 Figs. 14, 19, 20: rated torque, 100 -> 1200 rpm at 400 rpm/s")
     for key, label in [("fw", "nominal"), ("fw_ls120", "L_s x1.2"), ("fw_lm080", "lambda_m x0.8")]:
         log = runs[key].log
         rpm = log["speed"] / RPM
@@ -417,7 +409,7 @@ def plot_ramp(runs: dict, metrics: dict, path: Path) -> None:
 
 
 def plot_sine(runs: dict, path: Path) -> None:
-    plt, fig, ax = _fig(2, "Rubino 2020 Figs. 23-24: 10 N m + 0.5 N m at 1.5 kHz, 100 rpm")
+    plt, fig, ax = stacked_axes(2, "Rubino 2020 Figs. 23-24: 10 N m + 0.5 N m at 1.5 kHz, 100 rpm")
     for a, key in zip(ax, ["bw_db", "bw_pi"]):
         log = runs[key].log
         m = (log["t"] > 0.12) & (log["t"] < 0.1233)
@@ -431,7 +423,7 @@ def plot_sine(runs: dict, path: Path) -> None:
 
 
 def plot_speed(run_: Run, path: Path) -> None:
-    plt, fig, ax = _fig(3, "Rubino 2020 Fig. 18: speed control 0 -> 1200 rpm, 1200 rpm/s")
+    plt, fig, ax = stacked_axes(3, "Rubino 2020 Fig. 18: speed control 0 -> 1200 rpm, 1200 rpm/s")
     log = run_.log
     ax[0].plot(log["t"], log["speed"] / RPM, label="speed")
     ax[0].plot(log["t"], log["speed_ref"] / RPM, "k--", label="reference (ramped)")
@@ -555,12 +547,6 @@ def main_rubino(args) -> int:
     plot_speed(runs["speed"], figs / "rubino2020_speed.png")
     table = report(met)
     print(table)
-    if args.doc:
-        doc = Path(args.doc)
-        text = doc.read_text()
-        a, b = "<!-- rubino2020-table:begin -->", "<!-- rubino2020-table:end -->"
-        if a in text and b in text:
-            text = text[:text.index(a) + len(a)] + "\n" + table + "\n" + text[text.index(b):]
-            doc.write_text(text)
-            print(f"updated {doc}")
+    if args.doc and replace_table(Path(args.doc), "rubino2020-table", table):
+        print(f"updated {args.doc}")
     return 0

@@ -34,6 +34,7 @@ import tempfile
 import numpy as np
 
 from .fluxmap import blob as blobmod
+from .paper_report import replace_table, stacked_axes
 from .fluxmap.model import FluxMap
 
 RPM = np.pi / 30.0
@@ -749,15 +750,6 @@ def report(res: Results) -> str:
     return "\n".join(L)
 
 
-def _fig(rows: int, title: str, w: float = 8.0):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(rows, 1, figsize=(w, 2.2 * rows), sharex=True)
-    fig.suptitle(title, fontsize=10)
-    return plt, fig, np.atleast_1d(ax)
-
-
 def _finish(plt, fig, ax, path):
     for a in ax:
         a.grid(True, alpha=0.3)
@@ -769,7 +761,7 @@ def _finish(plt, fig, ax, path):
 
 
 def plot_bandwidth(res: Results, path: Path) -> None:
-    plt, fig, ax = _fig(2, "Varatharajan 2022 Figs. 10-11: fitted bandwidth / design, 9 points each")
+    plt, fig, ax = stacked_axes(2, "Varatharajan 2022 Figs. 10-11: fitted bandwidth / design, 9 points each")
     for k, (lbl, key) in enumerate((("flux loop", "flux"), ("i_tau loop", "itau"))):
         for g, mk in ((0, "o"), (1, "x")):
             for fs, col in ((5000.0, "C0"), (16000.0, "C1")):
@@ -790,7 +782,7 @@ def plot_bandwidth(res: Results, path: Path) -> None:
 def plot_speed_step(step: SpeedStep, tab: MapTables, path: Path) -> None:
     lg = step.run.log
     t = lg["t"]
-    plt, fig, ax = _fig(4, "Varatharajan 2022 Fig. 12: speed step 0 -> 2625 rpm, online MTPA / MTPV")
+    plt, fig, ax = stacked_axes(4, "Varatharajan 2022 Fig. 12: speed step 0 -> 2625 rpm, online MTPA / MTPV")
     ax[0].plot(t, lg["speed"] / RPM, label="speed (rpm)")
     ax[1].plot(t, lg["torque"], label="torque")
     ax[1].plot(t, lg["torque_max"], "--", label="limit in force")
@@ -809,7 +801,7 @@ def plot_sine(st: SineTorque, tab: MapTables, path: Path) -> None:
     lg = st.run.log
     t = lg["t"]
     m = t >= t[-1] - 0.12
-    plt, fig, ax = _fig(3, "Varatharajan 2022 Fig. 13: 25 Hz torque at 750 rpm, online MTPA (k_A = 60)")
+    plt, fig, ax = stacked_axes(3, "Varatharajan 2022 Fig. 13: 25 Hz torque at 750 rpm, online MTPA (k_A = 60)")
     ax[0].plot(t[m], lg["torque"][m], label="torque")
     ax[0].plot(t[m], lg["torque_ref"][m], "--", label="reference")
     ax[1].plot(t[m], lg["flux_mtpa"][m], label="adapted flux (32)")
@@ -821,7 +813,7 @@ def plot_sine(st: SineTorque, tab: MapTables, path: Path) -> None:
 
 
 def plot_robustness(res: Results, path: Path) -> None:
-    plt, fig, ax = _fig(2, "Varatharajan 2022 Fig. 14: map error in d 1.3 -> 0.7 (q 1.25), 300 rpm, 5 kHz")
+    plt, fig, ax = stacked_axes(2, "Varatharajan 2022 Fig. 14: map error in d 1.3 -> 0.7 (q 1.25), 300 rpm, 5 kHz")
     for k, g in enumerate((1, 0)):
         lg = res.robust[(5000.0, g)][0].log
         ax[k].plot(lg["t"], lg["torque"], lw=0.6, label=f"torque, {GAIN_LBL[g]}")
@@ -845,14 +837,8 @@ def main_varatharajan(args) -> int:
     plot_robustness(res, figs / "varatharajan2022_robustness.png")
     table = report(res)
     print(table)
-    if args.doc:
-        doc = Path(args.doc)
-        text = doc.read_text()
-        a, b = "<!-- varatharajan2022:begin -->", "<!-- varatharajan2022:end -->"
-        if a in text and b in text:
-            text = text[:text.index(a) + len(a)] + "\n" + table + "\n" + text[text.index(b):]
-            doc.write_text(text)
-            print(f"updated {doc}")
+    if args.doc and replace_table(Path(args.doc), "varatharajan2022", table):
+        print(f"updated {args.doc}")
     return 0
 
 

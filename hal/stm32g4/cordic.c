@@ -59,6 +59,29 @@ HOT float cordic_hw_atan2f(float y, float x) {
   return (float)r * (INV_Q31 * PI_F);
 }
 
+HOT int32_t cordic_hw_atan2_q31(int32_t y, int32_t x, int32_t *mag) {
+  if (x == 0 && y == 0) {
+    if (mag != 0) {
+      *mag = 0;
+    }
+    return 0;
+  }
+  const uint32_t pm = hal_irq_save();
+  CORDIC->CSR = (CORDIC_FUNC_PHASE << CORDIC_CSR_FUNC_Pos) |
+                (PRECISION << CORDIC_CSR_PRECISION_Pos) | /* SCALE = 0 */
+                CORDIC_CSR_NARGS | CORDIC_CSR_NRES;       /* (x, y) -> (phase, modulus), q1.31 */
+  CORDIC->WDATA = (uint32_t)x;
+  CORDIC->WDATA = (uint32_t)y;
+  const int32_t phase = (int32_t)CORDIC->RDATA;
+  const int32_t modulus = (int32_t)CORDIC->RDATA;
+  hal_irq_restore(pm);
+  if (mag != 0) {
+    /* the software CORDIC's gain, 1.6467602581 in q2.30 */
+    *mag = (int32_t)(((int64_t)modulus * 1768255360LL) >> 30);
+  }
+  return phase;
+}
+
 HOT void cordic_hw_sincosf(float theta, float *s, float *c) {
   if (!(absf(theta) <= 1.0e6f)) { /* NaN, inf, huge */
     *s = 0.0f;

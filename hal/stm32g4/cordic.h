@@ -26,11 +26,18 @@
 #ifndef FLUXDRIVE_STM32G4_CORDIC_H
 #define FLUXDRIVE_STM32G4_CORDIC_H
 
+#include <stdint.h>
+
 void hal_cordic_init(void);
 /* atan2(y, x) in (-pi, pi]; 0 for (0, 0) and for non-finite inputs. */
 float cordic_hw_atan2f(float y, float x);
 /* sin and cos of theta [rad], any finite theta (reduced modulo 2 pi);
  * s = 0, c = 1 for non-finite theta or |theta| > 1e6 rad. */
 void cordic_hw_sincosf(float theta, float *s, float *c);
+/* atan2(y, x) of integer inputs |x|, |y| < 2^30 in Q31 (pi = 2^31, the
+ * unit's q1.31 phase), and in *mag (may be NULL) the modulus times the
+ * software CORDIC's gain 1.6467602581 (firmware/core/math/cordic_q31.h's
+ * conventions); (0, 0) gives 0 and 0. */
+int32_t cordic_hw_atan2_q31(int32_t y, int32_t x, int32_t *mag);
 
 #endif

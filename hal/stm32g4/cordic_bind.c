@@ -1,6 +1,7 @@
 /*
  * cordic_bind.c - binds the core's trigonometry API (firmware/core/math/
- * fast_trig.h) to the CORDIC co-processor: these strong definitions replace
+ * fast_trig.h, and the Q31 CORDIC of math/cordic_q31.h) to the CORDIC
+ * co-processor: these strong definitions replace
  * the core's weak software ones at link time (this file is an object of the
  * firmware executable, not an archive member). Host, SIL and QEMU (PIL)
  * builds keep the software versions. Accuracy: cordic.h (~6e-6 rad for
@@ -8,6 +9,7 @@
  * Selected by the CMake option FD_HW_CORDIC (default ON).
  */
 #include "cordic.h"
+#include "math/cordic_q31.h"
 #include "math/fast_trig.h"
 
 void fd_sincosf(float theta, float *s, float *c) {
@@ -16,4 +18,8 @@ void fd_sincosf(float theta, float *s, float *c) {
 
 float fd_atan2f(float y, float x) {
   return cordic_hw_atan2f(y, x);
+}
+
+int32_t fd_cordic_atan2_q31(int32_t y, int32_t x, int32_t *mag) {
+  return cordic_hw_atan2_q31(y, x, mag);
 }

@@ -14,7 +14,9 @@ const int32_t fd_cordic_atan_q31[FD_CORDIC_ITER] = {
     1335087,   667544,    333772,    166886,   83443,    41722,    20861,    10430,   5215,
     2608,      1304,      652,       326,      163,      81,       41,       20};
 
-int32_t fd_cordic_atan2_q31(int32_t y, int32_t x, int32_t *mag) {
+/* weak: the STM32G4 build binds the CORDIC co-processor (hal/stm32g4/
+ * cordic_bind.c), host, SIL and PIL keep this one */
+__attribute__((weak)) int32_t fd_cordic_atan2_q31(int32_t y, int32_t x, int32_t *mag) {
   /* into the right half-plane: a rotation by pi, the angle offset
    * (modular: +pi and -pi are the same Q31 word, 2^31) */
   if (x == 0 && y == 0) {

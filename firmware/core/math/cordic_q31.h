@@ -31,6 +31,9 @@ extern const int32_t fd_cordic_atan_q31[FD_CORDIC_ITER];
  * the magnitude times the CORDIC gain 1.6467602581. (0, 0) gives 0.
  * Requires |x|, |y| < 2^30. */
 int32_t fd_cordic_atan2_q31(int32_t y, int32_t x, int32_t *mag);
+/* (Defined weak: the STM32G4 build binds the CORDIC co-processor's phase
+ * and modulus function, hal/stm32g4/cordic_bind.c, with the same
+ * conventions; its precision is the hardware's, ~6e-6 rad, cordic.h.) */
 
 /* Float entry point: atan2(y, x) in [-pi, pi] by the Q31 CORDIC after an
  * exact power-of-two normalisation (no libm); +pi for y = +-0, x < 0 (as

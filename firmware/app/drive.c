@@ -13,6 +13,7 @@
 #include <stdatomic.h>
 #include <string.h>
 
+#include "control/dfc_window.h"
 #include "control/modulation.h"
 #include "math/fd_math.h"
 #include "math/frames.h"
@@ -38,7 +39,7 @@ bool drive_state_enabled(drive_state_t s) {
  * voltage when the gates come back). */
 static void drive_gates_off(const drive_t *drv) {
   hal_pwm_disable();
-  const float mid = 0.5f * (drv->caps->duty_min + drv->caps->duty_max);
+  const float mid = 0.5f * (drv->duty_lo + drv->duty_hi);
   const hal_pwm_t p = hal_pwm_centred(mid, mid, mid);
   hal_pwm_write(&p, NULL);
 }
@@ -101,6 +102,12 @@ int drive_config_usable(const drive_config_t *cfg, drive_law_t law, machine_t *m
     err->reason = "the law has no current mode";
     return -1;
   }
+  const pos_source_row_t *ps = pos_source(cfg->pos_source);
+  const char *pwhy = ps->check != NULL ? ps->check(cfg, &err->field) : NULL;
+  if (pwhy != NULL) {
+    err->reason = pwhy;
+    return -1;
+  }
   return 0;
 }
 
@@ -108,6 +115,14 @@ int drive_config_usable(const drive_config_t *cfg, drive_law_t law, machine_t *m
  * included: called again when they change). */
 static void drive_derive(drive_t *drv) {
   const drive_config_t *c = &drv->cfg;
+  /* the duty range: the board's, narrowed by a DFC window */
+  drv->duty_lo = drv->caps->duty_min;
+  drv->duty_hi = drv->caps->duty_max;
+  const pos_source_row_t *ps = pos_source(c->pos_source);
+  if (ps != NULL && (ps->caps & POS_CAP_GATED) != 0u) {
+    dfc_window_range(c->dfc_t0 / c->ts, c->dfc_tw / c->ts, drv->caps->duty_min, drv->caps->duty_max,
+                     &drv->duty_lo, &drv->duty_hi);
+  }
   drv->lc_n_fast = c->lc_time / c->ts;
   drv->lc_n_track = c->lc_track_time / c->ts;
   drv->inv_pole_pairs = 1.0f / c->pole_pairs;
@@ -119,6 +134,13 @@ static int drive_configure(drive_t *drv, const drive_config_t *cfg, drive_law_t 
   machine_t m;
   flux_map_t map;
   if (drive_config_usable(cfg, law, &m, &map, err) != 0) {
+    return -1;
+  }
+  const uint32_t need = HAL_CAP_STAR_POINT | HAL_CAP_ASYM_EDGES;
+  if ((pos_source(cfg->pos_source)->caps & POS_CAP_GATED) != 0u &&
+      (drv->caps->features & need) != need) {
+    err->field = "pos_source";
+    err->reason = "the board has no star-point samples with asymmetric PWM edges (DFC window)";
     return -1;
   }
   drv->cfg = *cfg;
@@ -167,7 +189,10 @@ static bool configure_live(drive_t *drv, const drive_config_t *cfg) {
       rest = rest || v < w || v > w;
     }
   }
-  if (drive_config_check(&next, NULL) != 0) {
+  const char *pf = NULL;
+  const pos_source_row_t *ps = pos_source(next.pos_source);
+  if (drive_config_check(&next, NULL) != 0 ||
+      (ps->check != NULL && ps->check(&next, &pf) != NULL)) {
     return true; /* all of it when the gates are off */
   }
   drv->cfg = next;
@@ -300,7 +325,9 @@ static uint32_t drive_protect(const drive_t *drv, const hal_sample_t *s, const f
   }
   /* the position must be usable before the gates go on, and plausible
    * while they are */
-  if (drive_state_enabled(drv->state) &&
+  const bool gated = (drv->pos_src->caps & POS_CAP_GATED) != 0u;
+  const bool need = gated ? drv->state == DRIVE_STATE_RUN : drive_state_enabled(drv->state);
+  if (need &&
       (!drv->pos.valid || (drv->state == DRIVE_STATE_RUN && drv->pos.health > c->pos_err_max))) {
     f |= DRIVE_FAULT_POSITION;
   }
@@ -369,9 +396,21 @@ static ab_t drive_write(drive_t *drv, const float duty[3], const float dtc[3], f
    * asks only for what the board can do (the HAL would clamp the same) */
   float dc[3];
   for (int x = 0; x < 3; ++x) {
-    dc[x] = fd_clampf(duty[x] + dtc[x], drv->caps->duty_min, drv->caps->duty_max);
+    dc[x] = fd_clampf(duty[x] + dtc[x], drv->duty_lo, drv->duty_hi);
   }
-  const hal_pwm_t req = hal_pwm_centred(dc[0], dc[1], dc[2]);
+  hal_pwm_t req = hal_pwm_centred(dc[0], dc[1], dc[2]);
+  if ((drv->pos_src->caps & POS_CAP_GATED) != 0u) {
+    /* the DFC window (Fig. 2.11): test vectors v1, v3, v5 in turn */
+    const drive_config_t *c = &drv->cfg;
+    const float inv_ts = 1.0f / c->ts;
+    const unsigned leg = drv->dfc_leg;
+    drv->dfc_leg = leg >= 2u ? 0u : leg + 1u;
+    dfc_window_pattern(dc, leg, c->dfc_t0 * inv_ts, c->dfc_tw * inv_ts, req.on, req.off);
+    req.test_vector = (uint8_t)(2u * leg + 1u);
+    req.n_star = 2u;
+    req.t_star_req[0] = 0.5f * c->dfc_t0;
+    req.t_star_req[1] = c->dfc_t0 + c->dfc_t_meas;
+  }
   hal_pwm_t got;
   hal_pwm_write(&req, &got);
   float pole[3];
@@ -441,8 +480,7 @@ static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
     drive_trip(drv, DRIVE_FAULT_CONTROL);
     return;
   }
-  const hal_caps_t *caps = drv->caps;
-  const modulation_out_t m = modulation_minmax(out.v_ref, s->v_dc, caps->duty_min, caps->duty_max);
+  const modulation_out_t m = modulation_minmax(out.v_ref, s->v_dc, drv->duty_lo, drv->duty_hi);
   float dtc[3];
   ctrl_deadtime_delta(&drv->ctrl, &out, dtc);
   drv->v_applied = drive_write(drv, m.duty, dtc, s->v_dc);
@@ -467,7 +505,7 @@ static void drive_align(drive_t *drv, const float i[3], const hal_sample_t *s) {
   const dq_t v = current_ctrl_update(&drv->align_cc, (dq_t){c->align_current, 0.0f},
                                      (dq_t){i_ab.alpha, i_ab.beta}, 0.0f, c->v_margin * drv->v_lin);
   const modulation_out_t m =
-      modulation_minmax((ab_t){v.d, v.q}, s->v_dc, drv->caps->duty_min, drv->caps->duty_max);
+      modulation_minmax((ab_t){v.d, v.q}, s->v_dc, drv->duty_lo, drv->duty_hi);
   const float none[3] = {0.0f, 0.0f, 0.0f};
   drv->v_applied = drive_write(drv, m.duty, none, s->v_dc);
   if ((float)++drv->align_n * c->ts >= c->align_time) {
@@ -490,7 +528,7 @@ static void drive_start(drive_t *drv) {
     current_ctrl_reset(&drv->align_cc);
     drv->align_n = 0u;
   }
-  const float mid = 0.5f * (drv->caps->duty_min + drv->caps->duty_max);
+  const float mid = 0.5f * (drv->duty_lo + drv->duty_hi);
   const hal_pwm_t p = hal_pwm_centred(mid, mid, mid);
   hal_pwm_write(&p, NULL);
   hal_pwm_enable();
@@ -552,11 +590,12 @@ void drive_isr(drive_t *drv) {
     i[x] = s.i_abc[x] - drv->offset[x];
   }
   drive_speed_loop(drv); /* on the rates of the previous slow_div periods */
-  drv->pos_src->update(&drv->pos_st, &drv->cfg, &s, &drv->pos);
+  const pos_in_t pin = {drv->tm.i_dq[1]};
+  drv->pos_src->update(&drv->pos_st, &drv->cfg, &s, &pin, &drv->pos);
   drv->omega_m = drv->pos.omega * drv->inv_pole_pairs;
   drv->rate_acc += drv->pos.rate;
   drv->rate_n++;
-  drv->v_lin = modulation_v_max(s.v_dc, drv->caps->duty_min, drv->caps->duty_max);
+  drv->v_lin = modulation_v_max(s.v_dc, drv->duty_lo, drv->duty_hi);
 
   const uint32_t f = drive_protect(drv, &s, i);
   if (f != 0u) {

@@ -141,7 +141,9 @@ typedef struct {
   float torque_scale, flux_scale;           /* torque and flux amplitude on MTPA at i_max */
   float lc_n_fast, lc_n_track;              /* lc_time, lc_track_time in periods */
   float inv_pole_pairs;
-  float v_lin; /* linear voltage range now [V] */
+  float v_lin;            /* linear voltage range now [V] */
+  float duty_lo, duty_hi; /* duty range: the board's, narrowed by a DFC window */
+  unsigned dfc_leg;       /* leg of the next DFC test vector (0: v1, 1: v3, 2: v5) */
 
   /* telemetry, under a sequence lock */
   volatile uint32_t tm_seq;

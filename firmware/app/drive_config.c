@@ -197,6 +197,9 @@ int drive_config_check(const drive_config_t *cfg, drive_config_err_t *err) {
   RULE(cfg->align_time <= 0.0f || cfg->align_current > 0.0f, "align_current",
        "must be positive when align_time > 0");
   RULE(cfg->align_current <= cfg->i_max, "align_current", "must be at most i_max");
+  RULE(cfg->dfc_t_meas < cfg->dfc_tw, "dfc_t_meas", "must be shorter than dfc_tw");
+  RULE(cfg->dfc_t0 + cfg->dfc_tw <= 0.25f * c, "dfc_tw",
+       "the DFC window dfc_t0 + dfc_tw must end within the first quarter of the period ts");
   flux_map_t map;
   const int has_map = drive_config_map(cfg, &map, e);
   if (has_map < 0) {

@@ -51,7 +51,10 @@
 /* Position sources: X(ENUM, name, doc). The source table (pos_sources.c)
  * has one row per entry, in this order. */
 #define POS_SOURCE_LIST(X) \
-  X(ENCODER, encoder, "encoder (quantised, half-count corrected) and PLL")
+  X(ENCODER, encoder, "encoder (quantised, half-count corrected) and PLL")                              \
+  X(DFC, dfc, "star point: standard Direct Flux Control (3.8)-(3.10) and PLL")                             \
+  X(DFC_INV, dfc_inv, "star point: inverse DFC (3.15)-(3.16) and PLL")                                     \
+  X(IVD, ivd, "star point: DFC with Iterative Vector Decoupling (3.76), Full IVD (3.100) with phase shifts, and PLL")
 /* clang-format on */
 
 #define DRIVE_ENUM_LAW(E, n, d)       DRIVE_LAW_##E,

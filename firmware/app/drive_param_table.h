@@ -127,6 +127,23 @@
     "d current of the alignment")                                                                           \
   X(46, pos_err_max,    F32,  "rad",    0.5f,        0.01f,   3.2f,     LIVE, "controller.pos_err_max",    \
     "position fault: measured angle this far (electrical) from the PLL's prediction")                       \
+  /* Direct Flux Control position (Fabbri 2022; docs/dfc.md) */                                            \
+  X(8,  dfc_a,          F32,  "",       0.05f,       -1.0f,   1.0f,     IDLE, "controller.dfc_a",          \
+    "DFC: amplitude a of the 2theta term of Gamma / v_dc (3.6)-(3.7)")                                     \
+  X(9,  dfc_b,          F32,  "",       -0.0047f,    -1.0f,   1.0f,     LIVE, "controller.dfc_b",          \
+    "DFC: amplitude b of the 4theta term of Gamma / v_dc (3.6)-(3.7); IVD needs |b/a| < 1/2")               \
+  X(27, dfc_iter,       U16,  "",       1.0f,        0.0f,    8.0f,     LIVE, "controller.dfc_iter",       \
+    "IVD: iterations of (3.76) / (3.100)")                                                                  \
+  X(28, dfc_phi_a,      F32,  "rad/A",  0.0f,        -1.0f,   1.0f,     LIVE, "controller.dfc_phi_a",      \
+    "Full IVD: phase shift phi_a of the 2theta term per A of i_q (3.97)")                                  \
+  X(29, dfc_phi_b,      F32,  "rad/A",  0.0f,        -1.0f,   1.0f,     LIVE, "controller.dfc_phi_b",      \
+    "Full IVD: phase shift phi_b of the 4theta term per A of i_q (3.97)")                                  \
+  X(47, dfc_t0,         F32,  "s",      1.5e-6f,     2e-7f,   2e-5f,    IDLE, "controller.dfc_t0",         \
+    "DFC window: test vector start after the period start (the star point is sampled at t0/2 before it)") \
+  X(48, dfc_tw,         F32,  "s",      3e-6f,       5e-7f,   3e-5f,    IDLE, "controller.dfc_tw",         \
+    "DFC window: test vector length")                                                                       \
+  X(49, dfc_t_meas,     F32,  "s",      2.5e-6f,     1e-7f,   3e-5f,    IDLE, "controller.dfc_t_meas",     \
+    "DFC window: star-point sample after the test-vector edge (dead time plus settling, < dfc_tw)")        \
   /* timing and calibration */                                                                              \
   X(40, ts,             F32,  "s",      6.25e-5f,    1e-6f,   1e-2f,    RO,   "inverter.pwm_frequency",    \
     "PWM and ISR period")                                                                                   \

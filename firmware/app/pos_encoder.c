@@ -36,7 +36,8 @@ static float enc_electrical(const pos_state_t *s, const drive_config_t *cfg,
 }
 
 static void enc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
-                       pos_estimate_t *out) {
+                       const pos_in_t *in, pos_estimate_t *out) {
+  (void)in;
   angle_pll_t *pll = &s->enc.pll;
   out->t = smp->t_enc;
   out->valid = smp->enc_valid && fd_isfinite(smp->enc_angle);
@@ -68,5 +69,5 @@ static void enc_align(pos_state_t *s, const drive_config_t *cfg, const hal_sampl
   s->enc.started = false;
 }
 
-const pos_source_row_t pos_source_encoder = {"encoder", POS_CAP_ALIGN, enc_init,
-                                             enc_reset, enc_update,    enc_align};
+const pos_source_row_t pos_source_encoder = {"encoder",  POS_CAP_ALIGN, enc_init, enc_reset,
+                                             enc_update, enc_align,     NULL};

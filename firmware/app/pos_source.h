@@ -20,6 +20,7 @@
 
 #include "drive_config.h"
 #include "estimation/angle_pll.h"
+#include "estimation/dfc.h"
 #include "hal.h"
 
 typedef struct {
@@ -32,8 +33,16 @@ typedef struct {
 } pos_estimate_t;
 
 enum {
-  POS_CAP_ALIGN = 1u << 0 /* the angle offset can be found by an alignment */
+  POS_CAP_ALIGN = 1u << 0, /* the angle offset can be found by an alignment */
+  POS_CAP_GATED = 1u << 1  /* measures only with the gates on, through the DFC
+                              window of the pattern (dfc_window.h): invalid in
+                              offset calibration, resolved by the alignment */
 };
+
+/* What the drive knows of the last period, for the sources that use it. */
+typedef struct {
+  float i_q; /* rotor-frame q current of the last period [A] */
+} pos_in_t;
 
 typedef union {
   struct {
@@ -42,6 +51,17 @@ typedef union {
     float half;   /* half a count [rad mechanical] */
     bool started; /* the PLL has seen a measurement since reset */
   } enc;
+  struct {
+    angle_pll_t pll;
+    dfc_cfg_t dc;
+    dfc_signals_t sig;
+    bool started; /* the PLL follows a branch since reset */
+    /* the last estimate, for logs: e^{j 2 theta_k} after step k (cos, sin)
+     * and the instant it belongs to (relative to the period start) */
+    float trace[2u * (DFC_ITER_MAX + 1u)];
+    float t;
+    uint32_t n; /* periods since the reset (the components' time base) */
+  } dfc;
 } pos_state_t;
 
 typedef struct {
@@ -50,10 +70,13 @@ typedef struct {
   void (*init)(pos_state_t *s, const drive_config_t *cfg);
   void (*reset)(pos_state_t *s);
   void (*update)(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
-                 pos_estimate_t *out);
+                 const pos_in_t *in, pos_estimate_t *out);
   /* The rotor is held at electrical angle theta: take it as the reference
    * (alignment). Only for POS_CAP_ALIGN. */
   void (*align)(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp, float theta);
+  /* Whether cfg can run this source: NULL, or the reason with *field set
+   * to the parameter (NULL: nothing to check). */
+  const char *(*check)(const drive_config_t *cfg, const char **field);
 } pos_source_row_t;
 
 /* The row of a source (NULL out of range). */

@@ -62,6 +62,9 @@ int plant_init(plant_t *pl, const plant_params_t *p, const char **field) {
   a->all_zero = 0;
   a->gates_prev = 0;
   a->v_star = 0.0;
+  a->star_n = 0;
+  a->l0 = 0.5 * (p->machine.ld + p->machine.lq) + p->machine.aniso.m0;
+  a->l2 = (p->machine.ld - p->machine.lq) - 2.0 * p->machine.aniso.m2;
   pl->t = 0.0;
   plant_mag_flux0(&a->mag, &pl->lambda_d, &pl->lambda_q); /* zero current */
   pl->theta_m = wrap_2pi(p->mech.theta0);
@@ -120,6 +123,9 @@ void plant_step_pattern(plant_t *pl, const double on_in[3], const double off_in[
   pl->i_dc_avg = x[X_IDC] * inv_ts;
   if (avg) {
     pl->aux.v_star = x[X_VN] * inv_ts;
+    for (int k = 0; k < pl->aux.star_n; k++) { /* no switching instants */
+      pl->aux.star_v[k] = pl->aux.v_star + 0.5 * pl->v_dc;
+    }
   }
   pl->lambda_d = x[X_LD];
   pl->lambda_q = x[X_LQ];

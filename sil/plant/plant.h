@@ -19,6 +19,24 @@
 #include "plant_magnetics.h"
 #include "profile.h"
 
+/* The phase inductance matrix the star point sees (Fabbri 2022, (3.3)):
+ * self L0 + L2 cos(2 theta_e - k 2pi/3), mutual M0 + M2 cos(...), k per
+ * phase as printed there. Given by its mutual terms beside ld, lq:
+ *   L0 = (ld + lq)/2 + m0,   L2 = (ld - lq) - 2 m2,
+ * so that its alpha-beta part is exactly the dq model the plant integrates
+ * (ld = L0 - M0 + L2/2 + M2, lq = L0 - M0 - L2/2 - M2) and the DFC
+ * anisotropy is p = b/a = (ld - lq)/(ld + lq) (3.7), whatever the split;
+ * the split sets the signal amplitude a of (3.7) (docs/star-point.md).
+ * phi_iq: the saliency axis of these (incremental) inductances shifted
+ * with load, 2 theta_e -> 2 theta_e + phi_iq * i_q: the phase shifts of
+ * the Full IVD model (3.97) with phi_a = phi_iq i_q, phi_b = 2 phi_iq i_q.
+ * The shift acts on the star point only (the dq model keeps ld, lq). */
+typedef struct {
+  int enabled;   /* 0: isotropic star point (the mean of the leg potentials) */
+  double m0, m2; /* [H] */
+  double phi_iq; /* [rad/A] */
+} plant_aniso_t;
+
 typedef struct {
   int pole_pairs;
   double rs;       /* stator phase resistance [Ohm] */
@@ -27,6 +45,7 @@ typedef struct {
   /* NULL: linear (ld, lq, lambda_m); else the saturated machine's flux map
    * (plant_fluxmap.h; ld, lq, lambda_m unused), owned by the caller */
   const plant_fluxmap_t *map;
+  plant_aniso_t aniso; /* linear machines only */
 } plant_machine_t;
 
 typedef enum { PLANT_INV_AVERAGE, PLANT_INV_SWITCHING } plant_inverter_model_t;
@@ -67,6 +86,14 @@ typedef struct {
   double i_noise;         /* white noise rms on each current [A] */
   double v_noise;         /* white noise rms on the DC-link voltage [V] */
   int encoder_cpr;        /* encoder counts per mechanical revolution, 0 = ideal */
+  /* star-point channel (w.r.t. the DC-link midpoint): bipolar ADC of
+   * adc_bits over +-star_full_scale (0: v_full_scale / 2), behind a
+   * first-order measurement circuit of time constant star_tau */
+  double star_full_scale; /* [V] */
+  double star_gain_error; /* relative */
+  double star_offset;     /* [V] */
+  double star_noise;      /* white noise rms [V] */
+  double star_tau;        /* [s], 0: none */
   uint32_t seed;          /* noise generator seed */
 } plant_sensors_t;
 
@@ -104,7 +131,8 @@ typedef struct {
   double i_dc;         /* period-average DC-link current drawn [A] */
 } plant_state_t;
 
-#define PLANT_ZIG_N 128 /* layers of the ziggurat normal generator */
+#define PLANT_ZIG_N    128 /* layers of the ziggurat normal generator */
+#define PLANT_STAR_MAX 2   /* star-point samples per period */
 
 /* True currents of one state, cached (plant_machine.c): valid while the
  * state equals the key (lambda_d, lambda_q, theta_m) bit for bit. */
@@ -142,6 +170,13 @@ typedef struct {
   int all_zero;   /* all phase currents blocked by the diodes */
   int gates_prev; /* gates were on during the last period */
   double v_star;  /* star-point voltage at the last valley (see plant_sample) */
+  /* star-point samples (plant_star.c): requested instants of the next
+   * period, the measurement circuit's output there (w.r.t. the negative
+   * rail, before the ADC), the circuit's state */
+  int star_n;
+  double star_t[PLANT_STAR_MAX], star_v[PLANT_STAR_MAX];
+  double star_vf;
+  double l0, l2; /* the (3.3) matrix (aniso.enabled) [H] */
   /* mechanical input profile (plant_internal.h): equal to m_val for
    * t in [m_t0, m_t1) */
   double m_val, m_t0, m_t1;
@@ -184,6 +219,23 @@ void plant_step(plant_t *pl, const double duty[3], bool gates_on);
  * [on[x], off[x]) in fractions of the period (0 <= on <= off <= 1). The
  * average model uses the duty off - on. */
 void plant_step_pattern(plant_t *pl, const double on[3], const double off[3], bool gates_on);
+/* Star-point samples during the next plant_step_pattern (switching
+ * inverter model), at instants t_req [s] from its start, ascending, inside
+ * (0, ts); n <= PLANT_STAR_MAX (0: none). Read them after the step with
+ * plant_star_read(): the measurement circuit's output through the star
+ * channel's ADC, w.r.t. the DC-link midpoint [V]; returns their number
+ * (the average model has no switching instants: it returns the period
+ * average of the star point for each). */
+void plant_star_request(plant_t *pl, int n, const double t_req[]);
+int plant_star_read(plant_t *pl, double v[PLANT_STAR_MAX]);
+/* Whether a machine's (3.3) matrix is an inductance matrix (positive
+ * definite at every angle) that carries the position (L2 != M2). */
+int plant_aniso_ok(const plant_machine_t *m);
+/* a and b of (3.7) (normalised to v_dc) of a machine's (3.3) matrix. */
+void plant_aniso_ab(const plant_machine_t *m, double *a, double *b);
+/* The static star-point divider G_c = L_Sigma / (L_Sigma T^T) of (2.90)
+ * at electrical angle theta_e and q current i_q (isotropic: 1/3 each). */
+void plant_star_gain(const plant_t *pl, double theta_e, double i_q, double g[3]);
 /* Sensor readings at the present plant time (the carrier valley). */
 void plant_sample(plant_t *pl, plant_adc_t *out);
 void plant_get_state(const plant_t *pl, plant_state_t *out);

@@ -138,6 +138,16 @@ void plant_mech_end_step(const plant_t *pl, double *x, double t_end);
 int plant_sensors_check(const plant_sensors_t *s, const char **field);
 void plant_sensors_init(plant_t *pl);
 
+/* plant_star.c: the star point w.r.t. the negative rail for leg
+ * potentials v, phase currents i, electrical angle and speed, the q
+ * current (load shift) and back-EMF e; the measurement circuit over a step
+ * of length h whose input went linearly from v0 to v1. */
+double plant_star_vn(const plant_t *pl, const double v[3], const double i[3], double th_e,
+                     double we, double i_q, const double e[3]);
+void plant_star_filter(plant_t *pl, double v0, double v1, double h);
+/* plant_sensors.c: one standard normal number from the plant's generator */
+double plant_sensors_normal(plant_t *pl);
+
 /* Small helpers. */
 static inline int plant_finite_pos(double v) {
   return v > 0.0 && v < 1e300; /* false for NaN and +inf */

@@ -50,7 +50,8 @@ typedef struct {
 typedef struct {
   double u;   /* voltage of the blocked leg [V] */
   double gap; /* all-zero: > 0 when a diode path must open [V] */
-  double vn0; /* star point w.r.t. the negative rail [V] */
+  double vn0; /* star point w.r.t. the negative rail [V] (isotropic) */
+  double vns; /* the same with the (3.3) matrix (plant_star.c) [V] */
   double vdc;
 } sw_out_t;
 
@@ -107,6 +108,7 @@ static void sw_deriv(const plant_t *pl, const sw_cfg_t *cf, const double *x, dou
     }
     o->gap = lo_max - hi_min;
     vn0 = o->gap > 0.0 ? 0.5 * (lo_max + hi_min) : fmin(fmax(0.5 * vdc, lo_max), hi_min);
+    o->vns = vn0;
     o->u = 0.0;
     dx[X_LD] = 0.0;
     dx[X_LQ] = 0.0;
@@ -150,6 +152,12 @@ static void sw_deriv(const plant_t *pl, const sw_cfg_t *cf, const double *x, dou
     }
     o->gap = 0.0;
     vn0 = (v[0] + v[1] + v[2]) * (1.0 / 3.0);
+    o->vns = vn0;
+    if (pl->p.machine.aniso.enabled && pl->aux.star_n > 0) {
+      double e[3];
+      backemf(pl, x, w, e);
+      o->vns = plant_star_vn(pl, v, i, th, we, iq, e);
+    }
     dx[X_LD] = dld;
     dx[X_LQ] = dlq;
     dx[X_VA] = v[0] - vn0;
@@ -321,9 +329,18 @@ static double sw_locate(const plant_t *pl, const sw_cfg_t *cf, double t, const d
   return b;
 }
 
+/* The star point at (t, x) for the measurement circuit. */
+static double sw_star(const plant_t *pl, const sw_cfg_t *cf, double t, const double *x) {
+  double dx[X_N];
+  sw_out_t o;
+  sw_deriv(pl, cf, x, plant_mech_input(pl, t), dx, &o);
+  return o.vns;
+}
+
 /* Integrates over len with a fixed leg configuration, splitting at diode
  * events. */
-static void sw_integrate(const plant_t *pl, sw_cfg_t *cf, double *t, double *x, double len) {
+static void sw_integrate(plant_t *pl, sw_cfg_t *cf, double *t, double *x, double len) {
+  const int star = pl->aux.star_n > 0;
   const double hmax = pl->p.ts / pl->p.inverter.substeps;
   const int nsub = (int)ceil(len / hmax - 1e-9);
   const double h = len / (nsub > 0 ? nsub : 1);
@@ -331,6 +348,7 @@ static void sw_integrate(const plant_t *pl, sw_cfg_t *cf, double *t, double *x, 
     double rem = h;
     for (int guard = 0; rem > 1e-12 * pl->p.ts; guard++) {
       double x1[X_N], z0[EV_N], z1[EV_N];
+      const double vs0 = star ? sw_star(pl, cf, *t, x) : 0.0;
       sw_events(pl, cf, *t, x, z0);
       sw_rk4(pl, cf, *t, x, rem, x1);
       sw_events(pl, cf, *t + rem, x1, z1);
@@ -348,6 +366,9 @@ static void sw_integrate(const plant_t *pl, sw_cfg_t *cf, double *t, double *x, 
       if (best < 0) {
         memcpy(x, x1, sizeof x1);
         *t += rem;
+        if (star) {
+          plant_star_filter(pl, vs0, sw_star(pl, cf, *t, x), rem);
+        }
         break;
       }
       double tau = 0.0;
@@ -357,6 +378,9 @@ static void sw_integrate(const plant_t *pl, sw_cfg_t *cf, double *t, double *x, 
         memcpy(x, xb, sizeof xb);
       }
       *t += tau;
+      if (star && tau > 0.0) {
+        plant_star_filter(pl, vs0, sw_star(pl, cf, *t, x), tau);
+      }
       rem -= tau;
       sw_transition(pl, cf, *t, x, best);
     }
@@ -421,7 +445,7 @@ void plant_inverter_sw_period(plant_t *pl, const double on[3], const double off[
   plant_aux_t *a = &pl->aux;
   const double ts = pl->p.ts, td = pl->p.inverter.dead_time;
   edges_t ed[3];
-  double ev[2 + 3 * 2 * SW_MAX_EDGES];
+  double ev[2 + 3 * 2 * SW_MAX_EDGES + PLANT_STAR_MAX];
   int nev = 0;
   ev[nev++] = 0.0;
   ev[nev++] = ts;
@@ -458,7 +482,10 @@ void plant_inverter_sw_period(plant_t *pl, const double on[3], const double off[
       }
     }
   }
-  for (int i = 1; i < nev; i++) { /* insertion sort, <= 26 entries */
+  for (int k = 0; k < a->star_n; k++) {
+    ev[nev++] = a->star_t[k]; /* star-point samples end an interval */
+  }
+  for (int i = 1; i < nev; i++) { /* insertion sort, <= 28 entries */
     const double v = ev[i];
     int k = i - 1;
     while (k >= 0 && ev[k] > v) {
@@ -476,18 +503,26 @@ void plant_inverter_sw_period(plant_t *pl, const double on[3], const double off[
   cf.all_zero = a->all_zero;
   cf.blocked = -1;
   double t = pl->t;
+  int ks = 0;      /* next star-point sample */
+  int vf_init = 0; /* the circuit's state set (settled in the zero vector) */
   for (int i = 0; i + 1 < nev; i++) {
     const double len = ev[i + 1] - ev[i];
-    if (len <= 1e-12 * ts) {
-      continue;
+    if (len > 1e-12 * ts) {
+      const double mid = 0.5 * (ev[i] + ev[i + 1]);
+      int type[3];
+      for (int j = 0; j < 3; j++) {
+        type[j] = gates_on ? leg_type_at(&ed[j], mid, td) : LEG_FLOAT;
+      }
+      sw_setup(pl, &cf, x, type);
+      if (!vf_init && a->star_n > 0) {
+        a->star_vf = sw_star(pl, &cf, t, x);
+        vf_init = 1;
+      }
+      sw_integrate(pl, &cf, &t, x, len);
     }
-    const double mid = 0.5 * (ev[i] + ev[i + 1]);
-    int type[3];
-    for (int j = 0; j < 3; j++) {
-      type[j] = gates_on ? leg_type_at(&ed[j], mid, td) : LEG_FLOAT;
+    while (ks < a->star_n && a->star_t[ks] <= ev[i + 1]) {
+      a->star_v[ks++] = a->star_vf;
     }
-    sw_setup(pl, &cf, x, type);
-    sw_integrate(pl, &cf, &t, x, len);
   }
 
   /* memory for the next period */

@@ -30,6 +30,11 @@ int plant_machine_check(const plant_machine_t *m, const char **field) {
     bad = "machine.lq";
   } else if (!plant_finite_nonneg(m->lambda_m)) {
     bad = "machine.lambda_m";
+  } else if (m->aniso.enabled && !plant_aniso_ok(m)) {
+    bad = "machine.star_m0"; /* the (3.3) matrix is not positive definite */
+  }
+  if (bad == NULL && m->map != NULL && m->aniso.enabled) {
+    bad = "machine.star_m0"; /* the star-point model needs a linear machine */
   }
   if (bad != NULL) {
     *field = bad;

@@ -11,7 +11,10 @@
  *   normals (rng_normal); deterministic for a given seed and call sequence;
  *   no random number is drawn for a zero noise setting.
  * Encoder: mechanical angle floored to 2 pi / encoder_cpr (0 = ideal).
- * Star point: returned exactly (no ADC model), see plant.c.
+ * Star point at the valley (plant_adc_t.v_star): returned exactly (see
+ *   plant.c); the star-point samples of the DFC window go through their own
+ *   channel (plant_star.c: circuit, gain, offset, noise, adc_bits over
+ *   +-star_full_scale).
  */
 #include "plant_internal.h"
 
@@ -31,6 +34,16 @@ int plant_sensors_check(const plant_sensors_t *s, const char **field) {
     bad = "sensors.v_noise";
   } else if (s->encoder_cpr < 0 || s->encoder_cpr > (1 << 30)) {
     bad = "sensors.encoder_cpr";
+  } else if (!plant_finite_nonneg(s->star_full_scale)) {
+    bad = "sensors.star_full_scale";
+  } else if (!(fabs(s->star_gain_error) < 0.5)) {
+    bad = "sensors.star_gain_error";
+  } else if (!(fabs(s->star_offset) < 1e6)) {
+    bad = "sensors.star_offset";
+  } else if (!plant_finite_nonneg(s->star_noise)) {
+    bad = "sensors.star_noise";
+  } else if (!(s->star_tau >= 0.0 && s->star_tau < 1e-3)) {
+    bad = "sensors.star_tau";
   }
   for (int k = 0; bad == NULL && k < 3; k++) {
     if (!(fabs(s->gain_error[k]) < 0.5)) {
@@ -139,6 +152,10 @@ static inline double rng_normal(const plant_aux_t *a, uint64_t *s) {
     return x; /* inside the layer's rectangle */
   }
   return rng_normal_slow(a, s, hz, iz, x);
+}
+
+double plant_sensors_normal(plant_t *pl) {
+  return rng_normal(&pl->aux, &pl->rng);
 }
 
 void plant_sensors_init(plant_t *pl) {

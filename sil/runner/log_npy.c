@@ -14,8 +14,10 @@ static const char *const signals[] = {
     "i_qs_ref",    "flux",        "flux_ref",    "flux_est",   "delta",      "delta_est",
     "v_dc",        "duty_a",      "duty_b",      "duty_c",     "gates",      "state",
     "faults",      "theta_e",     "theta_e_est", "lc_cause",   "torque_max", "flux_mtpa",
-    "torque_mtpv", "gain_a",      "gain_b",      "mtpa_angle", "mtpv_angle"};
-enum { NSIG = sizeof signals / sizeof signals[0], HEADER_LEN = 2048 };
+    "torque_mtpv", "gain_a",      "gain_b",      "mtpa_angle", "mtpv_angle", "theta_e_enc",
+    "dfc_t",       "dfc_ga",      "dfc_gb",      "dfc_gc",     "dfc_k0",     "dfc_k1",
+    "dfc_k2",      "dfc_k3",      "dfc_k4"};
+enum { NSIG = sizeof signals / sizeof signals[0], HEADER_LEN = 4096 };
 
 static void fill_row(const sil_step_t *st, double *r) {
   const plant_state_t *p = st->plant;
@@ -25,6 +27,15 @@ static void fill_row(const sil_step_t *st, double *r) {
   const dfvc_sat_tm_t sat = st->drive->ctrl.law == DRIVE_LAW_DFVC_DECOUPLED
                                 ? st->drive->ctrl.st.dfvc_sat.tm
                                 : (dfvc_sat_tm_t){0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+  /* the star-point source's last estimate (pos_dfc.c; zeros otherwise):
+   * 2 theta after IVD step k, from its unit vector */
+  const bool dfc = (st->drive->pos_src->caps & POS_CAP_GATED) != 0u;
+  const float *tr = st->drive->pos_st.dfc.trace;
+  double k2[5];
+  for (int k = 0; k < 5; ++k) {
+    k2[k] = dfc ? atan2((double)tr[2 * k + 1], (double)tr[2 * k]) : 0.0;
+  }
+  const float *g = st->drive->pos_st.dfc.sig.g;
   double ld = p->lambda_dq[0], lq = p->lambda_dq[1];
   double flux = hypot(ld, lq);
   /* True stator-flux frame currents: projection of i on lambda_s and its
@@ -71,7 +82,17 @@ static void fill_row(const sil_step_t *st, double *r) {
                     sat.gain_a,
                     sat.gain_b,
                     sat.mtpa_angle,
-                    sat.mtpv_angle};
+                    sat.mtpv_angle,
+                    st->scenario->plant.machine.pole_pairs * (double)st->adc->enc_angle,
+                    dfc ? (double)st->drive->pos_st.dfc.t : 0.0,
+                    dfc ? (double)g[0] : 0.0,
+                    dfc ? (double)g[1] : 0.0,
+                    dfc ? (double)g[2] : 0.0,
+                    k2[0],
+                    k2[1],
+                    k2[2],
+                    k2[3],
+                    k2[4]};
   memcpy(r, v, sizeof v);
 }
 

@@ -21,25 +21,38 @@ static const machine_preset_t presets[] = {
     },
     {
         .name = "fabbri2022_t51",
-        .source = "Fabbri 2022, Table 5.1 (inertia and rating assumed, docs/scenarios.md)",
-        .machine = {.pole_pairs = 8, .rs = 2.2, .ld = 394e-6, .lq = 475e-6, .lambda_m = 0.1186},
+        .source = "Fabbri 2022, Table 5.1 (118.6 mVs per mechanical rad/s; inertia and rating "
+                  "assumed, docs/scenarios.md)",
+        .machine = {.pole_pairs = 8,
+                    .rs = 2.2,
+                    .ld = 394e-6,
+                    .lq = 475e-6,
+                    .lambda_m = 0.1186 / 8.0,
+                    /* star point (3.3): a = 0.05, p = -0.0932 (docs/dfc.md) */
+                    .aniso = {.enabled = 1, .m0 = 20e-6, .m2 = -48.54e-6, .phi_iq = 0.0}},
         .inertia = 2e-4,
         .friction = 1e-5,
         .v_dc = 24.0,
         .i_rated = 2.0,
-        .torque_rated = 0.8,
-        .speed_max = 1500.0 * RPM,
+        .torque_rated = 0.5,
+        .speed_max = 1000.0 * RPM,
     },
     {
         .name = "fabbri2022_ebike",
         .source = "Fabbri 2022, Table 5.4 (inertia and rating assumed, docs/scenarios.md)",
-        .machine = {.pole_pairs = 23, .rs = 0.069, .ld = 103e-6, .lq = 149e-6, .lambda_m = 0.0236},
+        .machine = {.pole_pairs = 23,
+                    .rs = 0.069,
+                    .ld = 103e-6,
+                    .lq = 149e-6,
+                    .lambda_m = 0.0236,
+                    /* star point (3.3): a = 0.05, p = -0.1825 (docs/dfc.md) */
+                    .aniso = {.enabled = 1, .m0 = 6e-6, .m2 = -21.42e-6, .phi_iq = 0.0}},
         .inertia = 0.05,
         .friction = 1e-3,
         .v_dc = 24.0,
         .i_rated = 15.0,
         .torque_rated = 15.0,
-        .speed_max = 300.0 * RPM,
+        .speed_max = 200.0 * RPM,
     },
     {
         .name = "syr_1k1",
@@ -115,6 +128,12 @@ void preset_apply(const machine_preset_t *p, plant_params_t *plant, drive_config
   drive->flux_min = 0.2f * drive->lambda_m;
   drive->machine_map = NULL; /* a map preset's: set by the scenario parser */
   plant->machine.map = NULL;
+  if (p->machine.aniso.enabled) { /* the DFC model of the star point (3.7) */
+    double a, b;
+    plant_aniso_ab(&p->machine, &a, &b);
+    drive->dfc_a = (float)a;
+    drive->dfc_b = (float)b;
+  }
   plant->sensors.i_full_scale = 2.5 * drive->i_trip;
   plant->sensors.v_full_scale = 2.0 * p->v_dc;
 }

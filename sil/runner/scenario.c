@@ -250,8 +250,9 @@ static int use_map(ctx_t *c, const char *key, const char *file, scenario_t *sc) 
 }
 
 static int parse_machine(ctx_t *c, const cJSON *m, scenario_t *sc) {
-  static const char *const keys[] = {"preset", "pole_pairs", "rs",  "ld", "lq",
-                                     "ls",     "lambda_m",   "map", NULL};
+  static const char *const keys[] = {"preset",  "pole_pairs", "rs",          "ld",
+                                     "lq",      "ls",         "lambda_m",    "map",
+                                     "star_m0", "star_m2",    "star_phi_iq", NULL};
   if (check_keys(c, m, "machine", keys) != 0) {
     return -1;
   }
@@ -303,6 +304,32 @@ static int parse_machine(ctx_t *c, const cJSON *m, scenario_t *sc) {
       return fail(c, "machine.ls", "give either ls (SPM) or ld and lq, not both");
     }
     pm->ld = pm->lq = ls;
+  }
+  /* the star point's inductance matrix (3.3), plant.h */
+  const int star = cJSON_GetObjectItemCaseSensitive(m, "star_m0") != NULL ||
+                   cJSON_GetObjectItemCaseSensitive(m, "star_m2") != NULL ||
+                   cJSON_GetObjectItemCaseSensitive(m, "star_phi_iq") != NULL;
+  if (star && sc->plant.machine.map != NULL) {
+    return fail(c, "machine.star_m0", "the star-point model needs a linear machine (no map)");
+  }
+  if (get_num(c, m, M, "star_m0", -1.0, 1.0, &pm->aniso.m0) ||
+      get_num(c, m, M, "star_m2", -1.0, 1.0, &pm->aniso.m2) ||
+      get_num(c, m, M, "star_phi_iq", -1.0, 1.0, &pm->aniso.phi_iq)) {
+    return -1;
+  }
+  if (star) {
+    pm->aniso.enabled = 1;
+    if (!plant_aniso_ok(pm)) {
+      return fail(c, "machine.star_m0",
+                  "with ld, lq and star_m2 the (3.3) matrix is not a positive definite inductance "
+                  "matrix carrying the position (L2 != M2)");
+    }
+  }
+  if (pm->aniso.enabled) { /* the controller's DFC model (3.7), unless set */
+    double a, b;
+    plant_aniso_ab(pm, &a, &b);
+    sc->drive.dfc_a = (float)a;
+    sc->drive.dfc_b = (float)b;
   }
   sc->drive.pole_pairs = (float)pm->pole_pairs;
   sc->drive.rs = (float)pm->rs;
@@ -382,8 +409,9 @@ static int parse_mechanics(ctx_t *c, const cJSON *o, scenario_t *sc) {
 
 static int parse_sensors(ctx_t *c, const cJSON *o, scenario_t *sc) {
   static const char *const keys[] = {
-      "adc_bits", "i_full_scale", "v_full_scale", "gain_error", "offset_error",
-      "i_noise",  "v_noise",      "encoder_cpr",  "seed",       NULL};
+      "adc_bits",   "i_full_scale",    "v_full_scale", "gain_error", "offset_error",
+      "i_noise",    "v_noise",         "encoder_cpr",  "seed",       "star_full_scale",
+      "star_noise", "star_gain_error", "star_offset",  "star_tau",   NULL};
   if (check_keys(c, o, "sensors", keys) != 0) {
     return -1;
   }
@@ -396,7 +424,12 @@ static int parse_sensors(ctx_t *c, const cJSON *o, scenario_t *sc) {
       get_num(c, o, "sensors", "v_noise", 0.0, 1e3, &s->v_noise) ||
       get_int(c, o, "sensors", "encoder_cpr", 0, (int)drive_params_by_name("enc_cpr")->max,
               &s->encoder_cpr) ||
-      get_int(c, o, "sensors", "seed", 0, 0x7fffffff, &seed)) {
+      get_int(c, o, "sensors", "seed", 0, 0x7fffffff, &seed) ||
+      get_num(c, o, "sensors", "star_full_scale", 0.0, 1e5, &s->star_full_scale) ||
+      get_num(c, o, "sensors", "star_noise", 0.0, 1e3, &s->star_noise) ||
+      get_num(c, o, "sensors", "star_gain_error", -0.49, 0.49, &s->star_gain_error) ||
+      get_num(c, o, "sensors", "star_offset", -1e3, 1e3, &s->star_offset) ||
+      get_num(c, o, "sensors", "star_tau", 0.0, 1e-4, &s->star_tau)) {
     return -1;
   }
   s->seed = (uint32_t)seed;
@@ -682,6 +715,15 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
                 (profile_term_t){.kind = PROFILE_CONST, .value = sc->plant.dclink.v_source});
   }
   sc->plant.dclink.v_source = profile_eval(&sc->v_source, 0.0);
+  const pos_source_row_t *ps = pos_source(sc->drive.pos_source);
+  if (ps != NULL && (ps->caps & POS_CAP_GATED) != 0u &&
+      sc->plant.inverter.model != PLANT_INV_SWITCHING) {
+    return fail(&c, "inverter.model",
+                "a star-point position source needs the switching model (the DFC window's edges)");
+  }
+  if (ps != NULL && (ps->caps & POS_CAP_GATED) != 0u && !sc->board.asym_edges) {
+    return fail(&c, "board", "a star-point position source needs a board with asymmetric edges");
+  }
   const char *field = "";
   if (plant_check(&sc->plant, &field) != 0) {
     return fail(&c, field, "invalid plant parameter (see docs/scenarios.md)");

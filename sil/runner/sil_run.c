@@ -18,16 +18,28 @@ static double wall_now(void) {
 }
 
 /* The plant's sensors at the valley as the board's sample set. */
-static void to_hal_sample(const plant_adc_t *a, double enc_error, bool enc_ok, hal_sample_t *s) {
-  for (int x = 0; x < 3; ++x) {
-    s->i_abc[x] = (float)a->i_abc[x];
+static void to_hal_sample(const plant_adc_t *a, const sil_ctx_t *x, double enc_error, bool enc_ok,
+                          hal_sample_t *s) {
+  for (int k = 0; k < 3; ++k) {
+    s->i_abc[k] = (float)a->i_abc[k];
   }
   s->v_dc = (float)a->v_dc;
   s->t_i = 0.0f;
-  s->n_star = 1u;
-  s->v_star[0] = (float)a->v_star;
-  s->t_star[0] = 0.0f;
-  s->test_vector = 0u;
+  if (x->star_got > 0) { /* the DFC window of the last period */
+    s->n_star = (uint8_t)x->star_got;
+    for (int k = 0; k < HAL_STAR_MAX; ++k) {
+      s->v_star[k] = k < x->star_got ? (float)x->star_v[k] : 0.0f;
+      s->t_star[k] = k < x->star_got ? (float)x->star_tt[k] : 0.0f;
+    }
+    s->test_vector = x->star_got_tv;
+  } else { /* the star point at the valley */
+    s->n_star = 1u;
+    s->v_star[0] = (float)a->v_star;
+    s->t_star[0] = 0.0f;
+    s->v_star[1] = 0.0f;
+    s->t_star[1] = 0.0f;
+    s->test_vector = 0u;
+  }
   double th = a->enc_angle + enc_error;
   if (!(th >= 0.0 && th < 2.0 * SIL_PI)) { /* fmod is the identity on [0, 2 pi) */
     th = fmod(th, 2.0 * SIL_PI);
@@ -114,6 +126,8 @@ int sil_setup(sil_ctx_t *x, const scenario_t *sc, char *err, size_t errlen) {
     x->pwm_on[j] = 0.25;
     x->pwm_off[j] = 0.75;
   }
+  x->star_n = 0;
+  x->star_got = 0;
   x->enc_err = 0.0;
   x->enc_err_end = -INFINITY;
   x->v_src = 0.0;
@@ -127,7 +141,7 @@ void sil_sample(sil_ctx_t *x, const scenario_t *sc, double t) {
   if (!(t < x->enc_err_end)) {
     x->enc_err = profile_eval_span(&sc->encoder_error, t, &x->enc_err_end);
   }
-  to_hal_sample(&adc, x->enc_err, !injected(&sc->encoder_invalid, t), &x->hal.sample);
+  to_hal_sample(&adc, x, x->enc_err, !injected(&sc->encoder_invalid, t), &x->hal.sample);
 }
 
 void sil_advance(sil_ctx_t *x, const scenario_t *sc, double t) {
@@ -135,12 +149,27 @@ void sil_advance(sil_ctx_t *x, const scenario_t *sc, double t) {
     x->v_src = profile_eval_span(&sc->v_source, t, &x->v_src_end);
   }
   x->plant.p.dclink.v_source = x->v_src;
-  /* the pattern preloaded by the previous ISR acts over this period */
+  /* the pattern preloaded by the previous ISR acts over this period,
+   * with its star-point samples (gates on only) */
+  const int n_star = x->hal.gates_on ? x->star_n : 0;
+  plant_star_request(&x->plant, n_star, x->star_t);
   plant_step_pattern(&x->plant, x->pwm_on, x->pwm_off, x->hal.gates_on);
+  double v[PLANT_STAR_MAX];
+  x->star_got = plant_star_read(&x->plant, v);
+  x->star_got_tv = x->star_tv;
+  for (int k = 0; k < x->star_got && k < HAL_STAR_MAX; ++k) {
+    x->star_v[k] = v[k];
+    x->star_tt[k] = x->plant.aux.star_t[k] - sc->plant.ts;
+  }
   for (int j = 0; j < 3; ++j) {
     x->pwm_on[j] = x->hal.pwm.on[j];
     x->pwm_off[j] = x->hal.pwm.off[j];
   }
+  x->star_n = x->hal.pwm.n_star;
+  for (int k = 0; k < HAL_STAR_MAX; ++k) {
+    x->star_t[k] = x->hal.pwm.t_star_req[k];
+  }
+  x->star_tv = x->hal.pwm.test_vector;
   /* hardware comparator: gates off in hardware, latched */
   if (sc->hw_trip > 0.0 && x->hal.gates_on) {
     plant_brief_t br;

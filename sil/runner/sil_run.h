@@ -95,8 +95,16 @@ typedef struct {
   drive_t drv;
   hal_sil_t hal;
   double pwm_on[3], pwm_off[3]; /* the pattern acting over the present period */
-  double enc_err, enc_err_end;  /* encoder error profile, constant until _end */
-  double v_src, v_src_end;      /* DC source profile, constant until _end */
+  /* its star-point requests, and the samples they gave (delivered with the
+   * next sample set: taken in the period before it, t_star < 0) */
+  int star_n;
+  double star_t[HAL_STAR_MAX];
+  uint8_t star_tv;
+  int star_got;
+  double star_v[HAL_STAR_MAX], star_tt[HAL_STAR_MAX];
+  uint8_t star_got_tv;
+  double enc_err, enc_err_end; /* encoder error profile, constant until _end */
+  double v_src, v_src_end;     /* DC source profile, constant until _end */
 } sil_ctx_t;
 
 /* Plant, HAL and drive from the scenario; 0 or -1 with the message. */

@@ -1,0 +1,148 @@
+/*
+ * pos_dfc.c - the star point as a position source: Direct Flux Control
+ * (standard, inverse) and Iterative Vector Decoupling (IVD, Full IVD),
+ * Fabbri 2022 chapter 3, on estimation/dfc.h; speed by the angle PLL until
+ * a Kalman filter replaces it.
+ *
+ * Each period brings one component of the DFC signal vector (the test
+ * vector of the last window, hal_sample_t.test_vector, and the star-point
+ * samples around its edge); the others are held, so the vector mixes three
+ * consecutive periods: it is dated at the middle one, one period before
+ * the newest sample (the sequentiality effect, docs/dfc.md), and the drive
+ * extrapolates the angle from that instant with the PLL's speed.
+ * The estimate is 2 theta_e. The branch (theta or theta + pi) follows the
+ * PLL's prediction; the magnet's polarity is resolved once, by the
+ * alignment: with the rotor held at theta = 0 by the d current, the branch
+ * nearest 0 is the north pole (Fabbri 2022, 3.1.3). Hence align_time > 0.
+ */
+#include <stddef.h>
+
+#include "math/cordic_q31.h"
+#include "math/fd_math.h"
+#include "math/frames.h"
+#include "pos_source.h"
+
+static dfc_method_t method_of(pos_source_t src, const drive_config_t *cfg) {
+  if (src == POS_SOURCE_DFC_INV) {
+    return DFC_INVERSE;
+  }
+  if (src == POS_SOURCE_IVD) {
+    return (fabsf(cfg->dfc_phi_a) > 0.0f || fabsf(cfg->dfc_phi_b) > 0.0f) ? DFC_FULL_IVD : DFC_IVD;
+  }
+  return DFC_STANDARD;
+}
+
+static dfc_cfg_t cfg_of(const drive_config_t *cfg) {
+  const dfc_cfg_t d = {method_of(cfg->pos_source, cfg),
+                       cfg->dfc_a,
+                       cfg->dfc_b,
+                       cfg->dfc_phi_a,
+                       cfg->dfc_phi_b,
+                       cfg->dfc_iter};
+  return d;
+}
+
+static void dfc_init(pos_state_t *s, const drive_config_t *cfg) {
+  angle_pll_init(&s->dfc.pll, cfg->pll_bw, cfg->ts);
+  s->dfc.dc = cfg_of(cfg);
+  dfc_signals_reset(&s->dfc.sig);
+  s->dfc.started = false;
+  s->dfc.t = 0.0f;
+  s->dfc.n = 0u;
+  for (unsigned k = 0u; k < 2u * (DFC_ITER_MAX + 1u); ++k) {
+    s->dfc.trace[k] = 0.0f;
+  }
+}
+
+static void dfc_reset(pos_state_t *s) {
+  dfc_signals_reset(&s->dfc.sig);
+  s->dfc.started = false;
+  s->dfc.n = 0u;
+}
+
+/* The branch of 2 theta / 2 nearest ref. */
+static float nearest_branch(float theta0, float ref) {
+  const float d = frames_wrap_pi(theta0 - ref);
+  return (d > 0.5f * FRAMES_PI || d < -0.5f * FRAMES_PI) ? frames_wrap_pi(theta0 + FRAMES_PI)
+                                                         : theta0;
+}
+
+static void dfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
+                       const pos_in_t *in, pos_estimate_t *out) {
+  angle_pll_t *pll = &s->dfc.pll;
+  /* the live parameters (b, iterations, phase shifts) in force */
+  s->dfc.dc = cfg_of(cfg);
+  /* the component's instant: the edge, between the two samples; counted
+   * in periods since the reset (isr) so that the held ones keep theirs */
+  s->dfc.n++;
+  const float t_edge = 0.5f * (smp->t_star[0] + smp->t_star[1]);
+  if (smp->n_star >= 2u && dfc_signals_push(&s->dfc.sig, smp->test_vector, smp->v_star[0],
+                                            smp->v_star[1], smp->v_dc, t_edge)) {
+    s->dfc.sig.t[s->dfc.sig.last] = (float)s->dfc.n * cfg->ts + t_edge;
+    s->dfc.t = t_edge;
+  } else {
+    s->dfc.t -= cfg->ts; /* the newest component ages by a period */
+  }
+  out->t = s->dfc.t;
+  float c2 = 1.0f, s2 = 0.0f;
+  dfc_vec_t v;
+  const bool full = dfc_signals_complete(&s->dfc.sig);
+  if (full) { /* sequentiality: the held components turned to the newest */
+    dfc_signals_vector(&s->dfc.sig, 2.0f * pll->omega, &v);
+  }
+  const bool ok =
+      full && dfc_vector2(&s->dfc.dc, s->dfc.sig.g, &v, in->i_q, &c2, &s2, s->dfc.trace);
+  out->valid = ok;
+  if (!ok) {
+    angle_pll_update(pll, NAN); /* coast */
+    out->theta = pll->theta;
+    out->omega = pll->omega;
+    out->rate = pll->omega_rate;
+    out->health = 0.0f;
+    return;
+  }
+  const float theta0 = 0.5f * fd_cordic_atan2f(s2, c2); /* (3.10), branch 0 */
+  if (!s->dfc.started) {
+    angle_pll_reset(pll, theta0, 0.0f); /* polarity: the alignment decides */
+    s->dfc.started = true;
+  }
+  const float th = nearest_branch(theta0, pll->theta);
+  out->health = fabsf(frames_wrap_pi(th - pll->theta)); /* measured - predicted */
+  angle_pll_update(pll, th);
+  out->theta = th;
+  out->omega = pll->omega;
+  out->rate = pll->omega_rate;
+}
+
+/* Held at electrical angle theta by the alignment: the branch nearest it. */
+static void dfc_align(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
+                      float theta) {
+  (void)cfg;
+  (void)smp;
+  const float th = nearest_branch(s->dfc.pll.theta, theta);
+  angle_pll_reset(&s->dfc.pll, th, 0.0f);
+  s->dfc.started = true;
+}
+
+static const char *dfc_check_cfg(const drive_config_t *cfg, const char **field) {
+  const dfc_cfg_t d = cfg_of(cfg);
+  const int e = dfc_check(&d);
+  if (e != DFC_OK) {
+    *field = e == DFC_ERR_P ? "dfc_b" : (e == DFC_ERR_PHI ? "dfc_phi_a" : "dfc_a");
+    return dfc_strerror(e);
+  }
+  if (!(cfg->align_time > 0.0f)) {
+    *field = "align_time";
+    return "a star-point source resolves the magnet's polarity by the alignment: align_time > 0";
+  }
+  return NULL;
+}
+
+#define POS_DFC_ROW(n)                                                                             \
+  const pos_source_row_t pos_source_##n = {#n,           POS_CAP_ALIGN | POS_CAP_GATED,            \
+                                           dfc_init,     dfc_reset,                                \
+                                           dfc_update,   dfc_align,                                \
+                                           dfc_check_cfg}
+POS_DFC_ROW(dfc);
+POS_DFC_ROW(dfc_inv);
+POS_DFC_ROW(ivd);

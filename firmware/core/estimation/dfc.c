@@ -1,0 +1,231 @@
+/*
+ * dfc.c - Direct Flux Control position with Iterative Vector Decoupling
+ * (see dfc.h; Fabbri 2022, (2.101), (3.6)-(3.16), (3.76), (3.100)).
+ */
+#include "dfc.h"
+
+#include <stddef.h>
+
+#include "math/cordic_q31.h"
+#include "math/fd_math.h"
+#include "math/frames.h"
+
+#define DFC_SQRT3_INV 0.57735026918962576f
+#define DFC_PHI_MAX   1.0f /* rad/A: a phase shift model beyond this is a typo */
+
+int dfc_check(const dfc_cfg_t *c) {
+  if ((unsigned)c->method > (unsigned)DFC_FULL_IVD) {
+    return DFC_ERR_METHOD;
+  }
+  if (!fd_isfinite(c->a) || !fd_isfinite(c->b) || !(fabsf(c->a) > 0.0f)) {
+    return DFC_ERR_A;
+  }
+  if (c->iterations > DFC_ITER_MAX) {
+    return DFC_ERR_ITER;
+  }
+  if (!(fabsf(c->phi_a) <= DFC_PHI_MAX) || !(fabsf(c->phi_b) <= DFC_PHI_MAX)) {
+    return DFC_ERR_PHI;
+  }
+  /* Theorem 1: |Delta_k| -> 0 iff |p| < 1/2 */
+  if ((c->method == DFC_IVD || c->method == DFC_FULL_IVD) && !(fabsf(c->b) < 0.5f * fabsf(c->a))) {
+    return DFC_ERR_P;
+  }
+  return DFC_OK;
+}
+
+const char *dfc_strerror(int err) {
+  switch (err) {
+  case DFC_OK:
+    return "ok";
+  case DFC_ERR_METHOD:
+    return "unknown DFC method";
+  case DFC_ERR_A:
+    return "the DFC amplitude a must be finite and non-zero, b finite";
+  case DFC_ERR_P:
+    return "IVD needs |p| = |b/a| < 1/2 (Theorem 1: no convergence otherwise)";
+  case DFC_ERR_ITER:
+    return "too many IVD iterations";
+  case DFC_ERR_PHI:
+    return "Full IVD phase shifts must be finite, within 1 rad/A";
+  default:
+    return "?";
+  }
+}
+
+void dfc_signals_reset(dfc_signals_t *s) {
+  for (int x = 0; x < 3; ++x) {
+    s->g[x] = 0.0f;
+    s->t[x] = 0.0f;
+  }
+  s->have = 0u;
+  s->last = 0u;
+}
+
+bool dfc_signals_push(dfc_signals_t *s, uint8_t tv, float v_before, float v_after, float v_dc,
+                      float t) {
+  const int x = tv == 1u ? 0 : (tv == 3u ? 1 : (tv == 5u ? 2 : -1));
+  if (x < 0 || !fd_isfinite(v_before) || !fd_isfinite(v_after) || !(v_dc > 0.0f) ||
+      !fd_isfinite(v_dc)) {
+    return false;
+  }
+  /* (2.96)-(2.101): the virtual star point steps by v_dc / 3 */
+  s->g[x] = (v_after - v_before) / v_dc - (1.0f / 3.0f);
+  s->t[x] = t;
+  s->have |= (uint8_t)(1u << x);
+  s->last = (uint8_t)x;
+  return true;
+}
+
+void dfc_vec_plain(const float g[3], dfc_vec_t *v) {
+  v->al = (2.0f * g[0] - g[1] - g[2]) * (1.0f / 3.0f);
+  v->be = (g[1] - g[2]) * DFC_SQRT3_INV;
+  v->k[0] = 1.0f;
+  v->k[1] = 0.0f;
+  v->k[2] = 0.0f;
+  v->k[3] = 1.0f;
+}
+
+void dfc_signals_vector(const dfc_signals_t *s, float w2, dfc_vec_t *v) {
+  /* phase axes c_x of the amplitude-invariant Clarke transform */
+  static const float cx[3][2] = {{1.0f, 0.0f}, {-0.5f, 0.86602540f}, {-0.5f, -0.86602540f}};
+  const float t_new = s->t[s->last];
+  float a11 = 0.0f, a12 = 0.0f, a22 = 0.0f, r1 = 0.0f, r2 = 0.0f;
+  float b11 = 0.0f, b12 = 0.0f, b21 = 0.0f, b22 = 0.0f;
+  for (int x = 0; x < 3; ++x) {
+    /* phi = 2 omega_e (t_new - t_x): the 2theta term was e^{+j phi} ahead,
+     * so Gamma_x projects it on c_x e^{-j phi} (d); the 4theta term was
+     * e^{-j2phi} behind: on c_x e^{+j2phi} (e) */
+    const float phi = w2 * (t_new - s->t[x]);
+    const float co = 1.0f - 0.5f * phi * phi, si = -phi;
+    const float co2 = 1.0f - 2.0f * phi * phi, si2 = 2.0f * phi;
+    const float d1 = cx[x][0] * co - cx[x][1] * si, d2 = cx[x][0] * si + cx[x][1] * co;
+    const float e1 = cx[x][0] * co2 - cx[x][1] * si2, e2 = cx[x][0] * si2 + cx[x][1] * co2;
+    a11 += d1 * d1;
+    a12 += d1 * d2;
+    a22 += d2 * d2;
+    r1 += d1 * s->g[x];
+    r2 += d2 * s->g[x];
+    b11 += d1 * e1;
+    b12 += d1 * e2;
+    b21 += d2 * e1;
+    b22 += d2 * e2;
+  }
+  const float det = a11 * a22 - a12 * a12; /* 9/4 for phi = 0 */
+  const float k = det > 0.5f ? 1.0f / det : 0.0f;
+  v->al = (a22 * r1 - a12 * r2) * k;
+  v->be = (a11 * r2 - a12 * r1) * k;
+  /* K = A^-1 B, conjugated: C K C */
+  const float k11 = (a22 * b11 - a12 * b21) * k, k12 = (a22 * b12 - a12 * b22) * k;
+  const float k21 = (a11 * b21 - a12 * b11) * k, k22 = (a11 * b22 - a12 * b12) * k;
+  v->k[0] = k11;
+  v->k[1] = -k12;
+  v->k[2] = -k21;
+  v->k[3] = k22;
+}
+
+/* u <- w / |w|; false when |w| is zero or not finite */
+static inline bool dfc_normalise(float wr, float wi, float *ur, float *ui) {
+  const float m2 = wr * wr + wi * wi;
+  if (!(m2 > 1e-30f) || !fd_isfinite(m2)) {
+    return false;
+  }
+  const float k = 1.0f / sqrtf(m2);
+  *ur = wr * k;
+  *ui = wi * k;
+  return true;
+}
+
+bool dfc_ivd_step(float zr, float zi, float p, const float k[4], const float rb[2],
+                  const float ra[2], float *ur, float *ui) {
+  /* e^{-j4theta_{k-1}} = conj(u)^2; times r_b = e^{-j phi_b} (3.100); the
+   * sequentiality map K */
+  const float sr = *ur * *ur - *ui * *ui, si = -2.0f * *ur * *ui;
+  const float tr = sr * rb[0] - si * rb[1], ti = sr * rb[1] + si * rb[0];
+  const float qr = k[0] * tr + k[1] * ti, qi = k[2] * tr + k[3] * ti;
+  float vr, vi;
+  if (!dfc_normalise(zr + p * qr, zi + p * qi, &vr, &vi)) {
+    return false;
+  }
+  /* minus phi_a: times r_a = e^{-j phi_a} */
+  *ur = vr * ra[0] - vi * ra[1];
+  *ui = vr * ra[1] + vi * ra[0];
+  return true;
+}
+
+/* Clarke (amplitude invariant) of three components */
+static inline void dfc_clarke(const float x[3], float *al, float *be) {
+  *al = (2.0f * x[0] - x[1] - x[2]) * (1.0f / 3.0f);
+  *be = (x[1] - x[2]) * DFC_SQRT3_INV;
+}
+
+bool dfc_vector2(const dfc_cfg_t *c, const float g[3], const dfc_vec_t *v, float i_q, float *c2,
+                 float *s2, float *trace) {
+  float ur = 1.0f, ui = 0.0f;
+  bool ok;
+  *c2 = 1.0f;
+  *s2 = 0.0f;
+  if (c->method == DFC_INVERSE) {
+    /* (3.15): kappa_x = sum L_Sigma / L_Sigma,x = 1 / (Gamma_x / v_dc + 1/3);
+     * (3.16): its Clarke vector turns as e^{-j2theta} */
+    float k[3], ka, kb;
+    for (int x = 0; x < 3; ++x) {
+      const float d = g[x] + (1.0f / 3.0f);
+      k[x] = fabsf(d) > 1e-6f ? 1.0f / d : 0.0f;
+    }
+    dfc_clarke(k, &ka, &kb);
+    const float sg = c->a > 0.0f ? 1.0f : -1.0f;
+    ok = dfc_normalise(sg * ka, -sg * kb, &ur, &ui);
+    if (ok && trace != NULL) {
+      trace[0] = ur;
+      trace[1] = ui;
+    }
+  } else {
+    const float inv_a = 1.0f / c->a;
+    const float zr = -v->al * inv_a, zi = v->be * inv_a; /* zeta = e^{j2th} - p e^{-j4th} */
+    const bool full = c->method == DFC_FULL_IVD;
+    float ra[2] = {1.0f, 0.0f}, rb[2] = {1.0f, 0.0f};
+    if (full) {
+      const sincos_t pa = frames_sincos(c->phi_a * i_q), pb = frames_sincos(c->phi_b * i_q);
+      ra[0] = pa.c;
+      ra[1] = -pa.s;
+      rb[0] = pb.c;
+      rb[1] = -pb.s;
+    }
+    /* (3.8) / (3.98): the raw estimate */
+    ok = dfc_normalise(zr, zi, &ur, &ui);
+    if (ok && full) {
+      const float r = ur * ra[0] - ui * ra[1];
+      ui = ur * ra[1] + ui * ra[0];
+      ur = r;
+    }
+    if (ok && trace != NULL) {
+      trace[0] = ur;
+      trace[1] = ui;
+    }
+    const uint32_t n = (c->method == DFC_IVD || full)
+                           ? (c->iterations < DFC_ITER_MAX ? c->iterations : DFC_ITER_MAX)
+                           : 0u;
+    const float p = c->b * inv_a;
+    for (uint32_t k = 1u; ok && k <= n; ++k) { /* (3.76) / (3.100) */
+      ok = dfc_ivd_step(zr, zi, p, v->k, rb, ra, &ur, &ui);
+      if (ok && trace != NULL) {
+        trace[2u * k] = ur;
+        trace[2u * k + 1u] = ui;
+      }
+    }
+  }
+  if (!ok) {
+    return false;
+  }
+  *c2 = ur;
+  *s2 = ui;
+  return true;
+}
+
+float dfc_angle2(const dfc_cfg_t *c, const float g[3], float i_q, bool *ok) {
+  float c2, s2;
+  dfc_vec_t v;
+  dfc_vec_plain(g, &v);
+  *ok = dfc_vector2(c, g, &v, i_q, &c2, &s2, NULL);
+  return fd_cordic_atan2f(s2, c2);
+}

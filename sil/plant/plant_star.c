@@ -1,0 +1,166 @@
+/*
+ * plant_star.c - the star-point voltage of the star-connected machine
+ * (Fabbri 2022, section 2.3.1) and its measurement.
+ *
+ * With no star-point current (sum of i_abc = 0) the machine equation
+ * v_XO - v_NO T^T = R i + L di/dt + omega_e dL/dtheta_e i + e fixes v_NO:
+ * T L^-1 (...) = T di/dt = 0 gives
+ *   v_NO = G_c (v_XO - R i - omega_e dL/dtheta_e i - e),
+ *   G_c  = L_Sigma / (L_Sigma T^T),  L_Sigma = T adj(L)          (2.64), (2.90)
+ * with the (3.3) inductance matrix L(theta_e) (plant.h: plant_aniso_t).
+ * This is the static divider of the star point at every instant: at a
+ * switching edge v_NO jumps by G_c times the step of the leg potentials,
+ * so the DFC signal (2.101) emerges from two samples around the edge; the
+ * slow terms (back-EMF, resistive, dL/dt) are continuous and cancel in the
+ * difference (2.92). Without anisotropy (aniso.enabled = 0, the (2.31)
+ * matrix, singular) the star point is the mean of the leg potentials.
+ * The measurement circuit is a first-order low-pass of time constant
+ * star_tau, integrated exactly for an input linear over each step of the
+ * switching model (first-order hold); the samples go through the star
+ * channel's ADC in plant_star_read().
+ */
+#include "plant_internal.h"
+
+#include <math.h>
+
+/* The (3.3) matrix at x = 2 theta_e (+ the load shift) and its derivative
+ * with respect to theta_e. */
+static void star_matrix_of(double l0, double l2, double m0, double m2, double x, double L[3][3],
+                           double dL[3][3]) {
+  const double q = 2.0 * PLANT_PI / 3.0;
+  const double self[3] = {x, x + q, x + 2.0 * q};
+  const double mut[3] = {x - q, x + q, x}; /* ab, ac, bc */
+  for (int k = 0; k < 3; k++) {
+    L[k][k] = l0 + l2 * cos(self[k]);
+    dL[k][k] = -2.0 * l2 * sin(self[k]);
+  }
+  const int r[3] = {0, 0, 1}, c[3] = {1, 2, 2};
+  for (int k = 0; k < 3; k++) {
+    L[r[k]][c[k]] = L[c[k]][r[k]] = m0 + m2 * cos(mut[k]);
+    dL[r[k]][c[k]] = dL[c[k]][r[k]] = -2.0 * m2 * sin(mut[k]);
+  }
+}
+
+static void star_matrix(const plant_t *pl, double x, double L[3][3], double dL[3][3]) {
+  star_matrix_of(pl->aux.l0, pl->aux.l2, pl->p.machine.aniso.m0, pl->p.machine.aniso.m2, x, L, dL);
+}
+
+/* The matrix from (ld, lq, m0, m2) must be an inductance matrix: positive
+ * definite at every angle (leading minors, checked every degree of 2
+ * theta_e), and carry the position (L2 != M2, first condition of (3.7)). */
+int plant_aniso_ok(const plant_machine_t *m) {
+  const double m0 = m->aniso.m0, m2 = m->aniso.m2;
+  if (!(isfinite(m0) && isfinite(m2) && fabs(m->aniso.phi_iq) < 10.0)) {
+    return 0;
+  }
+  const double l0 = 0.5 * (m->ld + m->lq) + m0, l2 = (m->ld - m->lq) - 2.0 * m2;
+  if (!(fabs(l2 - m2) > 1e-9 * l0)) {
+    return 0;
+  }
+  for (int k = 0; k < 360; k++) {
+    double L[3][3], dL[3][3];
+    star_matrix_of(l0, l2, m0, m2, k * (PLANT_PI / 180.0), L, dL);
+    const double d2 = L[0][0] * L[1][1] - L[0][1] * L[1][0];
+    const double d3 = L[0][0] * (L[1][1] * L[2][2] - L[1][2] * L[2][1]) -
+                      L[0][1] * (L[1][0] * L[2][2] - L[1][2] * L[2][0]) +
+                      L[0][2] * (L[1][0] * L[2][1] - L[1][1] * L[2][0]);
+    if (!(L[0][0] > 0.0 && d2 > 0.0 && d3 > 0.0)) {
+      return 0;
+    }
+  }
+  return 1;
+}
+
+/* g = T adj(L) / (T adj(L) T^T): the column sums of the adjugate of the
+ * symmetric L, normalised (the determinant cancels). */
+static void star_divider(const double L[3][3], double g[3]) {
+  double s[3] = {0.0, 0.0, 0.0}, sum = 0.0;
+  for (int i = 0; i < 3; i++) {
+    const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+    for (int j = 0; j < 3; j++) {
+      const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+      s[j] += L[i1][j1] * L[i2][j2] - L[i1][j2] * L[i2][j1]; /* cofactor C_ij = adj_ji */
+    }
+  }
+  for (int j = 0; j < 3; j++) {
+    sum += s[j];
+  }
+  for (int j = 0; j < 3; j++) {
+    g[j] = s[j] / sum;
+  }
+}
+
+void plant_star_gain(const plant_t *pl, double theta_e, double i_q, double g[3]) {
+  if (!pl->p.machine.aniso.enabled) {
+    g[0] = g[1] = g[2] = 1.0 / 3.0;
+    return;
+  }
+  double L[3][3], dL[3][3];
+  star_matrix(pl, 2.0 * theta_e + pl->p.machine.aniso.phi_iq * i_q, L, dL);
+  star_divider(L, g);
+}
+
+double plant_star_vn(const plant_t *pl, const double v[3], const double i[3], double th_e,
+                     double we, double i_q, const double e[3]) {
+  if (!pl->p.machine.aniso.enabled) {
+    return (v[0] + v[1] + v[2]) * (1.0 / 3.0);
+  }
+  double L[3][3], dL[3][3], g[3];
+  star_matrix(pl, 2.0 * th_e + pl->p.machine.aniso.phi_iq * i_q, L, dL);
+  star_divider(L, g);
+  double vn = 0.0;
+  for (int k = 0; k < 3; k++) {
+    const double dli = dL[k][0] * i[0] + dL[k][1] * i[1] + dL[k][2] * i[2];
+    vn += g[k] * (v[k] - pl->p.machine.rs * i[k] - we * dli - e[k]);
+  }
+  return vn;
+}
+
+void plant_star_filter(plant_t *pl, double v0, double v1, double h) {
+  const double tau = pl->p.sensors.star_tau;
+  if (!(tau > 0.0) || !(h > 0.0)) {
+    pl->aux.star_vf = v1;
+    return;
+  }
+  const double r = h / tau;
+  const double e = exp(-r);
+  /* exact for v(t) linear from v0 to v1 over h; 1 - e = r - r^2/2 ... for
+   * small r */
+  const double one_e = r < 1e-6 ? r * (1.0 - 0.5 * r) : 1.0 - e;
+  pl->aux.star_vf = v1 + (pl->aux.star_vf - v0) * e - (v1 - v0) * one_e / r;
+}
+
+void plant_star_request(plant_t *pl, int n, const double t_req[]) {
+  plant_aux_t *a = &pl->aux;
+  a->star_n = 0;
+  for (int k = 0; k < n && k < PLANT_STAR_MAX; k++) {
+    const double t = t_req[k];
+    if (t > 0.0 && t < pl->p.ts && (k == 0 || t > a->star_t[k - 1])) {
+      a->star_t[a->star_n++] = t;
+    }
+  }
+}
+
+int plant_star_read(plant_t *pl, double v[PLANT_STAR_MAX]) {
+  const plant_sensors_t *s = &pl->p.sensors;
+  const plant_aux_t *a = &pl->aux;
+  const double fs = s->star_full_scale > 0.0 ? s->star_full_scale : 0.5 * s->v_full_scale;
+  const double lsb = 2.0 * fs / a->adc_levels;
+  for (int k = 0; k < a->star_n; k++) {
+    const double noise = s->star_noise > 0.0 ? s->star_noise * plant_sensors_normal(pl) : 0.0;
+    const double raw =
+        (1.0 + s->star_gain_error) * (a->star_v[k] - 0.5 * pl->v_dc) + s->star_offset + noise;
+    double code = floor(raw / lsb + 0.5) + 0.5 * a->adc_levels;
+    code = code < 0.0 ? 0.0 : (code > a->adc_levels - 1.0 ? a->adc_levels - 1.0 : code);
+    v[k] = (code - 0.5 * a->adc_levels) * lsb;
+  }
+  return a->star_n;
+}
+
+void plant_aniso_ab(const plant_machine_t *m, double *a, double *b) {
+  const double l0 = 0.5 * (m->ld + m->lq) + m->aniso.m0, l2 = (m->ld - m->lq) - 2.0 * m->aniso.m2;
+  const double g0 = l0 - m->aniso.m0, g2 = 0.5 * l2 + m->aniso.m2;
+  const double k = (l2 - m->aniso.m2) / (3.0 * (g0 * g0 - g2 * g2)); /* (3.7) */
+  *a = g0 * k;
+  *b = g2 * k;
+}

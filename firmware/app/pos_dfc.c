@@ -12,8 +12,16 @@
  * extrapolates the angle from that instant with the PLL's speed.
  * The estimate is 2 theta_e. The branch (theta or theta + pi) follows the
  * PLL's prediction; the magnet's polarity is resolved once, by the
- * alignment: with the rotor held at theta = 0 by the d current, the branch
- * nearest 0 is the north pole (Fabbri 2022, 3.1.3). Hence align_time > 0.
+ * alignment (Fabbri 2022, 3.1.3; hence align_time > 0): the d current
+ * along theta = 0 pulls the rotor with a torque of the sign of
+ * -sin(theta). The tracked estimate is theta or theta + pi; over the
+ * alignment the source sums the change of its speed times -sin(estimate):
+ * positive when the estimate is theta (the rotor accelerates the way the
+ * torque pulls), negative when it is theta + pi. A rotor that does not
+ * move (already at 0, or held) leaves the sum near zero: then the branch
+ * nearest 0 is taken, where the current holds the north pole. A light
+ * rotor swinging through the alignment is thus resolved as well as one
+ * that settles (tests: both magnet polarities).
  */
 #include <stddef.h>
 
@@ -49,6 +57,8 @@ static void dfc_init(pos_state_t *s, const drive_config_t *cfg) {
   s->dfc.started = false;
   s->dfc.t = 0.0f;
   s->dfc.n = 0u;
+  s->dfc.pol_acc = 0.0f;
+  s->dfc.w_prev = 0.0f;
   for (unsigned k = 0u; k < 2u * (DFC_ITER_MAX + 1u); ++k) {
     s->dfc.trace[k] = 0.0f;
   }
@@ -58,6 +68,8 @@ static void dfc_reset(pos_state_t *s) {
   dfc_signals_reset(&s->dfc.sig);
   s->dfc.started = false;
   s->dfc.n = 0u;
+  s->dfc.pol_acc = 0.0f;
+  s->dfc.w_prev = 0.0f;
 }
 
 /* The branch of 2 theta / 2 nearest ref. */
@@ -112,16 +124,31 @@ static void dfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_samp
   out->theta = th;
   out->omega = pll->omega;
   out->rate = pll->omega_rate;
+  /* the polarity evidence (used by the alignment) */
+  s->dfc.pol_acc -= (pll->omega - s->dfc.w_prev) * frames_sincos(th).s;
+  s->dfc.w_prev = pll->omega;
 }
 
-/* Held at electrical angle theta by the alignment: the branch nearest it. */
+/* The alignment towards electrical angle theta (0) ends: the polarity
+ * from the motion it caused, or, without motion, the branch nearest it. */
+#define POS_DFC_POL_MIN 2.0f /* rad/s electrical: evidence of motion */
 static void dfc_align(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
                       float theta) {
   (void)cfg;
   (void)smp;
-  const float th = nearest_branch(s->dfc.pll.theta, theta);
-  angle_pll_reset(&s->dfc.pll, th, 0.0f);
+  angle_pll_t *pll = &s->dfc.pll;
+  const float acc = s->dfc.pol_acc;
+  float th;
+  if (acc > POS_DFC_POL_MIN) {
+    th = pll->theta; /* the estimate moved as the torque pulled: theta */
+  } else if (acc < -POS_DFC_POL_MIN) {
+    th = frames_wrap_pi(pll->theta + FRAMES_PI); /* theta + pi */
+  } else {
+    th = nearest_branch(pll->theta, theta);
+  }
+  angle_pll_reset(pll, th, pll->omega);
   s->dfc.started = true;
+  s->dfc.pol_acc = 0.0f;
 }
 
 static const char *dfc_check_cfg(const drive_config_t *cfg, const char **field) {

@@ -61,6 +61,9 @@ typedef union {
     float trace[2u * (DFC_ITER_MAX + 1u)];
     float t;
     uint32_t n; /* periods since the reset (the components' time base) */
+    /* polarity: sum of the speed change times -sin(theta) while the
+     * alignment pulls the rotor towards 0 (pos_dfc.c) */
+    float pol_acc, w_prev;
   } dfc;
 } pos_state_t;
 

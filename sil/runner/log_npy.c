@@ -16,7 +16,8 @@ static const char *const signals[] = {
     "faults",      "theta_e",     "theta_e_est", "lc_cause",   "torque_max", "flux_mtpa",
     "torque_mtpv", "gain_a",      "gain_b",      "mtpa_angle", "mtpv_angle", "theta_e_enc",
     "dfc_t",       "dfc_ga",      "dfc_gb",      "dfc_gc",     "dfc_k0",     "dfc_k1",
-    "dfc_k2",      "dfc_k3",      "dfc_k4"};
+    "dfc_k2",      "dfc_k3",      "dfc_k4",      "dfc_k5",     "dfc_k6",     "dfc_k7",
+    "dfc_k8"};
 enum { NSIG = sizeof signals / sizeof signals[0], HEADER_LEN = 4096 };
 
 static void fill_row(const sil_step_t *st, double *r) {
@@ -31,8 +32,8 @@ static void fill_row(const sil_step_t *st, double *r) {
    * 2 theta after IVD step k, from its unit vector */
   const bool dfc = (st->drive->pos_src->caps & POS_CAP_GATED) != 0u;
   const float *tr = st->drive->pos_st.dfc.trace;
-  double k2[5];
-  for (int k = 0; k < 5; ++k) {
+  double k2[DFC_ITER_MAX + 1u];
+  for (unsigned k = 0u; k <= DFC_ITER_MAX; ++k) {
     k2[k] = dfc ? atan2((double)tr[2 * k + 1], (double)tr[2 * k]) : 0.0;
   }
   const float *g = st->drive->pos_st.dfc.sig.g;
@@ -92,7 +93,11 @@ static void fill_row(const sil_step_t *st, double *r) {
                     k2[1],
                     k2[2],
                     k2[3],
-                    k2[4]};
+                    k2[4],
+                    k2[5],
+                    k2[6],
+                    k2[7],
+                    k2[8]};
   memcpy(r, v, sizeof v);
 }
 

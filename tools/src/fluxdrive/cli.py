@@ -228,6 +228,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--doc", metavar="MD", help="markdown file whose results tables are replaced")
     p.set_defaults(func=_cmd_varatharajan)
 
+    p = sub.add_parser("fabbri2022",
+                       help="reproduce Fabbri 2022 (DFC + IVD star-point position) in SIL")
+    p.add_argument("--sil", metavar="PATH", help=sil_help)
+    p.add_argument("--out", metavar="DIR", help="logs (default: out/fabbri2022)")
+    p.add_argument("--figures", metavar="DIR", help="figures (default: docs/figures)")
+    p.add_argument("--doc", metavar="MD", help="markdown file whose results tables are replaced")
+    p.set_defaults(func=_cmd_fabbri)
+
     p = sub.add_parser("pil", help="PIL: replay a scenario's ISRs on QEMU, compare, count")
     p.add_argument("scenario", nargs="+", metavar="SCENARIO", help="scenario JSON file(s)")
     p.add_argument("--law", metavar="LAWS", help="foc,pi_dfvc,db_dfvc (default: the scenario's)")
@@ -290,6 +298,12 @@ def _cmd_rubino(args: argparse.Namespace) -> int:
     from fluxdrive.rubino2020 import main_rubino
 
     return main_rubino(args)
+
+
+def _cmd_fabbri(args: argparse.Namespace) -> int:
+    from fluxdrive.fabbri2022 import main_fabbri
+
+    return main_fabbri(args)
 
 
 def _cmd_varatharajan(args: argparse.Namespace) -> int:

@@ -1,10 +1,16 @@
 """What the paper reproductions (`fluxdrive rubino2020`, `fluxdrive
-varatharajan2022`) share: a figure of stacked axes, and the replacement of
-a generated table between two markers of a docs page."""
+varatharajan2022`, `fluxdrive fabbri2022`) share: a SIL run of a scenario
+given as a dict, a figure of stacked axes, and the replacement of a
+generated table between two markers of a docs page."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+import json
+import os
 from pathlib import Path
+import subprocess
+import sys
 
 import numpy as np
 
@@ -29,3 +35,26 @@ def replace_table(doc: Path, tag: str, table: str) -> bool:
     text = text[:text.index(a) + len(a)] + "\n" + table + "\n" + text[text.index(b):]
     doc.write_text(text)
     return True
+
+
+@dataclass
+class Run:
+    scenario: dict
+    log: np.ndarray
+    summary: dict
+
+
+def run(sil: Path, scenario: dict, out: Path, name: str) -> Run:
+    out.mkdir(parents=True, exist_ok=True)
+    sc_path = out / f"{name}.json"
+    sc_path.write_text(json.dumps(scenario, indent=1))
+    log_path = out / f"{name}.npy"
+    # a map file (.npz) goes through `fluxdrive map convert`: with this
+    # interpreter unless the caller names one
+    env = dict(os.environ)
+    env.setdefault("FLUXDRIVE_PYTHON", sys.executable)
+    res = subprocess.run([str(sil), str(sc_path), "--log", str(log_path), "--decimate", "1"],
+                         capture_output=True, text=True, timeout=900, env=env)
+    if res.returncode != 0:
+        raise RuntimeError(f"{name}: fluxdrive-sil exit {res.returncode}: {res.stderr.strip()}")
+    return Run(scenario, np.load(log_path), json.loads(res.stdout))

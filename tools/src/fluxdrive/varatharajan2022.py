@@ -34,7 +34,7 @@ import tempfile
 import numpy as np
 
 from .fluxmap import blob as blobmod
-from .paper_report import replace_table, stacked_axes
+from .paper_report import Run, replace_table, run, stacked_axes
 from .fluxmap.model import FluxMap
 
 RPM = np.pi / 30.0
@@ -173,29 +173,6 @@ def sota_poles(r: float, omega: float) -> tuple:
 
 
 # ------------------------------------------------------------- running
-@dataclass
-class Run:
-    scenario: dict
-    log: np.ndarray
-    summary: dict
-
-
-def run(sil: Path, scenario: dict, out: Path, name: str) -> Run:
-    out.mkdir(parents=True, exist_ok=True)
-    sc_path = out / f"{name}.json"
-    sc_path.write_text(json.dumps(scenario, indent=1))
-    log_path = out / f"{name}.npy"
-    # a map file (.npz) goes through `fluxdrive map convert`: with this
-    # interpreter unless the caller names one
-    env = dict(os.environ)
-    env.setdefault("FLUXDRIVE_PYTHON", sys.executable)
-    res = subprocess.run([str(sil), str(sc_path), "--log", str(log_path), "--decimate", "1"],
-                         capture_output=True, text=True, timeout=900, env=env)
-    if res.returncode != 0:
-        raise RuntimeError(f"{name}: fluxdrive-sil exit {res.returncode}: {res.stderr.strip()}")
-    return Run(scenario, np.load(log_path), json.loads(res.stdout))
-
-
 def base(root: Path, name: str) -> dict:
     return json.loads((root / "sil" / "scenarios" / f"varatharajan_{name}.json").read_text())
 

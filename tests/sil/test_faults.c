@@ -119,11 +119,10 @@ static void overspeed(void **state) {
 }
 
 /* The dynamometer drives the low-inductance Fabbri 2022 Table 5.1 machine
- * (0.4 mH, lambda_m/L = 300 A) past its voltage limit while FOC holds
- * zero current (no flux weakening): the back-EMF exceeds what the inverter
- * can oppose and the current grows with the speed until the protection
- * acts. With the gates off the diodes still rectify at this speed (the
- * machine brakes into the DC link): that current is physics, not a drive
+ * (0.4 mH, lambda_m/L = 34 A, base speed about 1100 rpm on 24 V) past its voltage limit while FOC
+ * holds zero current (no flux weakening): the back-EMF exceeds what the inverter can oppose and the
+ * current grows with the speed until the protection acts. With the gates off the diodes still
+ * rectify at this speed (the machine brakes into the DC link): that current is physics, not a drive
  * fault. The loss-of-control monitor, which would trip first (current above
  * 1.15 i_max for 2 ms, tests/sil/test_lost_control.c), is set to its
  * widest bounds here: these tests time the overcurrent protections. */
@@ -131,8 +130,9 @@ static void overspeed(void **state) {
   "\"machine\": {\"preset\": \"fabbri2022_t51\"}, \"log\": {\"decimation\": 1},"                   \
   "\"sensors\": {\"i_noise\": 0.005, \"v_noise\": 0.05},"                                          \
   "\"mechanics\": {\"mode\": \"imposed\", \"speed\": {\"unit\": \"rpm\", \"terms\": "              \
-  "[{\"type\": \"ramp\", \"t0\": 0.02, \"t1\": 0.5, \"value\": 600}]}},"                           \
-  "\"controller\": {\"mode\": \"torque\", \"lc_current\": 3.0, \"lc_track\": 10}, "                \
+  "[{\"type\": \"ramp\", \"t0\": 0.02, \"t1\": 0.5, \"value\": 6000}]}},"                          \
+  "\"controller\": {\"mode\": \"torque\", \"lc_current\": 3.0, \"lc_track\": 10, \"speed_trip\": " \
+  "500}, "                                                                                         \
   "\"references\": {\"torque\": 0}"
 
 static void overcurrent(void **state) {

@@ -85,6 +85,14 @@ void dfc_vec_plain(const float g[3], dfc_vec_t *v) {
   v->k[3] = 1.0f;
 }
 
+/* cos, sin of a small angle (|x| < 0.5 rad: within 3e-5) by their series
+ * to the fourth / fifth order: no libm in the ISR */
+static inline void dfc_turn(float x, float *c, float *s) {
+  const float x2 = x * x;
+  *c = 1.0f - 0.5f * x2 * (1.0f - x2 * (1.0f / 12.0f));
+  *s = x * (1.0f - x2 * (1.0f / 6.0f) * (1.0f - x2 * (1.0f / 20.0f)));
+}
+
 void dfc_signals_vector(const dfc_signals_t *s, float w2, dfc_vec_t *v) {
   /* phase axes c_x of the amplitude-invariant Clarke transform */
   static const float cx[3][2] = {{1.0f, 0.0f}, {-0.5f, 0.86602540f}, {-0.5f, -0.86602540f}};
@@ -96,8 +104,9 @@ void dfc_signals_vector(const dfc_signals_t *s, float w2, dfc_vec_t *v) {
      * so Gamma_x projects it on c_x e^{-j phi} (d); the 4theta term was
      * e^{-j2phi} behind: on c_x e^{+j2phi} (e) */
     const float phi = w2 * (t_new - s->t[x]);
-    const float co = 1.0f - 0.5f * phi * phi, si = -phi;
-    const float co2 = 1.0f - 2.0f * phi * phi, si2 = 2.0f * phi;
+    float co, si, co2, si2;
+    dfc_turn(-phi, &co, &si);
+    dfc_turn(2.0f * phi, &co2, &si2);
     const float d1 = cx[x][0] * co - cx[x][1] * si, d2 = cx[x][0] * si + cx[x][1] * co;
     const float e1 = cx[x][0] * co2 - cx[x][1] * si2, e2 = cx[x][0] * si2 + cx[x][1] * co2;
     a11 += d1 * d1;

@@ -105,8 +105,9 @@ typedef struct {
 } dfc_vec_t;
 /* From the signals, the held components turned by 2 omega_e (t_newest -
  * t_x) (see above): w2 = 2 omega_e [rad/s]; w2 = 0 gives the plain Clarke
- * transform and K = I. The turns are second order in the angle (within
- * 1e-3 of the b term up to 2 omega_e dt = 0.4 rad). */
+ * transform and K = I. The turns are series to the fourth / fifth order
+ * (within 3e-5 up to 0.5 rad of 2 omega_e dt: 1800 rpm on 8 pole pairs at
+ * 16 kHz). */
 void dfc_signals_vector(const dfc_signals_t *s, float w2, dfc_vec_t *v);
 /* The plain Clarke vector of g (K = I). */
 void dfc_vec_plain(const float g[3], dfc_vec_t *v);

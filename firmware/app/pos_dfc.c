@@ -50,7 +50,7 @@ static dfc_cfg_t cfg_of(const drive_config_t *cfg) {
   return d;
 }
 
-static void dfc_init(pos_state_t *s, const drive_config_t *cfg) {
+static void pdfc_init(pos_state_t *s, const drive_config_t *cfg) {
   angle_pll_init(&s->dfc.pll, cfg->pll_bw, cfg->ts);
   s->dfc.dc = cfg_of(cfg);
   dfc_signals_reset(&s->dfc.sig);
@@ -64,7 +64,7 @@ static void dfc_init(pos_state_t *s, const drive_config_t *cfg) {
   }
 }
 
-static void dfc_reset(pos_state_t *s) {
+static void pdfc_reset(pos_state_t *s) {
   dfc_signals_reset(&s->dfc.sig);
   s->dfc.started = false;
   s->dfc.n = 0u;
@@ -79,8 +79,8 @@ static float nearest_branch(float theta0, float ref) {
                                                          : theta0;
 }
 
-static void dfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
-                       const pos_in_t *in, pos_estimate_t *out) {
+static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
+                        const pos_in_t *in, pos_estimate_t *out) {
   angle_pll_t *pll = &s->dfc.pll;
   /* the live parameters (b, iterations, phase shifts) in force */
   s->dfc.dc = cfg_of(cfg);
@@ -132,8 +132,8 @@ static void dfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_samp
 /* The alignment towards electrical angle theta (0) ends: the polarity
  * from the motion it caused, or, without motion, the branch nearest it. */
 #define POS_DFC_POL_MIN 2.0f /* rad/s electrical: evidence of motion */
-static void dfc_align(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
-                      float theta) {
+static void pdfc_align(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
+                       float theta) {
   (void)cfg;
   (void)smp;
   angle_pll_t *pll = &s->dfc.pll;
@@ -151,7 +151,7 @@ static void dfc_align(pos_state_t *s, const drive_config_t *cfg, const hal_sampl
   s->dfc.pol_acc = 0.0f;
 }
 
-static const char *dfc_check_cfg(const drive_config_t *cfg, const char **field) {
+static const char *pdfc_check_cfg(const drive_config_t *cfg, const char **field) {
   const dfc_cfg_t d = cfg_of(cfg);
   const int e = dfc_check(&d);
   if (e != DFC_OK) {
@@ -166,10 +166,13 @@ static const char *dfc_check_cfg(const drive_config_t *cfg, const char **field) 
 }
 
 #define POS_DFC_ROW(n)                                                                             \
-  const pos_source_row_t pos_source_##n = {#n,           POS_CAP_ALIGN | POS_CAP_GATED,            \
-                                           dfc_init,     dfc_reset,                                \
-                                           dfc_update,   dfc_align,                                \
-                                           dfc_check_cfg}
+  const pos_source_row_t pos_source_##n = {#n,                                                     \
+                                           POS_CAP_ALIGN | POS_CAP_GATED,                          \
+                                           pdfc_init,                                              \
+                                           pdfc_reset,                                             \
+                                           pdfc_update,                                            \
+                                           pdfc_align,                                             \
+                                           pdfc_check_cfg}
 POS_DFC_ROW(dfc);
 POS_DFC_ROW(dfc_inv);
 POS_DFC_ROW(ivd);

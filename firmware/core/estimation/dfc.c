@@ -104,9 +104,11 @@ void dfc_signals_vector(const dfc_signals_t *s, float w2, dfc_vec_t *v) {
      * so Gamma_x projects it on c_x e^{-j phi} (d); the 4theta term was
      * e^{-j2phi} behind: on c_x e^{+j2phi} (e) */
     const float phi = w2 * (t_new - s->t[x]);
-    float co, si, co2, si2;
-    dfc_turn(-phi, &co, &si);
-    dfc_turn(2.0f * phi, &co2, &si2);
+    float co = 1.0f, si = 0.0f, co2 = 1.0f, si2 = 0.0f; /* the newest: not turned */
+    if (x != (int)s->last) {
+      dfc_turn(-phi, &co, &si);
+      dfc_turn(2.0f * phi, &co2, &si2);
+    }
     const float d1 = cx[x][0] * co - cx[x][1] * si, d2 = cx[x][0] * si + cx[x][1] * co;
     const float e1 = cx[x][0] * co2 - cx[x][1] * si2, e2 = cx[x][0] * si2 + cx[x][1] * co2;
     a11 += d1 * d1;
@@ -144,8 +146,8 @@ static inline bool dfc_normalise(float wr, float wi, float *ur, float *ui) {
   return true;
 }
 
-bool dfc_ivd_step(float zr, float zi, float p, const float k[4], const float rb[2],
-                  const float ra[2], float *ur, float *ui) {
+FD_NOINLINE bool dfc_ivd_step(float zr, float zi, float p, const float k[4], const float rb[2],
+                              const float ra[2], float *ur, float *ui) {
   /* e^{-j4theta_{k-1}} = conj(u)^2; times r_b = e^{-j phi_b} (3.100); the
    * sequentiality map K */
   const float sr = *ur * *ur - *ui * *ui, si = -2.0f * *ur * *ui;

@@ -85,7 +85,12 @@ IN_SIZE = 240
 BLOCKS = [
     ("drive (ISR body, commands, protections, offsets)", ("drive_", "hal_pwm_centred")),
     ("speed loop (speed_ctrl, every slow_div ISRs)", ("speed_ctrl_",)),
-    ("position source (encoder, PLL)", ("enc_", "pos_source", "angle_pll_")),
+    ("position source (encoder, star point, PLL)", ("enc_", "pdfc_", "nearest_branch",
+                                                    "pos_source", "angle_pll_")),
+    ("DFC signals (dfc_signals_: (2.101), sequentiality)", ("dfc_signals_",)),
+    ("IVD iteration (dfc_ivd_step, (3.76)/(3.100))", ("dfc_ivd_step",)),
+    ("DFC / IVD angle (dfc_vector2, dfc_window)", ("dfc_",)),
+    ("CORDIC atan2 (math/cordic_q31, software Q31)", ("fd_cordic_",)),
     ("control-law dispatch (ctrl, law tables)", ("ctrl_", "dfvc_law_", "db_step", "pi_step",
                                                  "foc_step")),
     ("DFVC step", ("dfvc_step", "dfvc_reset")),

@@ -119,10 +119,12 @@ static void drive_derive(drive_t *drv) {
   drv->duty_lo = drv->caps->duty_min;
   drv->duty_hi = drv->caps->duty_max;
   const pos_source_row_t *ps = pos_source(c->pos_source);
-  if (ps != NULL && (ps->caps & POS_CAP_GATED) != 0u) {
+  drv->gated = ps != NULL && (ps->caps & POS_CAP_GATED) != 0u;
+  if (drv->gated) {
     dfc_window_range(c->dfc_t0 / c->ts, c->dfc_tw / c->ts, drv->caps->duty_min, drv->caps->duty_max,
                      &drv->duty_lo, &drv->duty_hi);
   }
+  drv->v_lin_k = modulation_v_max(1.0f, drv->duty_lo, drv->duty_hi);
   drv->lc_n_fast = c->lc_time / c->ts;
   drv->lc_n_track = c->lc_track_time / c->ts;
   drv->inv_pole_pairs = 1.0f / c->pole_pairs;
@@ -325,8 +327,7 @@ static uint32_t drive_protect(const drive_t *drv, const hal_sample_t *s, const f
   }
   /* the position must be usable before the gates go on, and plausible
    * while they are */
-  const bool gated = (drv->pos_src->caps & POS_CAP_GATED) != 0u;
-  const bool need = gated ? drv->state == DRIVE_STATE_RUN : drive_state_enabled(drv->state);
+  const bool need = drv->gated ? drv->state == DRIVE_STATE_RUN : drive_state_enabled(drv->state);
   if (need &&
       (!drv->pos.valid || (drv->state == DRIVE_STATE_RUN && drv->pos.health > c->pos_err_max))) {
     f |= DRIVE_FAULT_POSITION;
@@ -399,7 +400,7 @@ static ab_t drive_write(drive_t *drv, const float duty[3], const float dtc[3], f
     dc[x] = fd_clampf(duty[x] + dtc[x], drv->duty_lo, drv->duty_hi);
   }
   hal_pwm_t req = hal_pwm_centred(dc[0], dc[1], dc[2]);
-  if ((drv->pos_src->caps & POS_CAP_GATED) != 0u) {
+  if (drv->gated) {
     /* the DFC window (Fig. 2.11): test vectors v1, v3, v5 in turn */
     const drive_config_t *c = &drv->cfg;
     const float inv_ts = 1.0f / c->ts;
@@ -595,7 +596,8 @@ void drive_isr(drive_t *drv) {
   drv->omega_m = drv->pos.omega * drv->inv_pole_pairs;
   drv->rate_acc += drv->pos.rate;
   drv->rate_n++;
-  drv->v_lin = modulation_v_max(s.v_dc, drv->duty_lo, drv->duty_hi);
+  /* modulation_v_max() of the duty range in force, its span precomputed */
+  drv->v_lin = (s.v_dc > 0.0f && fd_isfinite(s.v_dc)) ? drv->v_lin_k * s.v_dc : 0.0f;
 
   const uint32_t f = drive_protect(drv, &s, i);
   if (f != 0u) {

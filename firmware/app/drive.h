@@ -143,7 +143,9 @@ typedef struct {
   float inv_pole_pairs;
   float v_lin;            /* linear voltage range now [V] */
   float duty_lo, duty_hi; /* duty range: the board's, narrowed by a DFC window */
+  float v_lin_k;          /* linear voltage range per volt of DC link */
   unsigned dfc_leg;       /* leg of the next DFC test vector (0: v1, 1: v3, 2: v5) */
+  bool gated;             /* the position source measures through the DFC window */
 
   /* telemetry, under a sequence lock */
   volatile uint32_t tm_seq;

@@ -59,6 +59,7 @@ static void pdfc_init(pos_state_t *s, const drive_config_t *cfg) {
   s->dfc.n = 0u;
   s->dfc.pol_acc = 0.0f;
   s->dfc.w_prev = 0.0f;
+  s->dfc.aligned = false;
   for (unsigned k = 0u; k < 2u * (DFC_ITER_MAX + 1u); ++k) {
     s->dfc.trace[k] = 0.0f;
   }
@@ -70,6 +71,7 @@ static void pdfc_reset(pos_state_t *s) {
   s->dfc.n = 0u;
   s->dfc.pol_acc = 0.0f;
   s->dfc.w_prev = 0.0f;
+  s->dfc.aligned = false;
 }
 
 /* The branch of 2 theta / 2 nearest ref. */
@@ -124,9 +126,11 @@ static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sam
   out->theta = th;
   out->omega = pll->omega;
   out->rate = pll->omega_rate;
-  /* the polarity evidence (used by the alignment) */
-  s->dfc.pol_acc -= (pll->omega - s->dfc.w_prev) * frames_sincos(th).s;
-  s->dfc.w_prev = pll->omega;
+  /* the polarity evidence, until the alignment has used it */
+  if (!s->dfc.aligned) {
+    s->dfc.pol_acc -= (pll->omega - s->dfc.w_prev) * frames_sincos(th).s;
+    s->dfc.w_prev = pll->omega;
+  }
 }
 
 /* The alignment towards electrical angle theta (0) ends: the polarity
@@ -148,6 +152,7 @@ static void pdfc_align(pos_state_t *s, const drive_config_t *cfg, const hal_samp
   }
   angle_pll_reset(pll, th, pll->omega);
   s->dfc.started = true;
+  s->dfc.aligned = true;
   s->dfc.pol_acc = 0.0f;
 }
 

@@ -64,6 +64,7 @@ typedef union {
     /* polarity: sum of the speed change times -sin(theta) while the
      * alignment pulls the rotor towards 0 (pos_dfc.c) */
     float pol_acc, w_prev;
+    bool aligned; /* the alignment has resolved the polarity */
   } dfc;
 } pos_state_t;
 

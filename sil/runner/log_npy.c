@@ -34,7 +34,7 @@ static void fill_row(const sil_step_t *st, double *r) {
   const float *tr = st->drive->pos_st.dfc.trace;
   double k2[DFC_ITER_MAX + 1u];
   for (unsigned k = 0u; k <= DFC_ITER_MAX; ++k) {
-    k2[k] = dfc ? atan2((double)tr[2 * k + 1], (double)tr[2 * k]) : 0.0;
+    k2[k] = dfc ? atan2((double)tr[(size_t)2 * k + 1u], (double)tr[(size_t)2 * k]) : 0.0;
   }
   const float *g = st->drive->pos_st.dfc.sig.g;
   double ld = p->lambda_dq[0], lq = p->lambda_dq[1];

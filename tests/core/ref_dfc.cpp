@@ -71,8 +71,8 @@ void test_against_eigen(void **state) {
       gam[x] = std::real(std::conj(cx[x]) * model(a, b, thk, pa, pb));
       const double vdc = 12.0 + 36.0 * u01(rng), vb = -0.5 * vdc;
       const float va = static_cast<float>(vb + vdc * (gam[x] + 1.0 / 3.0));
-      assert_true(dfc_signals_push(&s, static_cast<uint8_t>(2 * x + 1), static_cast<float>(vb),
-                                   va, static_cast<float>(vdc), static_cast<float>(tx[x])));
+      assert_true(dfc_signals_push(&s, static_cast<uint8_t>(2 * x + 1), static_cast<float>(vb), va,
+                                   static_cast<float>(vdc), static_cast<float>(tx[x])));
       w_sig = std::max(w_sig, std::abs(static_cast<double>(s.g[x]) - gam[x]) / a);
     }
     /* the reference vector and K */
@@ -104,15 +104,19 @@ void test_against_eigen(void **state) {
       const C kq(kc[0] * q.real() + kc[1] * q.imag(), kc[2] * q.real() + kc[3] * q.imag());
       t2 = std::arg(zeta + p * kq) - pa;
     }
-    const dfc_cfg_t c = {DFC_FULL_IVD, static_cast<float>(a), static_cast<float>(b),
-                         static_cast<float>(pa / 1.5), static_cast<float>(pb / 1.5), iters};
+    const dfc_cfg_t c = {DFC_FULL_IVD,
+                         static_cast<float>(a),
+                         static_cast<float>(b),
+                         static_cast<float>(pa / 1.5),
+                         static_cast<float>(pb / 1.5),
+                         iters};
     float c2, s2;
     assert_true(dfc_vector2(&c, s.g, &v, 1.5f, &c2, &s2, nullptr));
     const double ang = static_cast<double>(fd_cordic_atan2f(s2, c2));
     w_ang = std::max(w_ang, std::abs(wrap(ang - t2)));
   }
-  std::printf("ref_dfc: %d cases: signals %.2e a, vector %.2e a, K %.2e, angle %.2e rad\n",
-              n_cases, w_sig, w_vec, w_k, w_ang);
+  std::printf("ref_dfc: %d cases: signals %.2e a, vector %.2e a, K %.2e, angle %.2e rad\n", n_cases,
+              w_sig, w_vec, w_k, w_ang);
   assert_true(w_sig < 5e-5);
   assert_true(w_vec < 1e-4);
   assert_true(w_k < 1e-4);

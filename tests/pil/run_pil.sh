@@ -38,3 +38,12 @@ export PYTHONPATH="$src/tools/src${PYTHONPATH:+:$PYTHONPATH}"
 "$python" -m fluxdrive pil "$src/sil/scenarios/pil_dfvc_decoupled.json" --law dfvc_decoupled \
   --isrs all --check-mean 2500 --sil "$sil" --elf "$build/cross/pil/fluxdrive-pil.elf" \
   --out "$build/work" --markdown "$build/benchmarks-decoupled.md"
+# sensorless FOC on the star-point position (Fabbri 2022): the DFC window,
+# signals with the sequentiality compensation, one IVD iteration, the Q31
+# CORDIC atan2 and the PLL from standstill (alignment) to 500 rpm:
+# agreement, and the goal of at most 90 instructions per IVD
+# iteration (measured 62: docs/benchmarks.md, "Star-point position")
+"$python" -m fluxdrive pil "$src/sil/scenarios/pil_dfc_ivd.json" --law foc --isrs all \
+  --functions --check-call dfc_ivd_step=90 --sil "$sil" \
+  --elf "$build/cross/pil/fluxdrive-pil.elf" --out "$build/work" \
+  --markdown "$build/benchmarks-dfc.md"

@@ -36,6 +36,12 @@ def scenario(tmp: Path, key: str, value) -> Path:
     sc = {"name": "param walk", "duration": 0.01, section: {name: value}}
     if key == "controller.mode" and value == "current":
         sc["controller"]["law"] = "foc"
+    if key == "controller.pos_source" and value in ("dfc", "dfc_inv", "ivd"):
+        # a star-point source: the window's edges, a star point, the alignment
+        sc["controller"]["align_time"] = 0.01
+        sc["inverter"] = {"model": "switching"}
+        sc["board"] = {"asym_edges": 1}
+        sc["machine"] = {"preset": "fabbri2022_t51"}
     p = tmp / "walk.json"
     p.write_text(json.dumps(sc))
     return p

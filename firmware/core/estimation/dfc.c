@@ -220,8 +220,8 @@ bool dfc_vector2(const dfc_cfg_t *c, const float g[3], const dfc_vec_t *v, float
     for (uint32_t k = 1u; ok && k <= n; ++k) { /* (3.76) / (3.100) */
       ok = dfc_ivd_step(zr, zi, p, v->k, rb, ra, &ur, &ui);
       if (ok && trace != NULL) {
-        trace[2u * k] = ur;
-        trace[2u * k + 1u] = ui;
+        trace[(size_t)2 * k] = ur;
+        trace[(size_t)2 * k + 1u] = ui;
       }
     }
   }

@@ -252,6 +252,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="fail when the DB-DFVC worst case reaches N instructions")
     p.add_argument("--check-mean", type=_positive_int, metavar="N",
                    help="fail when a run's mean reaches N instructions per law ISR")
+    p.add_argument("--check-call", action="append", default=[], metavar="FUNC=N",
+                   help="fail when FUNC's mean instructions per call (callees included) "
+                   "exceed N, or FUNC was not called (repeatable; needs the trace)")
     p.add_argument("--check-cycles", type=_percent, metavar="PCT",
                    help="fail when the DB-DFVC worst case's estimated cycles exceed PCT %% of "
                    "the 10625-cycle budget (170 MHz / 16 kHz)")

@@ -772,18 +772,41 @@ def main(args) -> int:
         update_markdown(Path(args.markdown), md)
         print(f"markdown: {args.markdown} (section '{SECTION[3:]}')")
     return check_runs(runs, args.check_worst, getattr(args, "check_cycles", None),
-                      getattr(args, "check_mean", None))
+                      getattr(args, "check_mean", None), getattr(args, "check_call", None))
+
+
+def parse_call_limits(items: list[str] | None) -> dict[str, float]:
+    """FUNC=N items of --check-call as {FUNC: N}; ValueError names a bad one."""
+    out = {}
+    for it in items or []:
+        f, sep, n = it.partition("=")
+        try:
+            lim = float(n)
+        except ValueError:
+            lim = -1.0
+        if not sep or not f or lim <= 0:
+            raise ValueError(f"--check-call {it!r}: expected FUNC=N with N > 0")
+        out[f] = lim
+    return out
 
 
 def check_runs(runs: list[PilRun], worst_instr: int | None, worst_pct: float | None,
-               mean_instr: int | None = None) -> int:
+               mean_instr: int | None = None, call_limits: list[str] | None = None) -> int:
     """Agreement and exact trace for every run; with limits, the DB-DFVC
     worst case: fewer than ``worst_instr`` instructions and at most
     ``worst_pct`` % of the cycle budget (estimated); every run's mean below
-    ``mean_instr``. Prints; 1 on failure."""
+    ``mean_instr``; each FUNC of ``call_limits`` (FUNC=N) at most N
+    instructions per call, callees included. Prints; 1 on failure."""
     rc = 0
+    limits = parse_call_limits(call_limits)
     for r in runs:
         name = f"{r.scenario}/{r.law}"
+        for f, lim in limits.items():
+            k, v = r.counts.calls.get(f, (0.0, float("inf")))
+            ok = k > 0 and v <= lim
+            print(f"{'check' if ok else 'FAIL'}: {name}: {f} {v:.1f} instructions per call "
+                  f"({k:.2f} calls per ISR), limit {lim:g}")
+            rc |= 0 if ok else 1
         if not r.agreement.ok:
             print(f"FAIL: {name}: PIL outputs disagree with the host build")
             rc = 1

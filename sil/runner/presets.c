@@ -21,21 +21,21 @@ static const machine_preset_t presets[] = {
     },
     {
         .name = "fabbri2022_t51",
-        .source = "Fabbri 2022, Table 5.1 (118.6 mVs per mechanical rad/s; inertia and rating "
-                  "assumed, docs/scenarios.md)",
+        .source = "Fabbri 2022, Table 5.1 (118.6 mVs line to line per mechanical rad/s; inertia "
+                  "and rating assumed, docs/dfc.md)",
         .machine = {.pole_pairs = 8,
                     .rs = 2.2,
                     .ld = 394e-6,
                     .lq = 475e-6,
-                    .lambda_m = 0.1186 / 8.0,
+                    .lambda_m = 0.1186 / (8.0 * 1.7320508075688772),
                     /* star point (3.3): a = 0.05, p = -0.0932 (docs/dfc.md) */
                     .aniso = {.enabled = 1, .m0 = 20e-6, .m2 = -48.54e-6, .phi_iq = 0.0}},
         .inertia = 2e-4,
         .friction = 1e-5,
         .v_dc = 24.0,
         .i_rated = 2.0,
-        .torque_rated = 0.5,
-        .speed_max = 1000.0 * RPM,
+        .torque_rated = 0.3,
+        .speed_max = 1500.0 * RPM,
     },
     {
         .name = "fabbri2022_ebike",

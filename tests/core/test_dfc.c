@@ -222,21 +222,22 @@ static void test_window_pattern(void **state) {
   float lo, hi;
   const float t0 = 0.024f, tw = 0.048f;
   dfc_window_range(t0, tw, 0.01f, 0.98f, &lo, &hi);
-  ASSERT_NEAR(lo, tw, 1e-7);
+  ASSERT_NEAR(lo, 0.5f - t0, 1e-7);
   ASSERT_NEAR(hi, 1.0f - t0 - tw, 1e-7);
-  const float d[3][3] = {{0.5f, 0.5f, 0.5f}, {hi, lo, 0.5f}, {lo, hi, 0.3f}};
+  const float d[3][3] = {{0.7f, 0.7f, 0.7f}, {hi, lo, 0.6f}, {lo, hi, 0.8f}};
   for (int n = 0; n < 3; ++n) {
     for (unsigned leg = 0; leg < 3u; ++leg) {
       float on[3], off[3];
       dfc_window_pattern(d[n], leg, t0, tw, on, off);
       for (unsigned x = 0; x < 3u; ++x) {
         ASSERT_NEAR(off[x] - on[x], d[n][x], 1e-6); /* width (volt-seconds) kept */
-        ASSERT_IN(off[x], 0.0, 1.0 + 1e-6);
+        ASSERT_IN(on[x], 0.0, 0.5);                 /* rising edge in the first half */
+        ASSERT_IN(off[x], 0.5, 1.0 + 1e-6);         /* falling edge in the second */
         if (x == leg) {
           ASSERT_NEAR(on[x], t0, 0.0);     /* the test vector from t0 */
           ASSERT_IN(off[x], t0 + tw, 1.0); /* ... over the whole window */
         } else {
-          ASSERT_IN(on[x], t0 + tw, 1.0); /* the others after it */
+          ASSERT_NEAR(on[x], t0 + tw, 1e-7); /* the others when it closes */
         }
       }
     }

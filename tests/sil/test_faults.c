@@ -119,7 +119,7 @@ static void overspeed(void **state) {
 }
 
 /* The dynamometer drives the low-inductance Fabbri 2022 Table 5.1 machine
- * (0.4 mH, lambda_m/L = 34 A, base speed about 1100 rpm on 24 V) past its voltage limit while FOC
+ * (0.4 mH, lambda_m/L = 20 A, base speed about 1900 rpm on 24 V) past its voltage limit while FOC
  * holds zero current (no flux weakening): the back-EMF exceeds what the inverter can oppose and the
  * current grows with the speed until the protection acts. With the gates off the diodes still
  * rectify at this speed (the machine brakes into the DC link): that current is physics, not a drive

@@ -81,8 +81,8 @@ static void check_lost_control(const char *json, uint32_t cause, cond_fn cond, b
   "{\"duration\": 0.3, \"machine\": {\"preset\": \"fabbri2022_t51\"}, \"log\": {\"decimation\": "  \
   "1}, \"sensors\": {\"i_noise\": 0.005},"                                                         \
   "\"mechanics\": {\"mode\": \"imposed\", \"speed\": {\"unit\": \"rpm\", \"terms\": "              \
-  "[{\"type\": \"ramp\", \"t0\": 0.02, \"t1\": 0.5, \"value\": 3000}]}},"                          \
-  "\"controller\": {\"mode\": \"torque\", \"speed_trip\": 500, " extra                             \
+  "[{\"type\": \"ramp\", \"t0\": 0.02, \"t1\": 0.5, \"value\": 6000}]}},"                          \
+  "\"controller\": {\"mode\": \"torque\", \"speed_trip\": 900, " extra                             \
   "}, \"references\": {\"torque\": 0}}"
 
 static void current_above_limit(void **state) {

@@ -5,7 +5,10 @@
 #include "dfc_window.h"
 
 void dfc_window_range(float t0, float tw, float d_min, float d_max, float *lo, float *hi) {
-  *lo = d_min > tw ? d_min : tw;
+  /* every pulse rises in the first half and falls in the second: leg X
+   * (each leg in turn) needs t0 + d >= 1/2, the others t0 + tw + d <= 1 */
+  const float bottom = 0.5f - t0;
+  *lo = d_min > bottom ? d_min : bottom;
   const float top = 1.0f - t0 - tw;
   *hi = d_max < top ? d_max : top;
 }
@@ -13,13 +16,9 @@ void dfc_window_range(float t0, float tw, float d_min, float d_max, float *lo, f
 void dfc_window_pattern(const float d[3], unsigned leg, float t0, float tw, float on[3],
                         float off[3]) {
   for (unsigned x = 0u; x < 3u; ++x) {
-    float o;
-    if (x == leg) {
-      o = t0; /* the test vector: leg X alone from t0 */
-    } else {
-      o = 0.5f * (1.0f - d[x]);
-      o = o > t0 + tw ? o : t0 + tw; /* not before the window closes */
-    }
+    /* v0 -> v_X from t0, then v7 from t0 + tw: the rising edges fixed by
+     * the window, the falling ones by the duties */
+    const float o = x == leg ? t0 : t0 + tw;
     on[x] = o;
     off[x] = o + d[x];
   }

@@ -3,17 +3,24 @@
  * 2022, Fig. 2.11): v0 -> v_X at the start of the period for the star-point
  * measurement, then the normal pattern.
  *
- * In fractions of the period: leg X (the test vector v1, v3, v5 switches
- * leg a, b, c alone) turns on at t0; the other legs keep their centred
- * pulses but start no earlier than t0 + tw, so v_X holds over [t0, t0 + tw)
- * and the star point is sampled before t0 and at t0 + t_meas (< tw).
- * Every leg keeps its pulse width: leg X's pulse is only moved to start
- * at t0, so the period-average voltage is exactly the one asked for (the
+ * In fractions of the period, as the thesis's modified edge-aligned
+ * pattern v0 -> v_X -> v7 -> ... -> v0: leg X (the test vector v1, v3, v5
+ * switches leg a, b, c alone) turns on at t0, the other two at t0 + tw,
+ * and each turns off after its duty: off = on + d. The star point is
+ * sampled before t0 and at t0 + t_meas (< tw). Every leg keeps its pulse
+ * width, so the period-average voltage is exactly the one asked for (the
  * test vector costs no volt-seconds: the current loop does not see it).
- * It needs d_X >= tw (v_X must last past the sample) and, for the others,
+ * All rising edges fall in the first half of the period and all falling
+ * edges in the second: what a centre-aligned timer does with one compare
+ * value per half period (the STM32G4's TIM1, docs/dfc.md "Board"): the
+ * rising edges depend only on which leg is X (known periods ahead), the
+ * falling ones on the duties. It needs t0 + d_X >= 1/2 and
  * t0 + tw + d <= 1: the duty range is narrowed to
- * [max(d_min, tw), min(d_max, 1 - t0 - tw)] (dfc_window_range) and the
- * modulation keeps every leg inside it.
+ * [max(d_min, 1/2 - t0), min(d_max, 1 - t0 - tw)] (dfc_window_range),
+ * about half the linear voltage range, and the modulation keeps every leg
+ * inside it. The current sampled at the valley is in v0 (all low) but no
+ * longer at the centre of the zero vector: it differs from the period
+ * average by the ripple's asymmetry.
  */
 #ifndef FD_CONTROL_DFC_WINDOW_H
 #define FD_CONTROL_DFC_WINDOW_H

@@ -19,6 +19,7 @@
 #include "hal.h"
 #include "hal_stm32g4.h"
 #include "pwm_tim1.h"
+#include "star_window.h"
 
 #define HOT __attribute__((section(".ccmram.text.hal")))
 
@@ -61,6 +62,22 @@ static float adc_sample_instant(void) {
 
 /* adc_sample_instant(), set by hal_adc_init (the ISR reads it, no call). */
 static float s_t_i;
+/* the star point's injected sample: its instant after the valley */
+static float s_t_star;
+
+/* The middle of signal sig's sampling window after the trigger: the ranks
+ * before it on its ADC (sampling + 12.5 cycles of conversion each). */
+static float adc_signal_instant(uint32_t sig) {
+  const float f_adc = (float)BOARD_SYSCLK_HZ / 4.0f;
+  float half_cycles = 4.0f; /* trigger latency, ~2 ADC clocks */
+  for (uint32_t s = 0; s < sig; s++) {
+    if (k_sig[s].adc == k_sig[sig].adc) {
+      half_cycles += (float)k_smp_half_cycles[k_sig[s].smp & 7u] + 25.0f;
+    }
+  }
+  half_cycles += 0.5f * (float)k_smp_half_cycles[k_sig[sig].smp & 7u];
+  return 0.5f * half_cycles / f_adc;
+}
 
 static adc_regs_t *adc_of(uint32_t n) {
   return (n == 1u) ? ADC1 : ADC2;
@@ -109,6 +126,7 @@ static bool adc_power_up(adc_regs_t *adc) {
 
 bool hal_adc_init(void) {
   s_t_i = adc_sample_instant();
+  s_t_star = adc_signal_instant(SIG_VSTAR);
   opamp_init();
   for (uint32_t i = 0; i < BOARD_ADC_NPINS; i++) {
     hal_gpio_analog(k_adc_pins[i].port, k_adc_pins[i].pin);
@@ -154,6 +172,9 @@ bool hal_adc_init(void) {
     /* JEXTSEL = 0 (left at 0): TIM1_TRGO; JEXTEN = 01: rising edge; JL = length - 1 */
     adc->JSQR = jsqr[a] | (1u << ADC_JSQR_JEXTEN_Pos) | ((len[a] - 1u) << ADC_JSQR_JL_Pos);
   }
+#if BOARD_HAS_STAR_WINDOW
+  star_window_adc_init(); /* the after-sample: the star channel on TRGO2 */
+#endif
   return len[0] >= len[1]; /* the interrupt comes from ADC1: it must finish last */
 }
 
@@ -165,6 +186,9 @@ void hal_adc_start(void) {
   if ((ADC2->JSQR & (3u << ADC_JSQR_JEXTEN_Pos)) != 0u) {
     ADC2->CR |= ADC_CR_JADSTART;
   }
+#if BOARD_HAS_STAR_WINDOW
+  star_window_adc_start();
+#endif
   NVIC->IPR[IRQN_ADC1_2] = (uint8_t)(0u << (8u - NVIC_PRIO_BITS)); /* highest */
   NVIC->ICPR[IRQN_ADC1_2 / 32u] = 1u << (IRQN_ADC1_2 % 32u);
   NVIC->ISER[IRQN_ADC1_2 / 32u] = 1u << (IRQN_ADC1_2 % 32u);
@@ -197,16 +221,22 @@ HOT void hal_adc_read(hal_sample_t *s) {
   s->i_abc[2] = i[2];
   s->v_dc = (s_jdr[SIG_VDC] != 0) ? raw_volts(s_jdr[SIG_VDC]) * BOARD_VDC_RATIO : 0.0f;
   s->t_i = s_t_i;
-  /* star point measured to ground; hal.h wants it w.r.t. the DC midpoint;
-   * sampled with the currents (the DFC window needs HAL_CAP_STAR_POINT) */
+  /* star point measured to ground; hal.h wants it w.r.t. the DC midpoint */
+  const float v_star = (s_jdr[SIG_VSTAR] != 0)
+                           ? raw_volts(s_jdr[SIG_VSTAR]) * BOARD_VSTAR_RATIO - 0.5f * s->v_dc
+                           : 0.0f;
+#if BOARD_HAS_STAR_WINDOW
+  /* the window of the last period: its before- and after-samples */
+  star_window_read(s, v_star, s_t_star);
+#else
+  /* sampled with the currents */
   s->n_star = (s_jdr[SIG_VSTAR] != 0) ? 1u : 0u;
-  s->v_star[0] = (s_jdr[SIG_VSTAR] != 0)
-                     ? raw_volts(s_jdr[SIG_VSTAR]) * BOARD_VSTAR_RATIO - 0.5f * s->v_dc
-                     : 0.0f;
-  s->t_star[0] = s->t_i;
+  s->v_star[0] = v_star;
+  s->t_star[0] = s_t_star;
   s->v_star[1] = 0.0f;
   s->t_star[1] = 0.0f;
   s->test_vector = 0u;
+#endif
   s->enc_angle = 0.0f; /* no encoder interface on these boards yet */
   s->t_enc = 0.0f;
   s->enc_valid = false;
@@ -269,7 +299,12 @@ const hal_caps_t *hal_caps(void) {
     caps.t_i_clear = (1.0f - BOARD_DUTY_MAX) * ts; /* low sides on around the valley */
     caps.t_enc = 0.0f;
     caps.cpu_hz = (float)BOARD_SYSCLK_HZ;
+#if BOARD_HAS_STAR_WINDOW
+    /* the DFC window: independent edges, two star-point samples */
+    caps.features = HAL_CAP_DWT_CYCLES | HAL_CAP_ASYM_EDGES | HAL_CAP_STAR_POINT;
+#else
     caps.features = HAL_CAP_DWT_CYCLES; /* centred pulses, no encoder, star point at the valley */
+#endif
     done = true;
   }
   return &caps;

@@ -23,6 +23,7 @@
 
 #include "board.h"
 #include "hal.h"
+#include "star_window.h"
 
 #define HOT __attribute__((section(".ccmram.text.hal")))
 
@@ -79,6 +80,9 @@ void hal_tim1_init(void) {
     cr2 |= (BOARD_PWM_LOW_ACTIVE_LOW ? 1u : 0u) << (9u + 2u * ch);  /* OISxN */
   }
   TIM1->CR2 = cr2;
+#if BOARD_HAS_STAR_WINDOW
+  star_window_tim1_init(); /* TRGO = OC4REF, TRGO2 = OC5REF, DMA burst of CCR1..3 */
+#endif
 
   /* One BDTR write: dead time, break, off-state selection, LOCK level 1. */
   uint32_t bdtr = (hal_tim1_dtg(BOARD_DEAD_TIME_NS, BOARD_SYSCLK_HZ) & TIM_BDTR_DTG_Msk) |
@@ -118,6 +122,12 @@ static bool wait_update(void) {
 }
 
 bool hal_tim1_start(void) {
+#if BOARD_HAS_STAR_WINDOW
+  /* updates at both ends (RCR = 0): the ADC trigger is OC4REF, not the
+   * update, so there is no repetition phase to align */
+  TIM1->CR1 |= TIM_CR1_CEN;
+  return star_window_tim1_start();
+#endif
   /* RM0440 28.3.4: with an odd RCR in centre-aligned mode the update falls
    * on the underflow if RCR is written after the counter started. Write it
    * so, then verify with DIR (counting up right after an underflow) and
@@ -145,17 +155,25 @@ bool hal_tim1_start(void) {
   return false;
 }
 
+/* The flag set once per period near the valley: the update (RCR = 1), or
+ * with the DFC window (updates at both ends) the OC4 match after it. */
+#if BOARD_HAS_STAR_WINDOW
+#define TIM1_PERIOD_FLAG TIM_SR_CC4IF
+#else
+#define TIM1_PERIOD_FLAG TIM_SR_UIF
+#endif
+
 HOT void hal_tim1_clear_update(void) {
-  TIM1->SR = ~TIM_SR_UIF; /* rc_w0 */
+  TIM1->SR = ~TIM1_PERIOD_FLAG; /* rc_w0 */
 }
 
 HOT bool hal_tim1_update_pending(void) {
-  return (TIM1->SR & TIM_SR_UIF) != 0u;
+  return (TIM1->SR & TIM1_PERIOD_FLAG) != 0u;
 }
 
 /* ---- hal.h: PWM and hardware fault ---- */
 
-/* Centred pulses only (hal_caps_t.features has no HAL_CAP_ASYM_EDGES):
+/* Without the DFC window: centred pulses only (no HAL_CAP_ASYM_EDGES):
  * the duty off - on, limited to [0, BOARD_DUTY_MAX] (NaN: 0), rounded to a
  * compare step. */
 HOT static uint32_t duty_to_ccr(float d) {
@@ -175,6 +193,11 @@ HOT static void ccr_to_pattern(uint32_t ccr, int x, hal_pwm_t *a) {
 }
 
 HOT void hal_pwm_write(const hal_pwm_t *p, hal_pwm_t *applied) {
+#if BOARD_HAS_STAR_WINDOW
+  hal_pwm_t a;
+  star_window_write(p, applied != 0 ? applied : &a);
+  return;
+#endif
   const uint32_t c1 = duty_to_ccr(p->off[0] - p->on[0]);
   const uint32_t c2 = duty_to_ccr(p->off[1] - p->on[1]);
   const uint32_t c3 = duty_to_ccr(p->off[2] - p->on[2]);

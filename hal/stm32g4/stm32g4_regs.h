@@ -158,6 +158,9 @@ typedef struct {
   reg32_t TISEL; /* 0x5C */
   reg32_t AF1;   /* 0x60 */
   reg32_t AF2;   /* 0x64 */
+  reg32_t RES_DMA[221];
+  reg32_t DCR;  /* 0x3DC */
+  reg32_t DMAR; /* 0x3E0 */
 } tim_regs_t;
 #define TIM1 ((tim_regs_t *)0x40012C00u)
 #define TIM2 ((tim_regs_t *)0x40000000u)
@@ -173,6 +176,17 @@ typedef struct {
 #define TIM_SR_B2IF        (1u << 8)
 #define TIM_SR_SBIF        (1u << 13)
 #define TIM_EGR_UG         (1u << 0)
+#define TIM_SR_CC4IF       (1u << 4)
+#define TIM_DIER_UDE       (1u << 8)
+#define TIM_CR2_MMS_OC4REF 7u  /* TRGO = OC4REF */
+#define TIM_CR2_MMS2_Pos   20u /* 1000: TRGO2 = OC5REF */
+#define TIM_CR2_MMS2_OC5REF 8u
+#define TIM_CCMR_OC4PE     (1u << 11) /* in CCMR2 */
+#define TIM_CCMR_OC4M_Pos  12u
+#define TIM_CCMR3_OC5PE    (1u << 3)
+#define TIM_CCMR3_OC5M_Pos 4u
+#define TIM_DCR_DBA_Pos    0u /* DMA base: register index from CR1 */
+#define TIM_DCR_DBL_Pos    8u /* burst length - 1 */
 #define TIM_CCMR_OC1PE     (1u << 3)
 #define TIM_CCMR_OC1M_Pos  4u /* OC1M[2:0]; OC1M[3] is bit 16 */
 #define TIM_CCMR_OC2PE     (1u << 11)
@@ -251,6 +265,11 @@ typedef struct {
 #define ADC_CR_ADCALDIF (1u << 30)
 #define ADC_CR_ADCAL    (1u << 31)
 #define ADC_CFGR_JQDIS  (1u << 31)
+#define ADC_CFGR_EXTSEL_Pos 5u  /* ADC12 regular: 10 = TIM1_TRGO2 (RM0440 21.4.18) */
+#define ADC_CFGR_EXTEN_Pos  10u /* 01: rising edge */
+#define ADC_CFGR_OVRMOD     (1u << 12)
+#define ADC_CR_ADSTART      (1u << 2)
+#define ADC_SQR1_SQ1_Pos    6u
 #define ADC_JSQR_JL_Pos 0u
 #define ADC_JSQR_JEXTSEL_Pos                                                                       \
   2u /* ADC12 JEXT0 = TIM1_TRGO (RM0440 21.4.x, ADC1/2 injected trigger table) */
@@ -265,6 +284,33 @@ typedef struct {
 #define ADC_SMP_92_5           5u
 #define ADC_SMP_247_5          6u
 #define ADC_SMP_640_5          7u
+
+/* ---- DMA1 (RM0440 section 12) and DMAMUX (section 13): DMA1 channel 1
+ * is DMAMUX1 channel 0 ---- */
+typedef struct {
+  reg32_t CCR;   /* 0x08 + 0x14 (x - 1) */
+  reg32_t CNDTR; /* 0x0C */
+  reg32_t CPAR;  /* 0x10 */
+  reg32_t CMAR;  /* 0x14 */
+  reg32_t RES;
+} dma_channel_regs_t;
+typedef struct {
+  reg32_t ISR;  /* 0x00 */
+  reg32_t IFCR; /* 0x04 */
+  dma_channel_regs_t CH[8];
+} dma_regs_t;
+#define DMA1                ((dma_regs_t *)0x40020000u)
+#define DMAMUX1_C0CR        (*(reg32_t *)0x40020800u)
+#define DMA_CCR_EN          (1u << 0)
+#define DMA_CCR_DIR         (1u << 4) /* read from memory */
+#define DMA_CCR_CIRC        (1u << 5)
+#define DMA_CCR_MINC        (1u << 7)
+#define DMA_CCR_PSIZE_32    (2u << 8)
+#define DMA_CCR_MSIZE_32    (2u << 10)
+#define DMA_CCR_PL_VHIGH    (3u << 12)
+#define DMAMUX_REQ_TIM1_UP  46u /* RM0440 table 91 */
+#define RCC_AHB1ENR_DMA1EN    (1u << 0)
+#define RCC_AHB1ENR_DMAMUX1EN (1u << 2)
 
 /* ---- OPAMP: RM0440 section 25.5 (OPAMPx_CSR) ---- */
 typedef struct {
@@ -460,6 +506,9 @@ typedef struct {
 /* Layout checks against the manuals' offset tables. */
 _Static_assert(offsetof(rcc_regs_t, PLLCFGR) == 0x0Cu, "RCC_PLLCFGR");
 _Static_assert(offsetof(rcc_regs_t, AHB1ENR) == 0x48u, "RCC_AHB1ENR");
+_Static_assert(offsetof(tim_regs_t, DCR) == 0x3DCu, "TIM_DCR");
+_Static_assert(offsetof(tim_regs_t, DMAR) == 0x3E0u, "TIM_DMAR");
+_Static_assert(offsetof(dma_regs_t, CH[1]) == 0x1Cu, "DMA_CCR2");
 _Static_assert(offsetof(rcc_regs_t, APB1ENR1) == 0x58u, "RCC_APB1ENR1");
 _Static_assert(offsetof(rcc_regs_t, APB2ENR) == 0x60u, "RCC_APB2ENR");
 _Static_assert(offsetof(rcc_regs_t, CCIPR) == 0x88u, "RCC_CCIPR");

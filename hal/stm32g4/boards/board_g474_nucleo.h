@@ -58,7 +58,12 @@
 #define BOARD_ADC_VDC                                                                              \
   { 1u, 15u, ADC_SMP_47_5 } /* PB0  ADC1_IN15 */
 #define BOARD_ADC_VSTAR                                                                            \
-  { 2u, 17u, ADC_SMP_47_5 } /* PA4  ADC2_IN17 */
+  { 2u, 17u, ADC_SMP_24_5 } /* PA4  ADC2_IN17: sampled 0.6..1.2 us after the valley */
+/* The Direct Flux Control window (docs/dfc.md, star_window.c): the star
+ * channel again, its regular conversion at the after-sample */
+#define BOARD_HAS_STAR_WINDOW   1
+#define BOARD_ADC_VSTAR_ADC     2u
+#define BOARD_ADC_VSTAR_CHANNEL 17u
 #define BOARD_ADC_PINS                                                                             \
   {                                                                                                \
     {PORT_A, 0, 0}, {PORT_A, 1, 0}, {PORT_C, 1, 0}, {PORT_B, 0, 0}, {                              \

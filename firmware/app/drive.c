@@ -125,6 +125,9 @@ static void drive_derive(drive_t *drv) {
                      &drv->duty_lo, &drv->duty_hi);
   }
   drv->v_lin_k = modulation_v_max(1.0f, drv->duty_lo, drv->duty_hi);
+  /* Ts / L of the window's sampling correction (linear machines; a
+   * flux-map machine has no star-point model in the plant) */
+  drv->win_k = (drv->gated && c->machine_map == NULL) ? 2.0f * c->ts / (c->ld + c->lq) : 0.0f;
   drv->lc_n_fast = c->lc_time / c->ts;
   drv->lc_n_track = c->lc_track_time / c->ts;
   drv->inv_pole_pairs = 1.0f / c->pole_pairs;
@@ -388,6 +391,20 @@ static void drive_monitor(drive_t *drv, const ctrl_in_t *in, const ctrl_out_t *o
 
 /* ------------------------------------------------------------- the loop */
 
+/* The DFC window (Fig. 2.11) in the pattern: test vectors v1, v3, v5 in
+ * turn, the two star-point samples around the edge. */
+static FD_NOINLINE void drive_window_pattern(drive_t *drv, const float dc[3], hal_pwm_t *req) {
+  const drive_config_t *c = &drv->cfg;
+  const float inv_ts = 1.0f / c->ts;
+  const unsigned leg = drv->dfc_leg;
+  drv->dfc_leg = leg >= 2u ? 0u : leg + 1u;
+  dfc_window_pattern(dc, leg, c->dfc_t0 * inv_ts, c->dfc_tw * inv_ts, req->on, req->off);
+  req->test_vector = (uint8_t)(2u * leg + 1u);
+  req->n_star = 2u;
+  req->t_star_req[0] = 0.5f * c->dfc_t0;
+  req->t_star_req[1] = c->dfc_t0 + c->dfc_t_meas;
+}
+
 /* Writes duties (gates on states), returns the voltage the board applies
  * over the next period, rebuilt from the pattern the HAL reports it will
  * really apply (rounding, limits) less the dead-time correction where the
@@ -396,21 +413,18 @@ static ab_t drive_write(drive_t *drv, const float duty[3], const float dtc[3], f
   /* the correction may not take a leg out of the board's range: the drive
    * asks only for what the board can do (the HAL would clamp the same) */
   float dc[3];
+  hal_pwm_t req; /* centred pulses (hal_pwm_centred), built in the same loop */
   for (int x = 0; x < 3; ++x) {
     dc[x] = fd_clampf(duty[x] + dtc[x], drv->duty_lo, drv->duty_hi);
+    req.on[x] = 0.5f - 0.5f * dc[x];
+    req.off[x] = 0.5f + 0.5f * dc[x];
   }
-  hal_pwm_t req = hal_pwm_centred(dc[0], dc[1], dc[2]);
+  req.test_vector = 0u;
+  req.n_star = 0u;
+  req.t_star_req[0] = 0.0f;
+  req.t_star_req[1] = 0.0f;
   if (drv->gated) {
-    /* the DFC window (Fig. 2.11): test vectors v1, v3, v5 in turn */
-    const drive_config_t *c = &drv->cfg;
-    const float inv_ts = 1.0f / c->ts;
-    const unsigned leg = drv->dfc_leg;
-    drv->dfc_leg = leg >= 2u ? 0u : leg + 1u;
-    dfc_window_pattern(dc, leg, c->dfc_t0 * inv_ts, c->dfc_tw * inv_ts, req.on, req.off);
-    req.test_vector = (uint8_t)(2u * leg + 1u);
-    req.n_star = 2u;
-    req.t_star_req[0] = 0.5f * c->dfc_t0;
-    req.t_star_req[1] = c->dfc_t0 + c->dfc_t_meas;
+    drive_window_pattern(drv, dc, &req);
   }
   hal_pwm_t got;
   hal_pwm_write(&req, &got);
@@ -420,7 +434,23 @@ static ab_t drive_write(drive_t *drv, const float duty[3], const float dtc[3], f
     drv->tm.duty[x] = d;
     pole[x] = (d > 0.0f && d < 1.0f) ? d - dtc[x] : d;
   }
+  if (drv->gated) {
+    dfc_window_moments(got.on, got.off, drv->win_m); /* for the next sample */
+  }
   return frames_clarke((abc_t){pole[0] * v_dc, pole[1] * v_dc, pole[2] * v_dc});
+}
+
+/* The DFC window moves the pulses: the valley sample is corrected to what
+ * centred pulses would have given (dfc_window_moments); out of line, the
+ * encoder's ISR path pays only the test. */
+static FD_NOINLINE void drive_window_sample(const drive_t *drv, float i[3], float v_dc) {
+  if (!gates_on_state(drv->state)) {
+    return;
+  }
+  const float k = drv->win_k * v_dc;
+  for (int x = 0; x < 3; ++x) {
+    i[x] += k * drv->win_m[x];
+  }
 }
 
 /* The speed loop, every slow_div ISRs, on the angle rate averaged over that
@@ -590,9 +620,11 @@ void drive_isr(drive_t *drv) {
   for (int x = 0; x < 3; ++x) {
     i[x] = s.i_abc[x] - drv->offset[x];
   }
+  if (drv->gated) {
+    drive_window_sample(drv, i, s.v_dc);
+  }
   drive_speed_loop(drv); /* on the rates of the previous slow_div periods */
-  const pos_in_t pin = {drv->tm.i_dq[1]};
-  drv->pos_src->update(&drv->pos_st, &drv->cfg, &s, &pin, &drv->pos);
+  drv->pos_src->update(&drv->pos_st, &drv->cfg, &s, drv->tm.i_dq[1], &drv->pos);
   drv->omega_m = drv->pos.omega * drv->inv_pole_pairs;
   drv->rate_acc += drv->pos.rate;
   drv->rate_n++;

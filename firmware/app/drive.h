@@ -146,6 +146,8 @@ typedef struct {
   float v_lin_k;          /* linear voltage range per volt of DC link */
   unsigned dfc_leg;       /* leg of the next DFC test vector (0: v1, 1: v3, 2: v5) */
   bool gated;             /* the position source measures through the DFC window */
+  float win_m[3];         /* the window pattern in force: phase moments (dfc_window.h) */
+  float win_k;            /* Ts / L of their current correction [s/H] */
 
   /* telemetry, under a sequence lock */
   volatile uint32_t tm_seq;

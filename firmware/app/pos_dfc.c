@@ -82,7 +82,7 @@ static float nearest_branch(float theta0, float ref) {
 }
 
 static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
-                        const pos_in_t *in, pos_estimate_t *out) {
+                        float i_q, pos_estimate_t *out) {
   angle_pll_t *pll = &s->dfc.pll;
   /* the live parameters (b, iterations, phase shifts) in force */
   s->dfc.dc = cfg_of(cfg);
@@ -104,8 +104,7 @@ static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sam
   if (full) { /* sequentiality: the held components turned to the newest */
     dfc_signals_vector(&s->dfc.sig, 2.0f * pll->omega, &v);
   }
-  const bool ok =
-      full && dfc_vector2(&s->dfc.dc, s->dfc.sig.g, &v, in->i_q, &c2, &s2, s->dfc.trace);
+  const bool ok = full && dfc_vector2(&s->dfc.dc, s->dfc.sig.g, &v, i_q, &c2, &s2, s->dfc.trace);
   out->valid = ok;
   if (!ok) {
     angle_pll_update(pll, NAN); /* coast */

@@ -36,8 +36,8 @@ static float enc_electrical(const pos_state_t *s, const drive_config_t *cfg,
 }
 
 static void enc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
-                       const pos_in_t *in, pos_estimate_t *out) {
-  (void)in;
+                       float i_q, pos_estimate_t *out) {
+  (void)i_q;
   angle_pll_t *pll = &s->enc.pll;
   out->t = smp->t_enc;
   out->valid = smp->enc_valid && fd_isfinite(smp->enc_angle);

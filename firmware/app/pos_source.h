@@ -39,11 +39,6 @@ enum {
                               offset calibration, resolved by the alignment */
 };
 
-/* What the drive knows of the last period, for the sources that use it. */
-typedef struct {
-  float i_q; /* rotor-frame q current of the last period [A] */
-} pos_in_t;
-
 typedef union {
   struct {
     angle_pll_t pll;
@@ -73,8 +68,10 @@ typedef struct {
   uint32_t caps; /* POS_CAP_* */
   void (*init)(pos_state_t *s, const drive_config_t *cfg);
   void (*reset)(pos_state_t *s);
-  void (*update)(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
-                 const pos_in_t *in, pos_estimate_t *out);
+  /* i_q: the rotor-frame q current of the last period [A] (the Full
+   * IVD's phase shifts) */
+  void (*update)(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp, float i_q,
+                 pos_estimate_t *out);
   /* The rotor is held at electrical angle theta: take it as the reference
    * (alignment). Only for POS_CAP_ALIGN. */
   void (*align)(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp, float theta);

@@ -30,11 +30,14 @@
  * phi_iq: the saliency axis of these (incremental) inductances shifted
  * with load, 2 theta_e -> 2 theta_e + phi_iq * i_q: the phase shifts of
  * the Full IVD model (3.97) with phi_a = phi_iq i_q, phi_b = 2 phi_iq i_q.
- * The shift acts on the star point only (the dq model keeps ld, lq). */
+ * amp_iq: the amplitude of their 2theta terms with load, L2 and M2 times
+ * (1 + amp_iq |i_q|) (a and b of (3.97) change with it).
+ * Both act on the star point only (the dq model keeps ld, lq). */
 typedef struct {
   int enabled;   /* 0: isotropic star point (the mean of the leg potentials) */
   double m0, m2; /* [H] */
   double phi_iq; /* [rad/A] */
+  double amp_iq; /* [1/A] */
 } plant_aniso_t;
 
 typedef struct {

@@ -23,6 +23,11 @@
 
 #include <math.h>
 
+/* the load's scale of the 2theta terms is held within these (the matrix is
+ * checked at both ends) */
+#define STAR_K_MIN 0.5
+#define STAR_K_MAX 2.0
+
 /* The (3.3) matrix at x = 2 theta_e (+ the load shift) and its derivative
  * with respect to theta_e. */
 static void star_matrix_of(double l0, double l2, double m0, double m2, double x, double L[3][3],
@@ -41,8 +46,12 @@ static void star_matrix_of(double l0, double l2, double m0, double m2, double x,
   }
 }
 
-static void star_matrix(const plant_t *pl, double x, double L[3][3], double dL[3][3]) {
-  star_matrix_of(pl->aux.l0, pl->aux.l2, pl->p.machine.aniso.m0, pl->p.machine.aniso.m2, x, L, dL);
+/* at x = 2 theta_e + phi_iq i_q, the 2theta terms scaled by the load */
+static void star_matrix(const plant_t *pl, double x, double i_q, double L[3][3], double dL[3][3]) {
+  const plant_aniso_t *an = &pl->p.machine.aniso;
+  double k = 1.0 + an->amp_iq * fabs(i_q);
+  k = k < STAR_K_MIN ? STAR_K_MIN : (k > STAR_K_MAX ? STAR_K_MAX : k);
+  star_matrix_of(pl->aux.l0, k * pl->aux.l2, an->m0, k * an->m2, x, L, dL);
 }
 
 /* The matrix from (ld, lq, m0, m2) must be an inductance matrix: positive
@@ -50,16 +59,21 @@ static void star_matrix(const plant_t *pl, double x, double L[3][3], double dL[3
  * theta_e), and carry the position (L2 != M2, first condition of (3.7)). */
 int plant_aniso_ok(const plant_machine_t *m) {
   const double m0 = m->aniso.m0, m2 = m->aniso.m2;
-  if (!(isfinite(m0) && isfinite(m2) && fabs(m->aniso.phi_iq) < 10.0)) {
+  if (!(isfinite(m0) && isfinite(m2) && fabs(m->aniso.phi_iq) < 10.0 && m->aniso.amp_iq >= -0.5 &&
+        m->aniso.amp_iq <= 1.0)) {
     return 0;
   }
   const double l0 = 0.5 * (m->ld + m->lq) + m0, l2 = (m->ld - m->lq) - 2.0 * m2;
   if (!(fabs(l2 - m2) > 1e-9 * l0)) {
     return 0;
   }
-  for (int k = 0; k < 360; k++) {
+  for (int k = 0; k < 3 * 360; k++) {
+    const double sc = (k / 360 == 0) ? 1.0 : (k / 360 == 1 ? STAR_K_MIN : STAR_K_MAX);
+    if (sc != 1.0 && !(fabs(m->aniso.amp_iq) > 0.0)) {
+      break; /* no load scaling */
+    }
     double L[3][3], dL[3][3];
-    star_matrix_of(l0, l2, m0, m2, k * (PLANT_PI / 180.0), L, dL);
+    star_matrix_of(l0, sc * l2, m0, sc * m2, (k % 360) * (PLANT_PI / 180.0), L, dL);
     const double d2 = L[0][0] * L[1][1] - L[0][1] * L[1][0];
     const double d3 = L[0][0] * (L[1][1] * L[2][2] - L[1][2] * L[2][1]) -
                       L[0][1] * (L[1][0] * L[2][2] - L[1][2] * L[2][0]) +
@@ -96,7 +110,7 @@ void plant_star_gain(const plant_t *pl, double theta_e, double i_q, double g[3])
     return;
   }
   double L[3][3], dL[3][3];
-  star_matrix(pl, 2.0 * theta_e + pl->p.machine.aniso.phi_iq * i_q, L, dL);
+  star_matrix(pl, 2.0 * theta_e + pl->p.machine.aniso.phi_iq * i_q, i_q, L, dL);
   star_divider(L, g);
 }
 
@@ -106,7 +120,7 @@ double plant_star_vn(const plant_t *pl, const double v[3], const double i[3], do
     return (v[0] + v[1] + v[2]) * (1.0 / 3.0);
   }
   double L[3][3], dL[3][3], g[3];
-  star_matrix(pl, 2.0 * th_e + pl->p.machine.aniso.phi_iq * i_q, L, dL);
+  star_matrix(pl, 2.0 * th_e + pl->p.machine.aniso.phi_iq * i_q, i_q, L, dL);
   star_divider(L, g);
   double vn = 0.0;
   for (int k = 0; k < 3; k++) {

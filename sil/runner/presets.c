@@ -38,6 +38,27 @@ static const machine_preset_t presets[] = {
         .speed_max = 1500.0 * RPM,
     },
     {
+        .name = "fabbri2022_fig33",
+        .source = "Fabbri 2022, Fig. 3.3: L0 442.2, M0 20.7, L2 103.3 uH, M2 for p = 0.15 "
+                  "(machine.star_p sets another); the rest of Table 5.1",
+        .machine = {.pole_pairs = 8,
+                    .rs = 2.2,
+                    .ld = 421.5e-6 * 1.15,
+                    .lq = 421.5e-6 * 0.85,
+                    .lambda_m = 0.1186 / (8.0 * 1.7320508075688772),
+                    .aniso = {.enabled = 1,
+                              .m0 = 20.7e-6,
+                              .m2 = 0.15 * 421.5e-6 - 0.5 * 103.3e-6,
+                              .phi_iq = 0.0,
+                              .amp_iq = 0.0}},
+        .inertia = 2e-4,
+        .friction = 1e-5,
+        .v_dc = 24.0,
+        .i_rated = 2.0,
+        .torque_rated = 0.3,
+        .speed_max = 1500.0 * RPM,
+    },
+    {
         .name = "fabbri2022_ebike",
         .source = "Fabbri 2022, Table 5.4 (inertia and rating assumed, docs/scenarios.md)",
         .machine = {.pole_pairs = 23,
@@ -102,7 +123,8 @@ const machine_preset_t *preset_find(const char *name) {
 }
 
 const char *preset_names(void) {
-  return "rubino2020_spm, fabbri2022_t51, fabbri2022_ebike, syr_1k1, ipm_sat, pmasyr_file";
+  return "rubino2020_spm, fabbri2022_t51, fabbri2022_fig33, fabbri2022_ebike, syr_1k1, ipm_sat, "
+         "pmasyr_file";
 }
 
 void preset_apply(const machine_preset_t *p, plant_params_t *plant, drive_config_t *drive) {

@@ -250,9 +250,9 @@ static int use_map(ctx_t *c, const char *key, const char *file, scenario_t *sc) 
 }
 
 static int parse_machine(ctx_t *c, const cJSON *m, scenario_t *sc) {
-  static const char *const keys[] = {"preset",  "pole_pairs", "rs",          "ld",
-                                     "lq",      "ls",         "lambda_m",    "map",
-                                     "star_m0", "star_m2",    "star_phi_iq", NULL};
+  static const char *const keys[] = {"preset",      "pole_pairs",  "rs",     "ld",      "lq",
+                                     "ls",          "lambda_m",    "map",    "star_m0", "star_m2",
+                                     "star_phi_iq", "star_amp_iq", "star_p", NULL};
   if (check_keys(c, m, "machine", keys) != 0) {
     return -1;
   }
@@ -308,14 +308,35 @@ static int parse_machine(ctx_t *c, const cJSON *m, scenario_t *sc) {
   /* the star point's inductance matrix (3.3), plant.h */
   const int star = cJSON_GetObjectItemCaseSensitive(m, "star_m0") != NULL ||
                    cJSON_GetObjectItemCaseSensitive(m, "star_m2") != NULL ||
-                   cJSON_GetObjectItemCaseSensitive(m, "star_phi_iq") != NULL;
+                   cJSON_GetObjectItemCaseSensitive(m, "star_phi_iq") != NULL ||
+                   cJSON_GetObjectItemCaseSensitive(m, "star_amp_iq") != NULL ||
+                   cJSON_GetObjectItemCaseSensitive(m, "star_p") != NULL;
   if (star && sc->plant.machine.map != NULL) {
     return fail(c, "machine.star_m0", "the star-point model needs a linear machine (no map)");
   }
   if (get_num(c, m, M, "star_m0", -1.0, 1.0, &pm->aniso.m0) ||
       get_num(c, m, M, "star_m2", -1.0, 1.0, &pm->aniso.m2) ||
-      get_num(c, m, M, "star_phi_iq", -1.0, 1.0, &pm->aniso.phi_iq)) {
+      get_num(c, m, M, "star_phi_iq", -1.0, 1.0, &pm->aniso.phi_iq) ||
+      get_num(c, m, M, "star_amp_iq", -0.5, 1.0, &pm->aniso.amp_iq)) {
     return -1;
+  }
+  /* star_p: the anisotropy p of (3.7) with L0, M0, L2 kept (Fig. 3.3):
+   * gamma0 = L0 - M0, gamma2 = p gamma0 = L2/2 + M2, ld, lq = gamma0 +- gamma2 */
+  if (cJSON_GetObjectItemCaseSensitive(m, "star_p") != NULL) {
+    double p = 0.0;
+    if (get_num(c, m, M, "star_p", -0.999999, 0.999999, &p)) {
+      return -1;
+    }
+    if (cJSON_GetObjectItemCaseSensitive(m, "ld") || cJSON_GetObjectItemCaseSensitive(m, "lq") ||
+        cJSON_GetObjectItemCaseSensitive(m, "star_m2")) {
+      return fail(c, "machine.star_p", "sets ld, lq and star_m2: give none of them with it");
+    }
+    const double l0 = 0.5 * (pm->ld + pm->lq) + pm->aniso.m0;
+    const double l2 = (pm->ld - pm->lq) - 2.0 * pm->aniso.m2;
+    const double g0 = l0 - pm->aniso.m0, g2 = p * g0;
+    pm->ld = g0 + g2;
+    pm->lq = g0 - g2;
+    pm->aniso.m2 = g2 - 0.5 * l2;
   }
   if (star) {
     pm->aniso.enabled = 1;

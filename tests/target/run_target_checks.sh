@@ -4,18 +4,21 @@
 # Usage: tests/target/run_target_checks.sh [PRESET...]   (default: both)
 # Presets: stm32g474 stm32g431-esc1, and stm32g474-map (the g474 image with
 # the flux map maps/syr_1k1.fdmap linked as the table `fluxdrive map ctable`
-# generates: FD_MACHINE_MAP). Exit status non-zero on any failure.
+# generates: FD_MACHINE_MAP) and stm32g474-dfc (the g474 image with the
+# Direct Flux Control window: FD_STAR_WINDOW). Exit status non-zero on any
+# failure.
 # FD_TARGET_BUILD_DIR=dir puts the build trees in dir/<preset> instead of
 # the presets' binaryDir (build/<preset>).
 set -eu
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 cd "$ROOT"
-[ $# -gt 0 ] || set -- stm32g474 stm32g431-esc1 stm32g474-map
+[ $# -gt 0 ] || set -- stm32g474 stm32g431-esc1 stm32g474-map stm32g474-dfc
 status=0
 for preset in "$@"; do
   case "$preset" in
     stm32g474)      board=g474;         ld=stm32g474re.ld ;;
     stm32g474-map)  board=g474;         ld=stm32g474re.ld ;;
+    stm32g474-dfc)  board=g474;         ld=stm32g474re.ld ;;
     stm32g431-esc1) board=b_g431b_esc1; ld=stm32g431cb.ld ;;
     *) echo "unknown preset $preset"; exit 2 ;;
   esac
@@ -26,7 +29,12 @@ for preset in "$@"; do
   if [ "$preset" = stm32g474-map ]; then
     extra="-DFD_MACHINE_MAP=$ROOT/maps/syr_1k1.fdmap"
   fi
-  if ! cmake --preset "${preset%-map}" -B "$bdir" $extra >/dev/null || ! cmake --build "$bdir"; then
+  if [ "$preset" = stm32g474-dfc ]; then
+    extra="-DFD_STAR_WINDOW=ON"
+  fi
+  base=${preset%-map}
+  base=${base%-dfc}
+  if ! cmake --preset "$base" -B "$bdir" $extra >/dev/null || ! cmake --build "$bdir"; then
     echo "FAIL: build of $preset"; status=1; continue
   fi
   elf="$bdir/hal/stm32g4/fluxdrive-$board.elf"

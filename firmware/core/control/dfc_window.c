@@ -23,3 +23,16 @@ void dfc_window_pattern(const float d[3], unsigned leg, float t0, float tw, floa
     off[x] = o + d[x];
   }
 }
+
+void dfc_window_moments(const float on[3], const float off[3], float m[3]) {
+  float mean = 0.0f;
+  for (unsigned x = 0u; x < 3u; ++x) {
+    const float d = off[x] - on[x];
+    m[x] = 0.5f * d * (1.0f - on[x] - off[x]);
+    mean += m[x];
+  }
+  mean *= 1.0f / 3.0f;
+  for (unsigned x = 0u; x < 3u; ++x) {
+    m[x] -= mean;
+  }
+}

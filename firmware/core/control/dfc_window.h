@@ -33,4 +33,12 @@ void dfc_window_range(float t0, float tw, float d_min, float d_max, float *lo, f
 void dfc_window_pattern(const float d[3], unsigned leg, float t0, float tw, float on[3],
                         float off[3]);
 
+/* The current sampled at the start of a period whose pattern is (on, off)
+ * differs from what centred pulses give (the period average less half the
+ * period's change) by -(v_dc Ts / L) m_x, with the phase moments
+ *   m_x = M_x - mean(M),  M_x = int_0^1 (1 - t)(P_x(t) - d_x) dt = d_x (1 - on_x - off_x) / 2
+ * (P_x the leg's pulse, d_x its width; M_x = 0 for a centred pulse). The
+ * drive adds (v_dc Ts / L) m_x of the pattern in force to the sample. */
+void dfc_window_moments(const float on[3], const float off[3], float m[3]);
+
 #endif

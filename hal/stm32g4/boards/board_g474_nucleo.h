@@ -61,7 +61,9 @@
   { 2u, 17u, ADC_SMP_24_5 } /* PA4  ADC2_IN17: sampled 0.6..1.2 us after the valley */
 /* The Direct Flux Control window (docs/dfc.md, star_window.c): the star
  * channel again, its regular conversion at the after-sample */
-#define BOARD_HAS_STAR_WINDOW   1
+#ifndef BOARD_HAS_STAR_WINDOW
+#define BOARD_HAS_STAR_WINDOW 0 /* CMake FD_STAR_WINDOW=ON sets it to 1 */
+#endif
 #define BOARD_ADC_VSTAR_ADC     2u
 #define BOARD_ADC_VSTAR_CHANNEL 17u
 #define BOARD_ADC_PINS                                                                             \

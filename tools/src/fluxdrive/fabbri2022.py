@@ -92,7 +92,9 @@ def base(root: Path, name: str) -> dict:
 
 def fig33_machine(p: float) -> dict:
     """The Fig. 3.3 inductances with M2 for anisotropy p: gamma0 = L0 - M0,
-    gamma2 = p gamma0 = L2/2 + M2; L_d, L_q = gamma0 +- gamma2 (plant.h)."""
+    gamma2 = p gamma0 = L2/2 + M2; L_d, L_q = gamma0 +- gamma2 (plant.h;
+    what the preset fabbri2022_fig33 with machine.star_p makes, for the
+    report's M2 column)."""
     g0 = PAPER.l0 - PAPER.m0
     g2 = p * g0
     return {"ld": g0 + g2, "lq": g0 - g2, "star_m0": PAPER.m0, "star_m2": g2 - 0.5 * PAPER.l2}
@@ -146,7 +148,8 @@ def _run(sil, sc, out, name) -> Run:
 
 def _pole_pairs(sc: dict) -> int:
     pre = sc["machine"].get("preset", "")
-    return int(sc["machine"].get("pole_pairs", {"fabbri2022_t51": 8, "fabbri2022_ebike": 23}[pre]))
+    return int(sc["machine"].get("pole_pairs", {"fabbri2022_t51": 8, "fabbri2022_fig33": 8,
+                                                "fabbri2022_ebike": 23}[pre]))
 
 
 # ------------------------------------------------------------ experiments
@@ -174,7 +177,7 @@ class Convergence:
 def convergence(sil, root, out, p: float, rs: float | None = None) -> Convergence:
     sc = base(root, "dyno")
     sc["name"] = f"Theorem 1, p = {p:+.2f}"
-    sc["machine"].update(fig33_machine(p))
+    sc["machine"] = {"preset": "fabbri2022_fig33", "star_p": p}
     if rs is not None:
         sc["machine"]["rs"] = rs
     sc["mechanics"]["speed"] = speed_const(50.0)
@@ -191,7 +194,7 @@ def refused(sil, root, out, p: float) -> str:
     ('' when it was accepted)."""
     import subprocess
     sc = base(root, "dyno")
-    sc["machine"].update(fig33_machine(p))
+    sc["machine"] = {"preset": "fabbri2022_fig33", "star_p": p}
     out.mkdir(parents=True, exist_ok=True)
     path = out / f"refused_{p:+.2f}.json"
     path.write_text(json.dumps(sc))

@@ -160,8 +160,8 @@ HOT void star_window_read(hal_sample_t *s, float before_now, float t_before) {
   const float ts = (float)(2u * BOARD_PWM_ARR) / (float)BOARD_SYSCLK_HZ;
   const adc_regs_t *adc = BOARD_ADC_VSTAR_ADC == 1u ? ADC1 : ADC2;
   /* the after-sample of the last period, converted since its ISR */
-  const float after = (float)(adc->DR & 0xFFFFu) * (BOARD_VDDA / 4095.0f) * BOARD_VSTAR_RATIO -
-                      0.5f * s->v_dc;
+  const float after =
+      (float)(adc->DR & 0xFFFFu) * (BOARD_VDDA / 4095.0f) * BOARD_VSTAR_RATIO - 0.5f * s->v_dc;
   s->n_star = s_win.tv_prev != 0u ? 2u : 0u;
   s->test_vector = s_win.tv_prev;
   s->v_star[0] = s_win.before_prev;

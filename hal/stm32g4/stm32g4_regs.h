@@ -165,49 +165,49 @@ typedef struct {
 #define TIM1 ((tim_regs_t *)0x40012C00u)
 #define TIM2 ((tim_regs_t *)0x40000000u)
 
-#define TIM_CR1_CEN        (1u << 0)
-#define TIM_CR1_DIR        (1u << 4)
-#define TIM_CR1_CMS_Pos    5u
-#define TIM_CR1_ARPE       (1u << 7)
-#define TIM_CR2_MMS_Pos    4u
-#define TIM_CR2_MMS_UPDATE 2u
-#define TIM_SR_UIF         (1u << 0)
-#define TIM_SR_BIF         (1u << 7)
-#define TIM_SR_B2IF        (1u << 8)
-#define TIM_SR_SBIF        (1u << 13)
-#define TIM_EGR_UG         (1u << 0)
-#define TIM_SR_CC4IF       (1u << 4)
-#define TIM_DIER_UDE       (1u << 8)
-#define TIM_CR2_MMS_OC4REF 7u  /* TRGO = OC4REF */
-#define TIM_CR2_MMS2_Pos   20u /* 1000: TRGO2 = OC5REF */
+#define TIM_CR1_CEN         (1u << 0)
+#define TIM_CR1_DIR         (1u << 4)
+#define TIM_CR1_CMS_Pos     5u
+#define TIM_CR1_ARPE        (1u << 7)
+#define TIM_CR2_MMS_Pos     4u
+#define TIM_CR2_MMS_UPDATE  2u
+#define TIM_SR_UIF          (1u << 0)
+#define TIM_SR_BIF          (1u << 7)
+#define TIM_SR_B2IF         (1u << 8)
+#define TIM_SR_SBIF         (1u << 13)
+#define TIM_EGR_UG          (1u << 0)
+#define TIM_SR_CC4IF        (1u << 4)
+#define TIM_DIER_UDE        (1u << 8)
+#define TIM_CR2_MMS_OC4REF  7u  /* TRGO = OC4REF */
+#define TIM_CR2_MMS2_Pos    20u /* 1000: TRGO2 = OC5REF */
 #define TIM_CR2_MMS2_OC5REF 8u
-#define TIM_CCMR_OC4PE     (1u << 11) /* in CCMR2 */
-#define TIM_CCMR_OC4M_Pos  12u
-#define TIM_CCMR3_OC5PE    (1u << 3)
-#define TIM_CCMR3_OC5M_Pos 4u
-#define TIM_DCR_DBA_Pos    0u /* DMA base: register index from CR1 */
-#define TIM_DCR_DBL_Pos    8u /* burst length - 1 */
-#define TIM_CCMR_OC1PE     (1u << 3)
-#define TIM_CCMR_OC1M_Pos  4u /* OC1M[2:0]; OC1M[3] is bit 16 */
-#define TIM_CCMR_OC2PE     (1u << 11)
-#define TIM_CCMR_OC2M_Pos  12u /* OC2M[2:0]; OC2M[3] is bit 24 */
-#define TIM_OCM_PWM2       7u
-#define TIM_CCER_CC1E      (1u << 0)
-#define TIM_CCER_CC1P      (1u << 1)
-#define TIM_CCER_CC1NE     (1u << 2)
-#define TIM_CCER_CC1NP     (1u << 3) /* channel n: shift by 4*(n-1) */
-#define TIM_BDTR_DTG_Msk   0xFFu
-#define TIM_BDTR_LOCK_Pos  8u
-#define TIM_BDTR_OSSI      (1u << 10)
-#define TIM_BDTR_OSSR      (1u << 11)
-#define TIM_BDTR_BKE       (1u << 12)
-#define TIM_BDTR_BKP       (1u << 13)
-#define TIM_BDTR_AOE       (1u << 14)
-#define TIM_BDTR_MOE       (1u << 15)
-#define TIM_BDTR_BKF_Pos   16u
-#define TIM1_AF1_BKINE     (1u << 0) /* BKIN pin enable (reset value 1) */
-#define TIM1_AF1_BKCMP1E   (1u << 1) /* COMPx output to break: bit x */
-#define TIM1_AF1_BKINP     (1u << 9)
+#define TIM_CCMR_OC4PE      (1u << 11) /* in CCMR2 */
+#define TIM_CCMR_OC4M_Pos   12u
+#define TIM_CCMR3_OC5PE     (1u << 3)
+#define TIM_CCMR3_OC5M_Pos  4u
+#define TIM_DCR_DBA_Pos     0u /* DMA base: register index from CR1 */
+#define TIM_DCR_DBL_Pos     8u /* burst length - 1 */
+#define TIM_CCMR_OC1PE      (1u << 3)
+#define TIM_CCMR_OC1M_Pos   4u /* OC1M[2:0]; OC1M[3] is bit 16 */
+#define TIM_CCMR_OC2PE      (1u << 11)
+#define TIM_CCMR_OC2M_Pos   12u /* OC2M[2:0]; OC2M[3] is bit 24 */
+#define TIM_OCM_PWM2        7u
+#define TIM_CCER_CC1E       (1u << 0)
+#define TIM_CCER_CC1P       (1u << 1)
+#define TIM_CCER_CC1NE      (1u << 2)
+#define TIM_CCER_CC1NP      (1u << 3) /* channel n: shift by 4*(n-1) */
+#define TIM_BDTR_DTG_Msk    0xFFu
+#define TIM_BDTR_LOCK_Pos   8u
+#define TIM_BDTR_OSSI       (1u << 10)
+#define TIM_BDTR_OSSR       (1u << 11)
+#define TIM_BDTR_BKE        (1u << 12)
+#define TIM_BDTR_BKP        (1u << 13)
+#define TIM_BDTR_AOE        (1u << 14)
+#define TIM_BDTR_MOE        (1u << 15)
+#define TIM_BDTR_BKF_Pos    16u
+#define TIM1_AF1_BKINE      (1u << 0) /* BKIN pin enable (reset value 1) */
+#define TIM1_AF1_BKCMP1E    (1u << 1) /* COMPx output to break: bit x */
+#define TIM1_AF1_BKINP      (1u << 9)
 
 /* ---- ADC: RM0440 section 21.7 (ADC1/ADC2 registers) and 21.8 (common
  * registers of ADC1/ADC2 at ADC12 base + 0x300) ---- */
@@ -252,25 +252,25 @@ typedef struct {
 #define ADC2         ((adc_regs_t *)0x50000100u)
 #define ADC12_COMMON ((adc_common_regs_t *)0x50000300u)
 
-#define ADC_ISR_ADRDY   (1u << 0)
-#define ADC_ISR_JEOC    (1u << 5)
-#define ADC_ISR_JEOS    (1u << 6)
-#define ADC_ISR_JQOVF   (1u << 10)
-#define ADC_IER_JEOSIE  (1u << 6)
-#define ADC_CR_ADEN     (1u << 0)
-#define ADC_CR_ADDIS    (1u << 1)
-#define ADC_CR_JADSTART (1u << 3)
-#define ADC_CR_ADVREGEN (1u << 28)
-#define ADC_CR_DEEPPWD  (1u << 29)
-#define ADC_CR_ADCALDIF (1u << 30)
-#define ADC_CR_ADCAL    (1u << 31)
-#define ADC_CFGR_JQDIS  (1u << 31)
+#define ADC_ISR_ADRDY       (1u << 0)
+#define ADC_ISR_JEOC        (1u << 5)
+#define ADC_ISR_JEOS        (1u << 6)
+#define ADC_ISR_JQOVF       (1u << 10)
+#define ADC_IER_JEOSIE      (1u << 6)
+#define ADC_CR_ADEN         (1u << 0)
+#define ADC_CR_ADDIS        (1u << 1)
+#define ADC_CR_JADSTART     (1u << 3)
+#define ADC_CR_ADVREGEN     (1u << 28)
+#define ADC_CR_DEEPPWD      (1u << 29)
+#define ADC_CR_ADCALDIF     (1u << 30)
+#define ADC_CR_ADCAL        (1u << 31)
+#define ADC_CFGR_JQDIS      (1u << 31)
 #define ADC_CFGR_EXTSEL_Pos 5u  /* ADC12 regular: 10 = TIM1_TRGO2 (RM0440 21.4.18) */
 #define ADC_CFGR_EXTEN_Pos  10u /* 01: rising edge */
 #define ADC_CFGR_OVRMOD     (1u << 12)
 #define ADC_CR_ADSTART      (1u << 2)
 #define ADC_SQR1_SQ1_Pos    6u
-#define ADC_JSQR_JL_Pos 0u
+#define ADC_JSQR_JL_Pos     0u
 #define ADC_JSQR_JEXTSEL_Pos                                                                       \
   2u /* ADC12 JEXT0 = TIM1_TRGO (RM0440 21.4.x, ADC1/2 injected trigger table) */
 #define ADC_JSQR_JEXTEN_Pos    7u                           /* 01: rising edge */
@@ -299,16 +299,16 @@ typedef struct {
   reg32_t IFCR; /* 0x04 */
   dma_channel_regs_t CH[8];
 } dma_regs_t;
-#define DMA1                ((dma_regs_t *)0x40020000u)
-#define DMAMUX1_C0CR        (*(reg32_t *)0x40020800u)
-#define DMA_CCR_EN          (1u << 0)
-#define DMA_CCR_DIR         (1u << 4) /* read from memory */
-#define DMA_CCR_CIRC        (1u << 5)
-#define DMA_CCR_MINC        (1u << 7)
-#define DMA_CCR_PSIZE_32    (2u << 8)
-#define DMA_CCR_MSIZE_32    (2u << 10)
-#define DMA_CCR_PL_VHIGH    (3u << 12)
-#define DMAMUX_REQ_TIM1_UP  46u /* RM0440 table 91 */
+#define DMA1                  ((dma_regs_t *)0x40020000u)
+#define DMAMUX1_C0CR          (*(reg32_t *)0x40020800u)
+#define DMA_CCR_EN            (1u << 0)
+#define DMA_CCR_DIR           (1u << 4) /* read from memory */
+#define DMA_CCR_CIRC          (1u << 5)
+#define DMA_CCR_MINC          (1u << 7)
+#define DMA_CCR_PSIZE_32      (2u << 8)
+#define DMA_CCR_MSIZE_32      (2u << 10)
+#define DMA_CCR_PL_VHIGH      (3u << 12)
+#define DMAMUX_REQ_TIM1_UP    46u /* RM0440 table 91 */
 #define RCC_AHB1ENR_DMA1EN    (1u << 0)
 #define RCC_AHB1ENR_DMAMUX1EN (1u << 2)
 

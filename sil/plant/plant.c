@@ -121,6 +121,9 @@ void plant_step_pattern(plant_t *pl, const double on_in[3], const double off_in[
   pl->v_abc_avg[1] = x[X_VB] * inv_ts;
   pl->v_abc_avg[2] = -(pl->v_abc_avg[0] + pl->v_abc_avg[1]);
   pl->i_dc_avg = x[X_IDC] * inv_ts;
+  pl->torque_avg = x[X_TE] * inv_ts;
+  pl->i_dq_avg[0] = x[X_ID] * inv_ts;
+  pl->i_dq_avg[1] = x[X_IQ] * inv_ts;
   if (avg) {
     pl->aux.v_star = x[X_VN] * inv_ts;
     for (int k = 0; k < pl->aux.star_n; k++) { /* no switching instants */
@@ -189,4 +192,7 @@ void plant_get_state(const plant_t *pl, plant_state_t *out) {
   out->load_torque = pl->p.mech.mode == PLANT_MECH_FREE ? plant_mech_input(pl, pl->t) : 0.0;
   out->v_dc = pl->v_dc;
   out->i_dc = pl->i_dc_avg;
+  out->torque_avg = pl->torque_avg;
+  out->i_dq_avg[0] = pl->i_dq_avg[0];
+  out->i_dq_avg[1] = pl->i_dq_avg[1];
 }

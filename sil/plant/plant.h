@@ -132,6 +132,8 @@ typedef struct {
   double load_torque;  /* load torque in force [N m] */
   double v_dc;         /* DC-link capacitor voltage [V] */
   double i_dc;         /* period-average DC-link current drawn [A] */
+  double torque_avg;   /* period average of the torque, last step [N m] */
+  double i_dq_avg[2];  /* period averages of the rotor-frame currents, last step [A] */
 } plant_state_t;
 
 #define PLANT_ZIG_N    128 /* layers of the ziggurat normal generator */
@@ -201,6 +203,7 @@ typedef struct {
   double v_dc;
   double v_abc_avg[3];
   double i_dc_avg;
+  double torque_avg, i_dq_avg[2]; /* period averages of the last step */
   uint64_t rng;
   plant_aux_t aux; /* internal */
 } plant_t;

@@ -32,6 +32,9 @@ enum {
   X_VB,  /* integral of v_bn [V s] */
   X_VN,  /* integral of (star point w.r.t. DC midpoint) [V s] */
   X_IDC, /* integral of the DC-link current drawn by the inverter [A s] */
+  X_TE,  /* integral of the electromagnetic torque [N m s] */
+  X_ID,  /* integrals of the rotor-frame currents [A s] */
+  X_IQ,
   X_N
 };
 

@@ -98,11 +98,14 @@ static inline void avg_deriv(const avg_k_t *restrict k, int ideal, int imposed, 
   const double we = k->pp * w;
   dx[X_LD] = vd - k->rs * id + we * x[X_LQ];
   dx[X_LQ] = vq - k->rs * iq - we * x[X_LD];
+  const double te = 1.5 * k->pp * (x[X_LD] * iq - x[X_LQ] * id);
+  dx[X_TE] = te;
+  dx[X_ID] = id;
+  dx[X_IQ] = iq;
   if (imposed) {
     dx[X_TH] = m;
     dx[X_W] = 0.0;
   } else {
-    const double te = 1.5 * k->pp * (x[X_LD] * iq - x[X_LQ] * id);
     dx[X_TH] = x[X_W];
     dx[X_W] = (te - k->b * x[X_W] - m) * k->inv_j;
   }

@@ -96,7 +96,7 @@ static void sw_deriv(const plant_t *pl, const sw_cfg_t *cf, const double *x, dou
   const double vdc = plant_dclink_voltage(pl, x);
   const double w = plant_mech_speed(pl, x, m);
   const double we = pp * w;
-  double te = 0.0, idc = 0.0, vn0;
+  double te = 0.0, idc = 0.0, vn0, id_now = 0.0, iq_now = 0.0;
   if (cf->all_zero) {
     double e[3], lo_max = -1e300, hi_min = 1e300;
     backemf(pl, x, w, e);
@@ -163,6 +163,8 @@ static void sw_deriv(const plant_t *pl, const sw_cfg_t *cf, const double *x, dou
     dx[X_VA] = v[0] - vn0;
     dx[X_VB] = v[1] - vn0;
     te = 1.5 * pp * (x[X_LD] * iq - x[X_LQ] * id);
+    id_now = id;
+    iq_now = iq;
   }
   o->vn0 = vn0;
   o->vdc = vdc;
@@ -170,6 +172,9 @@ static void sw_deriv(const plant_t *pl, const sw_cfg_t *cf, const double *x, dou
   dx[X_VC] = plant_dclink_deriv(pl, x, idc);
   dx[X_VN] = vn0 - 0.5 * vdc;
   dx[X_IDC] = idc;
+  dx[X_TE] = te;
+  dx[X_ID] = id_now;
+  dx[X_IQ] = iq_now;
 }
 
 static void enter_all_zero(const plant_t *pl, sw_cfg_t *cf, double *x) {

@@ -17,7 +17,7 @@ static const char *const signals[] = {
     "torque_mtpv", "gain_a",      "gain_b",      "mtpa_angle", "mtpv_angle", "theta_e_enc",
     "dfc_t",       "dfc_ga",      "dfc_gb",      "dfc_gc",     "dfc_k0",     "dfc_k1",
     "dfc_k2",      "dfc_k3",      "dfc_k4",      "dfc_k5",     "dfc_k6",     "dfc_k7",
-    "dfc_k8"};
+    "dfc_k8",      "torque_avg",  "i_d_avg",     "i_q_avg"};
 enum { NSIG = sizeof signals / sizeof signals[0], HEADER_LEN = 4096 };
 
 static void fill_row(const sil_step_t *st, double *r) {
@@ -97,7 +97,10 @@ static void fill_row(const sil_step_t *st, double *r) {
                     k2[5],
                     k2[6],
                     k2[7],
-                    k2[8]};
+                    k2[8],
+                    p->torque_avg,
+                    p->i_dq_avg[0],
+                    p->i_dq_avg[1]};
   memcpy(r, v, sizeof v);
 }
 

@@ -109,3 +109,14 @@ def test_closed_loop_on_the_ivd_position(res):
         assert lp.speed_std < 0.01 * lp.rpm, tag
         assert abs(lp.err_mean_deg) < 1.0 and lp.err_std_deg < 1.0, tag
         assert lp.err_max_deg < 5.0, tag
+
+
+def test_the_other_laws_run_on_the_star_point(res):
+    """Drive integration: the decoupled DFVC (Table 5.1 motor, IVD) and the
+    DB-DFVC of Rubino 2020 (an SPM machine with a star point, DFC) hold
+    their torque references on the star-point position as on the encoder:
+    no fault, the period-average torque within 2 % of each reference."""
+    for st, enc in res.laws:
+        assert not st.faults and not enc.faults, st.law
+        for t, r in zip(st.torque, st.refs):
+            assert abs(t / r - 1.0) < 0.02, (st.law, t, r)

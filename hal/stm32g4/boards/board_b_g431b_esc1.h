@@ -74,11 +74,11 @@
 
 /* Shunt 3 mOhm; total gain shunt -> ADC pin 9.14 V/V (external resistor
  * network + PGA x16); the signal FALLS with current into the machine. */
-#define BOARD_VDDA        3.3f
-#define BOARD_I_MID_V     1.65f /* nominal; the drive calibrates the real offset */
-#define BOARD_I_A_PER_V   (-1.0f / (0.003f * 9.14f))
-#define BOARD_VDC_RATIO   (1.0f / 0.0962f) /* bus divider gain 0.0962 */
-#define BOARD_VSTAR_RATIO 0.0f
+#define BOARD_VDDA            3.3f
+#define BOARD_I_MID_V         1.65f /* nominal; the drive calibrates the real offset */
+#define BOARD_I_A_PER_V       (-1.0f / (0.003f * 9.14f))
+#define BOARD_VDC_RATIO       (1.0f / 0.0962f) /* bus divider gain 0.0962 */
+#define BOARD_VSTAR_RATIO     0.0f
 #define BOARD_HAS_STAR_WINDOW 0 /* no star-point sensing on the kit */
 
 /* Protections: 6S LiPo (25.2 V) max, kit rated 40 A peak. */

@@ -148,7 +148,7 @@ def _run(sil, sc, out, name) -> Run:
 
 def _pole_pairs(sc: dict) -> int:
     pre = sc["machine"].get("preset", "")
-    return int(sc["machine"].get("pole_pairs", {"fabbri2022_t51": 8, "fabbri2022_fig33": 8,
+    return int(sc["machine"].get("pole_pairs", {"fabbri2022_t51": 8, "fabbri2022_fig33": 8, "rubino2020_spm": 21,
                                                 "fabbri2022_ebike": 23}[pre]))
 
 
@@ -281,7 +281,7 @@ def _shift_measure(r: Run, label: str) -> ShiftRun:
     for i in range(len(PAPER.iq_steps)):
         a = 0.1 + i * SHIFT_STEP + 0.05
         m = (lg["t"] >= a) & (lg["t"] < a + SHIFT_STEP - 0.05)
-        iq.append(float(np.mean(lg["i_q"][m])))
+        iq.append(float(np.mean(lg["i_q_avg"][m])))  # the period average
         mean.append(float(np.mean(e[m])))
     m = lg["t"] >= 0.1
     return ShiftRun(label, np.array(iq), np.array(mean), lg["t"][m], e[m])
@@ -341,6 +341,55 @@ def closed_loop(sil, root, out, rpm: float, theta0_mech: float) -> Loop:
                 float(np.std(e[m])), float(np.max(np.abs(e[m]))), lg["t"], sp, e)
 
 
+@dataclass
+class LawRun:
+    law: str
+    machine: str
+    source: str
+    rpm: float
+    faults: list
+    refs: tuple  # torque references of the two steps [N m]
+    torque: tuple  # period-average torque over each step [N m]
+    err_deg: float  # angle - encoder, mean [deg electrical]
+
+
+# the other laws on the star point: (law, machine, star-point keys, source,
+# dyno speed [rpm], torque steps [N m]). The Rubino 2020 laws need an SPM
+# machine: the Table I machine given an assumed star point (p = 0: the IVD
+# is the standard DFC) at 100 rpm, inside the window's voltage range.
+LAW_CASES = (
+    ("dfvc_decoupled", "fabbri2022_t51", {}, "ivd", 300.0, (0.05, 0.1), 13.0),
+    ("db_dfvc", "rubino2020_spm", {"star_m0": 0.003, "star_m2": 0.005}, "dfc", 100.0, (5.0, 10.0),
+     200.0),
+)  # the last: the star channel's range [V] (310 V link for rubino2020_spm)
+
+
+def law_run(sil, root, out, case, source: str) -> LawRun:
+    law, machine, star, src, rpm, steps, fs = case
+    sc = base(root, "dyno")
+    sc["sensors"]["star_full_scale"] = fs
+    sc["name"] = f"{law} on {source}, {machine}"
+    sc["machine"] = {"preset": machine, **star}
+    sc["inverter"]["dead_time"] = 1e-6
+    sc["mechanics"] = {"mode": "imposed", "theta0": 0.001, "speed": {"unit": "rpm", "terms": [
+        {"type": "ramp", "t0": 0.05, "t1": 0.25, "value": rpm}]}}
+    sc["controller"] = {"law": law, "mode": "torque", "pos_source": source, "dfc_iter": 1,
+                        "align_time": 0.02,
+                        "align_current": 0.5 if machine == "fabbri2022_t51" else 1.0}
+    sc["references"] = {"torque": [{"type": "step", "t": 0.3, "value": steps[0]},
+                                   {"type": "step", "t": 0.55, "value": steps[1] - steps[0]}]}
+    sc["duration"] = 0.8
+    r = _run(sil, sc, out, f"law_{law}_{source}")
+    lg = r.log
+    tq = []
+    for a in (0.4, 0.65):
+        m = (lg["t"] >= a) & (lg["t"] < a + 0.15)
+        tq.append(float(np.mean(lg["torque_avg"][m])))
+    m = lg["t"] >= 0.4
+    e = float(np.mean(np.degrees(wrap(lg["theta_e_est"][m] - lg["theta_e_enc"][m]))))
+    return LawRun(law, machine, source, rpm, r.summary.get("faults_seen", []), steps, tuple(tq), e)
+
+
 class Results:
     """The experiments, each run on first use (the tests share one)."""
 
@@ -370,6 +419,11 @@ class Results:
     @functools.cached_property
     def shift(self) -> tuple:
         return phase_shift(self.sil, self.root, self.out)
+
+    @functools.cached_property
+    def laws(self) -> list:  # [(star-point run, encoder run)]
+        return [(law_run(self.sil, self.root, self.out, c, c[3]),
+                 law_run(self.sil, self.root, self.out, c, "encoder")) for c in LAW_CASES]
 
     @functools.cached_property
     def loops(self) -> list:
@@ -420,6 +474,16 @@ def report(res: Results) -> str:
                  f"{lp.speed_mean:.2f} +- {lp.speed_std:.2f} rpm | {lp.est_mean:+.2f} +- "
                  f"{lp.est_std:.2f} rpm | {lp.err_mean_deg:+.2f} deg | {lp.err_std_deg:.2f} deg | "
                  f"{lp.err_max_deg:.2f} deg |")
+    L += ["", "### The other laws on the star point (dynamometer, torque steps)", "",
+          "Period-average torque (plant) over each step, against the encoder's run:", "",
+          "| law | machine | source | speed | faults | torque (reference) | with the encoder | "
+          "angle - encoder |", "|---|---|---|---|---|---|---|---|"]
+    for st, enc in res.laws:
+        tq = ", ".join(f"{t:.4f} ({r:g})" for t, r in zip(st.torque, st.refs))
+        te = ", ".join(f"{t:.4f}" for t in enc.torque)
+        L.append(f"| {st.law} | {st.machine} | {st.source} | {st.rpm:g} rpm | "
+                 f"{', '.join(st.faults) or 'none'} | {tq} N m | {te} N m | "
+                 f"{st.err_deg:+.2f} deg |")
     return "\n".join(L)
 
 

@@ -12,7 +12,9 @@
  * link at t_i (the valley plus the ADC's sampling delay: the centre of the
  * zero vector 000, where the sampled current equals the period average),
  * the encoder at t_enc and up to HAL_STAR_MAX star-point voltages at their
- * own instants; drive_isr() runs after the last of them. The pattern
+ * own instants; drive_isr() runs after the last of them (a star-point
+ * sample taken in the period before, as the DFC window's after-sample is
+ * on the SIL and the STM32G4, has a negative instant). The pattern
  * written by hal_pwm_write() is preloaded and acts over the next period
  * [t_{k+1}, t_{k+2}), so a command computed from the samples of period k
  * acts one period later; the drive extrapolates the rotor angle from the

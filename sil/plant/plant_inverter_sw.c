@@ -264,7 +264,20 @@ static void exit_all_zero(const plant_t *pl, sw_cfg_t *cf, double t, const doubl
     }
   }
   /* jx sources current into the machine (i > 0: low diode), jy returns it
-   * (i < 0: high diode); jx != jy since gap > 0. */
+   * (i < 0: high diode); jx != jy when gap > 0. At the event's located
+   * instant the gap may be within rounding of 0 with one leg at both
+   * extremes (all three back-EMFs equal, e.g. at standstill): the returning
+   * leg is then the most negative of the other two. */
+  if (jy == jx) {
+    best_hi = 1e300;
+    for (int j = 0; j < 3; j++) {
+      leg_range(cf->type[j], vdc, &lo, &hi);
+      if (j != jx && hi - e[j] < best_hi) {
+        best_hi = hi - e[j];
+        jy = j;
+      }
+    }
+  }
   const int jz = 3 - jx - jy;
   cf->all_zero = 0;
   cf->cond[jx] = cf->type[jx] == LEG_FLOAT ? COND_LO : COND_NONE;

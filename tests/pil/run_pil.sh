@@ -6,8 +6,8 @@
 # every ISR of both (--isrs all: the whole flux-weakening ramp, current
 # limit, voltage limit and MTPV included). Outputs must agree with this host
 # build's within the stated tolerance; the DB-DFVC worst case must stay
-# below 3000 instructions (measured 2844, whole ramp) and at or below 50 %
-# of the 10625-cycle budget in estimated Cortex-M4 cycles (measured 44.7 %;
+# below 3000 instructions (measured 2852, whole ramp) and at or below 50 %
+# of the 10625-cycle budget in estimated Cortex-M4 cycles (measured 44.9 %;
 # why 50 %: docs/pil.md, "Scenarios and checks"). Prints the report and writes its
 # markdown section to BUILD_DIR/benchmarks.md.
 # Usage: run_pil.sh SRC_DIR BUILD_DIR PYTHON FLUXDRIVE_SIL
@@ -33,8 +33,8 @@ export PYTHONPATH="$src/tools/src${PYTHONPATH:+:$PYTHONPATH}"
   --markdown "$build/benchmarks-map.md"
 # the decoupled DFVC of Varatharajan 2022 on the same map through MTPA,
 # flux weakening and the MTPV limit: agreement, and the target of
-# fewer than 2500 instructions per ISR on average (measured 2488, worst
-# 2789: docs/benchmarks.md, "Decoupled DFVC")
+# fewer than 2500 instructions per ISR on average (measured 2497, worst
+# 2797: docs/benchmarks.md, "Decoupled DFVC")
 "$python" -m fluxdrive pil "$src/sil/scenarios/pil_dfvc_decoupled.json" --law dfvc_decoupled \
   --isrs all --check-mean 2500 --sil "$sil" --elf "$build/cross/pil/fluxdrive-pil.elf" \
   --out "$build/work" --markdown "$build/benchmarks-decoupled.md"

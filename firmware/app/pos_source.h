@@ -1,9 +1,9 @@
 /*
  * pos_source.h - where the rotor angle comes from, behind one table of
  * sources {name, capabilities, init, reset, update, align}; one row per
- * entry of POS_SOURCE_LIST (drive_enums.h). The encoder today; the
- * sensorless sources (Direct Flux Control, IVD, Kalman filter) come as more
- * rows with the same estimate.
+ * entry of POS_SOURCE_LIST (drive_enums.h): the encoder (pos_encoder.c)
+ * and the star point (pos_dfc.c: DFC, inverse DFC, IVD / Full IVD); the
+ * Kalman filter comes as more rows with the same estimate.
  *
  * Every period the source turns the HAL's sample set into an estimate
  * {theta, omega, t, valid, health}: the electrical angle at instant t of the

@@ -31,19 +31,51 @@ __attribute__((weak)) int32_t fd_cordic_atan2_q31(int32_t y, int32_t x, int32_t 
     y = -y;
     z = 0x80000000u;
   }
-  for (int i = 0; i < FD_CORDIC_ITER; ++i) {
-    const int32_t xs = x >> i; /* arithmetic shift: floor division by 2^i */
-    const int32_t ys = y >> i;
-    if (y > 0) {
-      x += ys;
-      y -= xs;
-      z += (uint32_t)fd_cordic_atan_q31[i];
-    } else {
-      x -= ys;
-      y += xs;
-      z -= (uint32_t)fd_cordic_atan_q31[i];
-    }
-  }
+  /* unrolled: constant shifts become the shifted operands of the adds
+   * (one Thumb-2 instruction each), no loop counter (the same arithmetic,
+   * bit for bit, as the loop over i) */
+#define FD_CORDIC_STEP(i)                                                                          \
+  do {                                                                                             \
+    const int32_t xs = x >> (i); /* arithmetic shift: floor division by 2^i */                     \
+    const int32_t ys = y >> (i);                                                                   \
+    if (y > 0) {                                                                                   \
+      x += ys;                                                                                     \
+      y -= xs;                                                                                     \
+      z += (uint32_t)fd_cordic_atan_q31[i];                                                        \
+    } else {                                                                                       \
+      x -= ys;                                                                                     \
+      y += xs;                                                                                     \
+      z -= (uint32_t)fd_cordic_atan_q31[i];                                                        \
+    }                                                                                              \
+  } while (0)
+  FD_CORDIC_STEP(0);
+  FD_CORDIC_STEP(1);
+  FD_CORDIC_STEP(2);
+  FD_CORDIC_STEP(3);
+  FD_CORDIC_STEP(4);
+  FD_CORDIC_STEP(5);
+  FD_CORDIC_STEP(6);
+  FD_CORDIC_STEP(7);
+  FD_CORDIC_STEP(8);
+  FD_CORDIC_STEP(9);
+  FD_CORDIC_STEP(10);
+  FD_CORDIC_STEP(11);
+  FD_CORDIC_STEP(12);
+  FD_CORDIC_STEP(13);
+  FD_CORDIC_STEP(14);
+  FD_CORDIC_STEP(15);
+  FD_CORDIC_STEP(16);
+  FD_CORDIC_STEP(17);
+  FD_CORDIC_STEP(18);
+  FD_CORDIC_STEP(19);
+  FD_CORDIC_STEP(20);
+  FD_CORDIC_STEP(21);
+  FD_CORDIC_STEP(22);
+  FD_CORDIC_STEP(23);
+  FD_CORDIC_STEP(24);
+  FD_CORDIC_STEP(25);
+#undef FD_CORDIC_STEP
+  _Static_assert(FD_CORDIC_ITER == 26, "one FD_CORDIC_STEP per iteration");
   if (mag != NULL) {
     *mag = x;
   }

@@ -214,6 +214,8 @@ class Harmonic:
     std: np.ndarray  # position-error standard deviation per k [rad electrical]
     t: np.ndarray
     e: dict  # k -> position error [rad electrical]
+    inv_amp: float = float("nan")  # the inverse DFC's (3.15)-(3.16), same run conditions
+    inv_std: float = float("nan")
 
     @property
     def cut(self) -> float:
@@ -238,8 +240,13 @@ def harmonic(sil, root, out, preset: str, rpm: float, iters: int) -> Harmonic:
         es[k] = 0.5 * e2
         amps.append(amp_at(t, 0.5 * e2, 6.0 * f_e))
         stds.append(float(np.std(0.5 * e2)))
+    # the inverse DFC (3.15)-(3.16) on the same machine and speed
+    sc["controller"]["pos_source"] = "dfc_inv"
+    ri = _run(sil, sc, out, f"harm_{preset}_{rpm:g}_inv")
+    ti, ei = err2(ri, 0, 0.05)
     return Harmonic(preset, rpm, PAPER.p_of(*ldq), iters, 6.0 * f_e, np.array(amps),
-                    np.array(stds), t, es)
+                    np.array(stds), t, es, amp_at(ti, 0.5 * ei, 6.0 * f_e),
+                    float(np.std(0.5 * ei)))
 
 
 @dataclass
@@ -449,13 +456,15 @@ def report(res: Results) -> str:
         L.append(f"* p = {p:+.2f}: `{msg.splitlines()[-1] if msg else 'ACCEPTED'}`")
     L += ["", "### Anisotropy harmonic of the position error (Figs. 5.3-5.4, 5.17-5.18)", "",
           "| motor | p | speed | 6 f_e | DFC amplitude | IVD amplitude (iterations) | cut | "
-          "DFC std | IVD std |", "|---|---|---|---|---|---|---|---|---|"]
+          "DFC std | IVD std | inverse DFC amplitude, std |",
+          "|---|---|---|---|---|---|---|---|---|---|"]
     for h in res.harm:
         n = h.iters
         L.append(f"| {h.motor} | {h.p:+.4f} | {h.rpm:g} rpm | {h.f6:.0f} Hz | "
                  f"{np.degrees(h.amp[0]):.3f} deg | {np.degrees(h.amp[n]):.4f} deg ({n}) | "
                  f"{100 * h.cut:.1f} % | {np.degrees(h.std[0]):.3f} deg | "
-                 f"{np.degrees(h.std[n]):.3f} deg |")
+                 f"{np.degrees(h.std[n]):.3f} deg | {np.degrees(h.inv_amp):.3f} deg, "
+                 f"{np.degrees(h.inv_std):.3f} deg |")
     runs, pa, pb = res.shift
     L += ["", "### Load-dependent phase shift (Fig. 5.5): 300 rpm, i_q steps", "",
           f"Plant: saliency shift {SHIFT_PHI_IQ} rad/A of 2theta (phi_a = {SHIFT_PHI_IQ} i_q, "

@@ -120,3 +120,20 @@ def test_the_other_laws_run_on_the_star_point(res):
         assert not st.faults and not enc.faults, st.law
         for t, r in zip(st.torque, st.refs):
             assert abs(t / r - 1.0) < 0.02, (st.law, t, r)
+
+
+def test_a_dead_star_channel_trips_position(tmp_path):
+    """Fault: the star channel reads nothing usable (its range 10 mV: every
+    sample clipped). The signal vector has no direction, the source is
+    invalid after the alignment, and the drive trips `position` with the
+    gates off, instead of commutating on a coasting PLL."""
+    sc = fb.base(REPO_ROOT, "speed")
+    sc["sensors"]["star_full_scale"] = 0.01
+    sc["duration"] = 0.3
+    r = fb.run(REAL_SIL, sc, tmp_path, "dead_star")
+    assert r.summary["faults_seen"] == ["position"]
+    lg = r.log
+    k = np.nonzero(lg["faults"])[0][0]
+    align = np.nonzero(lg["state"] == 4)[0]  # docs/log-format.md: 4 align
+    assert len(align) > 0 and 0 < k - align[-1] <= 2  # when the run would start
+    assert np.all(lg["gates"][k + 1:] == 0)

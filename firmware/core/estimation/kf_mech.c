@@ -4,6 +4,7 @@
  */
 #include "kf_mech.h"
 
+#include "math/fast_trig.h"
 #include "math/fd_math.h"
 #include "math/frames.h"
 
@@ -89,6 +90,45 @@ bool kf_mech_update(kf_mech_t *k, float theta_meas, float r) {
   p[P22] += -2.0f * k2 * c2 + s * k2 * k2;
   p[P23] += -k2 * c3 - c2 * k3 + s * k2 * k3;
   p[P33] += -2.0f * k3 * c3 + s * k3 * k3;
+  return true;
+}
+
+bool kf_mech_update_ekf(kf_mech_t *k, float g_al, float g_be, float a, float b, float r) {
+  if (!(fd_isfinite(g_al) && fd_isfinite(g_be) && fd_isfinite(a) && fd_isfinite(b)) ||
+      !(r > 0.0f) || !fd_isfinite(r)) {
+    return false;
+  }
+  float *x = k->x, *p = k->p;
+  float s2, c2;
+  fd_sincosf(2.0f * x[1], &s2, &c2);
+  const float c4 = c2 * c2 - s2 * s2, s4 = 2.0f * s2 * c2;
+  /* innovation (4.41) and the theta column of H (4.36) */
+  const float e1 = g_al - (-a * c2 + b * c4), e2 = g_be - (a * s2 + b * s4);
+  const float h1 = 2.0f * a * s2 - 4.0f * b * s4, h2 = 2.0f * a * c2 + 4.0f * b * c4;
+  /* P H^T = c h^T with c = P's theta column; S = (h h^T) p22 + r I (4.37) */
+  const float c1 = p[P12], cc2 = p[P22], c3 = p[P23];
+  const float s11 = h1 * h1 * cc2 + r, s12 = h1 * h2 * cc2, s22 = h2 * h2 * cc2 + r;
+  const float det = s11 * s22 - s12 * s12;
+  if (!(det > 0.0f) || !fd_isfinite(det)) {
+    return false;
+  }
+  const float id = 1.0f / det;
+  /* K = c h^T S^-1 = c v^T, v = S^-1 h */
+  const float v1 = (s22 * h1 - s12 * h2) * id, v2 = (s11 * h2 - s12 * h1) * id;
+  const float nu = v1 * e1 + v2 * e2; /* v^T e */
+  x[0] += c1 * nu;
+  x[1] = frames_wrap_pi(x[1] + cc2 * nu);
+  x[2] += c3 * nu;
+  /* Joseph form (4.39): with K = c v^T and H = h e_theta^T,
+   * P+ = P - c g c^T - c g c^T + (g^2 p22 + r |v|^2) c c^T, g = v^T h */
+  const float g = v1 * h1 + v2 * h2;
+  const float w = -2.0f * g + g * g * cc2 + r * (v1 * v1 + v2 * v2);
+  p[P11] += w * c1 * c1;
+  p[P12] += w * c1 * cc2;
+  p[P13] += w * c1 * c3;
+  p[P22] += w * cc2 * cc2;
+  p[P23] += w * cc2 * c3;
+  p[P33] += w * c3 * c3;
   return true;
 }
 

@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .paper_report import Run, replace_table, run, stacked_axes
+from .paper_report import Run, paper_paths, replace_table, run, stacked_axes
 
 RPM = np.pi / 30.0
 TWO_PI = 2.0 * np.pi
@@ -531,13 +531,7 @@ def plot_shift_loop(res: Results, path: Path) -> None:
 
 
 def main_fabbri(args) -> int:
-    from .sil import find_repo_root, locate_sil
-
-    root = find_repo_root() or Path.cwd()
-    sil = locate_sil(args.sil)
-    out = Path(args.out) if args.out else root / "out" / "fabbri2022"
-    figs = Path(args.figures) if args.figures else root / "docs" / "figures"
-    figs.mkdir(parents=True, exist_ok=True)
+    root, sil, out, figs = paper_paths(args, "fabbri2022")
     res = Results(sil, root, out)
     table = report(res)
     plot_harmonic(res, figs / "fabbri2022_harmonic.png")

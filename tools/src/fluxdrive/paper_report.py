@@ -58,3 +58,17 @@ def run(sil: Path, scenario: dict, out: Path, name: str) -> Run:
     if res.returncode != 0:
         raise RuntimeError(f"{name}: fluxdrive-sil exit {res.returncode}: {res.stderr.strip()}")
     return Run(scenario, np.load(log_path), json.loads(res.stdout))
+
+
+def paper_paths(args, name: str) -> tuple[Path, Path, Path, Path]:
+    """(repository root, fluxdrive-sil, log directory, figure directory) of
+    a paper reproduction's command line (--sil, --out, --figures; defaults
+    out/<name> and docs/figures, the latter created)."""
+    from .sil import find_repo_root, locate_sil
+
+    root = find_repo_root() or Path.cwd()
+    sil = locate_sil(args.sil)
+    out = Path(args.out) if args.out else root / "out" / name
+    figs = Path(args.figures) if args.figures else root / "docs" / "figures"
+    figs.mkdir(parents=True, exist_ok=True)
+    return root, sil, out, figs

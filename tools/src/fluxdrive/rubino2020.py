@@ -19,7 +19,7 @@ import subprocess
 import numpy as np
 
 from . import capability as capmod
-from .paper_report import replace_table, stacked_axes
+from .paper_report import paper_paths, replace_table, stacked_axes
 
 RPM = np.pi / 30.0
 
@@ -530,13 +530,7 @@ def report(met: dict) -> str:
 
 
 def main_rubino(args) -> int:
-    from .sil import find_repo_root, locate_sil
-
-    root = find_repo_root() or Path.cwd()
-    sil = locate_sil(args.sil)
-    out = Path(args.out) if args.out else root / "out" / "rubino2020"
-    figs = Path(args.figures) if args.figures else root / "docs" / "figures"
-    figs.mkdir(parents=True, exist_ok=True)
+    root, sil, out, figs = paper_paths(args, "rubino2020")
     runs, met = run_all(sil, root / "sil" / "scenarios", out)
     plot_steps(runs, ["step_db", "step_pi"], 0.1, figs / "rubino2020_step.png",
                "Rubino 2020 Figs. 21-22: torque step 10 -> 11 N m at 100 rpm")

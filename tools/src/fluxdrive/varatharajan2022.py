@@ -25,16 +25,13 @@ import copy
 from dataclasses import dataclass
 import functools
 import json
-import os
 from pathlib import Path
-import subprocess
-import sys
 import tempfile
 
 import numpy as np
 
 from .fluxmap import blob as blobmod
-from .paper_report import Run, replace_table, run, stacked_axes
+from .paper_report import Run, paper_paths, replace_table, run, stacked_axes
 from .fluxmap.model import FluxMap
 
 RPM = np.pi / 30.0
@@ -800,13 +797,7 @@ def plot_robustness(res: Results, path: Path) -> None:
 
 
 def main_varatharajan(args) -> int:
-    from .sil import find_repo_root, locate_sil
-
-    root = find_repo_root() or Path.cwd()
-    sil = locate_sil(args.sil)
-    out = Path(args.out) if args.out else root / "out" / "varatharajan2022"
-    figs = Path(args.figures) if args.figures else root / "docs" / "figures"
-    figs.mkdir(parents=True, exist_ok=True)
+    root, sil, out, figs = paper_paths(args, "varatharajan2022")
     res = run_all(sil, root, out)
     plot_bandwidth(res, figs / "varatharajan2022_bandwidth.png")
     plot_speed_step(res.step, res.tab, figs / "varatharajan2022_speed_step.png")

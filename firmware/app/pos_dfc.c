@@ -7,9 +7,10 @@
  * Each period brings one component of the DFC signal vector (the test
  * vector of the last window, hal_sample_t.test_vector, and the star-point
  * samples around its edge); the others are held, so the vector mixes three
- * consecutive periods: it is dated at the middle one, one period before
- * the newest sample (the sequentiality effect, docs/dfc.md), and the drive
- * extrapolates the angle from that instant with the PLL's speed.
+ * consecutive periods. The held components are turned to the newest one's
+ * instant with the PLL's speed (dfc_signals_vector: the sequentiality
+ * effect, docs/dfc.md); the estimate is dated at that edge, and the drive
+ * extrapolates the angle from it to the current sample.
  * The estimate is 2 theta_e. The branch (theta or theta + pi) follows the
  * PLL's prediction; the magnet's polarity is resolved once, by the
  * alignment (Fabbri 2022, 3.1.3; hence align_time > 0): the d current

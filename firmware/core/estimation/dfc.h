@@ -14,7 +14,7 @@
  * three rotor angles (2 theta advances by 2 omega_e Ts between them, 0.05
  * rad at 500 rpm on 8 pole pairs at 16 kHz); taken together by the plain
  * Clarke transform they give an error pattern repeating every three
- * periods. dfc_signals_clarke() removes it: the 2theta term rotates at
+ * periods. dfc_signals_vector() removes it: the 2theta term rotates at
  * -2 omega_e, so a component taken dt before the newest is the projection
  * of the newest vector on its phase axis turned by 2 omega_e dt; the
  * vector is the least-squares solution of the three projections (for

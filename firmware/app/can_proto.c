@@ -117,7 +117,7 @@ static void handle_param(can_proto_t *p, drive_t *drv, const uint8_t *d, reply_t
   bool set = can_codec_get_raw(CAN_SIG_PARAM_OP, d) == 1u;
   float v = can_codec_get(CAN_SIG_PARAM_VALUE, d);
   r->param = id;
-  bool proto = id >= CAN_PROTO_PARAM_FIRST;
+  bool proto = id >= CAN_PROTO_PARAM_FIRST && id < CAN_PROTO_PARAM_LAST;
   float now;
   bool known =
       proto ? can_proto_param_get(p, id, &now) : drive_params_get(drv, id, &now) == DRIVE_PARAM_OK;

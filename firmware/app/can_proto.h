@@ -100,10 +100,14 @@ void can_proto_cfg_default(can_proto_cfg_t *cfg);
 int can_proto_init(can_proto_t *p, const can_proto_cfg_t *cfg);
 void can_proto_poll(can_proto_t *p, drive_t *drv, uint32_t now_us);
 
-/* Protocol parameters (ids of the reply_param table from 64): node (read
+/* Protocol parameters (ids of the reply_param table 64..95): node (read
  * only), timeout, ramp and the periods. Same conventions as drive_params. */
 #define CAN_PROTO_PARAM_FIRST 64u
 #define CAN_PROTO_PARAM_COUNT (3u + (unsigned)CAN_PERIOD_COUNT)
+/* The protocol's ids end here; the drive's go on from it (drive_param_table.h) */
+#define CAN_PROTO_PARAM_LAST 96u
+_Static_assert(CAN_PROTO_PARAM_FIRST + CAN_PROTO_PARAM_COUNT <= CAN_PROTO_PARAM_LAST,
+               "CAN protocol parameters overflow their id range");
 /* Name of protocol parameter id ("can_node", "can_status_ms", ...), NULL
  * when there is none. */
 const char *can_proto_param_name(uint8_t id);

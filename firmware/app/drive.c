@@ -600,6 +600,7 @@ static void drive_publish(drive_t *drv, const hal_sample_t *s, const float i[3])
   tm->v_ab_applied[1] = drv->v_applied.beta;
   tm->omega_m = drv->omega_m;
   tm->pos_health = drv->pos.health;
+  tm->load_est = drv->pos.load;
   tm->cmd_seq = drv->cmd.seq;
   if (drv->state != DRIVE_STATE_RUN) {
     tm->theta_e = drv->pos.theta;
@@ -624,7 +625,10 @@ void drive_isr(drive_t *drv) {
     drive_window_sample(drv, i, s.v_dc);
   }
   drive_speed_loop(drv); /* on the rates of the previous slow_div periods */
-  drv->pos_src->update(&drv->pos_st, &drv->cfg, &s, drv->tm.i_dq[1], &drv->pos);
+  /* the last period's q current and torque (no torque before the run) */
+  const pos_input_t pin = {drv->tm.i_dq[1],
+                           drv->state == DRIVE_STATE_RUN ? drv->tm.torque_est : 0.0f};
+  drv->pos_src->update(&drv->pos_st, &drv->cfg, &s, &pin, &drv->pos);
   drv->omega_m = drv->pos.omega * drv->inv_pole_pairs;
   drv->rate_acc += drv->pos.rate;
   drv->rate_n++;

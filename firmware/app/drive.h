@@ -76,6 +76,7 @@ typedef struct {
   float torque_ref;      /* [N m] */
   float torque_est;      /* [N m] */
   float pos_health;      /* position source: |measured - predicted| [rad] */
+  float load_est;        /* position source's load torque estimate (Kalman filter) [N m] */
   uint32_t lc_cause;     /* DRIVE_LC_* that tripped lost_control */
   uint32_t cmd_seq;      /* last command block taken (drive_cmd_t.seq) */
   ctrl_telemetry_t law_tm;

@@ -11,7 +11,8 @@ static const char *const law_names[] = {DRIVE_LAW_LIST(NAME)};
 static const char *const mode_names[] = {DRIVE_MODE_LIST(NAME)};
 static const char *const state_names[] = {DRIVE_STATE_LIST(NAME)};
 static const char *const fault_names[] = {DRIVE_FAULT_LIST(NAME)};
-static const char *const pos_names[] = {POS_SOURCE_LIST(NAME)};
+#define POS_NAME(E, n, s, d) s,
+static const char *const pos_names[] = {POS_SOURCE_LIST(POS_NAME)};
 
 static const char *pick(const char *const *names, unsigned n, unsigned i) {
   return i < n ? names[i] : "?";

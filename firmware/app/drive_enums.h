@@ -48,20 +48,25 @@
   X(WATCHDOG, watchdog, "the MCU was reset by the watchdog (latched at start-up)")             \
   X(CONFIG, config, "the parameter set in force was refused (law unavailable)")
 
-/* Position sources: X(ENUM, name, doc). The source table (pos_sources.c)
- * has one row per entry, in this order. */
+/* Position sources: X(ENUM, ident, "name", doc); ident names the source's
+ * row (pos_source_<ident>), "name" is what scenarios, logs and CAN use.
+ * The source table (pos_sources.c) has one row per entry, in this order. */
 #define POS_SOURCE_LIST(X) \
-  X(ENCODER, encoder, "encoder (quantised, half-count corrected) and PLL")                              \
-  X(DFC, dfc, "star point: standard Direct Flux Control (3.8)-(3.10) and PLL")                             \
-  X(DFC_INV, dfc_inv, "star point: inverse DFC (3.15)-(3.16) and PLL")                                     \
-  X(IVD, ivd, "star point: DFC with Iterative Vector Decoupling (3.76), Full IVD (3.100) with phase shifts, and PLL")
+  X(ENCODER, encoder, "encoder", "encoder (quantised, half-count corrected) and PLL")                                    \
+  X(DFC, dfc, "dfc", "star point: standard Direct Flux Control (3.8)-(3.10) and PLL")                                     \
+  X(DFC_INV, dfc_inv, "dfc_inv", "star point: inverse DFC (3.15)-(3.16) and PLL")                                         \
+  X(IVD, ivd, "ivd", "star point: DFC with Iterative Vector Decoupling (3.76), Full IVD (3.100) with phase shifts, and PLL") \
+  X(DFC_KF, dfc_kf, "dfc+kf", "star point: standard DFC and the Kalman filter on speed, angle, load torque (4.46)-(4.49)")   \
+  X(IVD_KF, ivd_kf, "ivd+kf", "star point: IVD / Full IVD and the Kalman filter on speed, angle, load torque (4.46)-(4.49)") \
+  X(EKF, ekf, "ekf", "star point: extended Kalman filter on the DFC signals (4.35)-(4.41), a and b known")                \
+  X(IVD_KF_RLS, ivd_kf_rls, "ivd+kf+rls", "star point: IVD and Kalman filter with a, b identified online by RLS (4.51)-(4.57), Fig. 4.4")
 /* clang-format on */
 
 #define DRIVE_ENUM_LAW(E, n, d)       DRIVE_LAW_##E,
 #define DRIVE_ENUM_MODE(E, n, d)      DRIVE_MODE_##E,
 #define DRIVE_ENUM_STATE(E, n, d)     DRIVE_STATE_##E,
 #define DRIVE_ENUM_FAULT_BIT(E, n, d) DRIVE_FAULT_BIT_##E,
-#define DRIVE_ENUM_POS(E, n, d)       POS_SOURCE_##E,
+#define DRIVE_ENUM_POS(E, n, s, d)    POS_SOURCE_##E,
 
 typedef enum { DRIVE_LAW_LIST(DRIVE_ENUM_LAW) DRIVE_LAW_COUNT } drive_law_t;
 typedef enum { DRIVE_MODE_LIST(DRIVE_ENUM_MODE) DRIVE_MODE_COUNT } drive_mode_t;

@@ -14,7 +14,8 @@
  * (drive_config.c), each reported under the field it names.
  *
  * Columns: X(id, name, type, unit, default, min, max, access, scenario, doc)
- *   id        CAN parameter number (PARAM_REQ.param_id), unique, < 64
+ *   id        CAN parameter number (PARAM_REQ.param_id), unique, 1..63 or
+ *             96..255 (64..95 are the CAN protocol's own, can_proto.h)
  *   type      F32 float | U16 uint16_t | U32 uint32_t | LAW drive_law_t |
  *             MODE drive_mode_t | POS pos_source_t (enums: min 0, max count-1) |
  *             MAP a flux-map blob (const uint32_t *, docs/flux-maps.md): read as
@@ -144,6 +145,33 @@
     "DFC window: test vector length")                                                                       \
   X(49, dfc_t_meas,     F32,  "s",      2.5e-6f,     1e-7f,   3e-5f,    IDLE, "controller.dfc_t_meas",     \
     "DFC window: star-point sample after the test-vector edge (dead time plus settling, < dfc_tw)")        \
+  /* Kalman filter, EKF and RLS on the star-point position (Fabbri 2022 ch. 4; docs/dfc.md) */         \
+  X(96, friction,       F32,  "N m s/rad", 0.0f,     0.0f,    1e4f,     IDLE, "mechanics.b",               \
+    "viscous friction B, for the Kalman filter's model (4.46)")                                            \
+  X(97, kf_q_omega,     F32,  "(rad/s)^2", 1.0f,     0.0f,    1e8f,     LIVE, "controller.kf_q_omega",     \
+    "KF/EKF: process noise of the electrical speed, Q_11 (5.1)")                                           \
+  X(98, kf_q_theta,     F32,  "rad^2",  0.0f,        0.0f,    10.0f,    LIVE, "controller.kf_q_theta",     \
+    "KF/EKF: process noise of the electrical angle, Q_22 (5.1)")                                           \
+  X(99, kf_q_load,      F32,  "(N m)^2", 1e-6f,      0.0f,    1e6f,     LIVE, "controller.kf_q_load",      \
+    "KF/EKF: process noise of the load torque, Q_33 (5.1)")                                                \
+  X(100, dfc_sigma,     F32,  "",       2e-4f,       1e-7f,   0.5f,     LIVE, "controller.dfc_sigma",      \
+    "KF/EKF/RLS: standard deviation sigma_v of each DFC signal (Gamma / v_dc) (4.29), (4.38), (4.53)")     \
+  X(101, kf_r_scale,    F32,  "",       1.0f,        0.01f,   1e4f,     LIVE, "controller.kf_r_scale",     \
+    "KF/EKF: R_k = kf_r_scale times (4.29) / (4.38) (Table 5.2: 1 and 5)")                                  \
+  X(102, kf_r_m,        F32,  "1/(rad/s)", 0.0f,     0.0f,    1.0f,     LIVE, "controller.kf_r_m",         \
+    "KF/EKF: speed-dependent signal variance, slope m above omega_f (4.42), per sigma_v^2")               \
+  X(103, kf_r_wf,       F32,  "rad/s",  0.0f,        0.0f,    1e5f,     LIVE, "controller.kf_r_wf",        \
+    "KF/EKF: omega_f of (4.42), electrical")                                                                \
+  X(104, kf_r_m2,       F32,  "1/(rad/s)^2", 0.0f,   0.0f,    1.0f,     LIVE, "controller.kf_r_m2",        \
+    "KF/EKF: speed-dependent signal variance m_2 omega^2 (4.43), per sigma_v^2")                          \
+  X(105, rls_lambda,    F32,  "",       0.9999f,     0.9f,    1.0f,     LIVE, "controller.rls_lambda",     \
+    "RLS: forgetting factor lambda of the a, b identification (4.55)-(4.57)")                              \
+  X(106, rls_p_max,     F32,  "",       1e-5f,       1e-12f,  1.0f,     LIVE, "controller.rls_p_max",      \
+    "RLS: upper limit of P's diagonal (and P at the reset): the identification's bandwidth")               \
+  X(107, rls_p_min,     F32,  "",       1e-9f,       1e-12f,  1.0f,     LIVE, "controller.rls_p_min",      \
+    "RLS: lower limit of P's diagonal (keeps the identification alive)")                                   \
+  X(108, rls_w_min,     F32,  "rad/s",  50.0f,       0.0f,    1e5f,     LIVE, "controller.rls_w_min",      \
+    "RLS: identify only above this electrical speed (a and b are not separable at standstill)")           \
   /* timing and calibration */                                                                              \
   X(40, ts,             F32,  "s",      6.25e-5f,    1e-6f,   1e-2f,    RO,   "inverter.pwm_frequency",    \
     "PWM and ISR period")                                                                                   \

@@ -1,8 +1,33 @@
 /*
  * pos_dfc.c - the star point as a position source: Direct Flux Control
  * (standard, inverse) and Iterative Vector Decoupling (IVD, Full IVD),
- * Fabbri 2022 chapter 3, on estimation/dfc.h; speed by the angle PLL until
- * a Kalman filter replaces it.
+ * Fabbri 2022 chapter 3, on estimation/dfc.h; angle and speed tracked by
+ * the angle PLL or by the Kalman filter on the rotor's mechanics (chapter
+ * 4: estimation/kf_mech.h), which also estimates the load torque:
+ *   dfc, dfc_inv, ivd   the method's angle, PLL
+ *   dfc+kf, ivd+kf      the method's angle, Kalman filter (4.46)-(4.49),
+ *                       R_k of (4.29) (DFC: the measured |Gamma|, the b
+ *                       term included, (4.31)) or (4.30) (IVD: the b term
+ *                       removed, |Gamma| -> a), times kf_r_scale, with the
+ *                       speed-dependent signal variance (4.42)/(4.43)
+ *   ekf                 the Kalman filter updated on the signal vector
+ *                       itself (4.35)-(4.41), a and b known
+ *   ivd+kf+rls          ivd+kf with a, b identified online by the RLS of
+ *                       (4.51)-(4.57), the loop of Fig. 4.4: the IVD uses
+ *                       the identified a, b (held in the IVD's convergence
+ *                       region |b/a| <= 0.45 and within a factor 4 of
+ *                       dfc_a); the RLS regressor is the filter's
+ *                       predicted angle (a priori: free of this period's
+ *                       signal noise, which the IVD angle carries - no
+ *                       errors-in-variables bias); it identifies only above
+ *                       rls_w_min, where the 2theta and 4theta columns are
+ *                       separable, and never with the EKF: the EKF's angle
+ *                       is itself a function of a and b, the thesis's
+ *                       non-observable combination (5.1.3), so no source
+ *                       offers it.
+ * The Kalman filter's state is the angle at the newest component's edge:
+ * it predicts one period every period (the edges recur at the same point
+ * of the pattern) with the last period's torque estimate as input.
  *
  * Each period brings one component of the DFC signal vector (the test
  * vector of the last window, hal_sample_t.test_vector, and the star-point
@@ -31,11 +56,26 @@
 #include "math/frames.h"
 #include "pos_source.h"
 
+enum { TRACK_PLL = 0, TRACK_KF = 1, TRACK_EKF = 2 };
+
+static bool is_ivd(pos_source_t src) {
+  return src == POS_SOURCE_IVD || src == POS_SOURCE_IVD_KF || src == POS_SOURCE_IVD_KF_RLS;
+}
+
+static uint8_t track_of(pos_source_t src) {
+  if (src == POS_SOURCE_EKF) {
+    return TRACK_EKF;
+  }
+  return (src == POS_SOURCE_DFC_KF || src == POS_SOURCE_IVD_KF || src == POS_SOURCE_IVD_KF_RLS)
+             ? TRACK_KF
+             : TRACK_PLL;
+}
+
 static dfc_method_t method_of(pos_source_t src, const drive_config_t *cfg) {
   if (src == POS_SOURCE_DFC_INV) {
     return DFC_INVERSE;
   }
-  if (src == POS_SOURCE_IVD) {
+  if (is_ivd(src)) {
     return (fabsf(cfg->dfc_phi_a) > 0.0f || fabsf(cfg->dfc_phi_b) > 0.0f) ? DFC_FULL_IVD : DFC_IVD;
   }
   return DFC_STANDARD;
@@ -51,8 +91,35 @@ static dfc_cfg_t cfg_of(const drive_config_t *cfg) {
   return d;
 }
 
+static kf_mech_cfg_t kf_cfg_of(const drive_config_t *cfg) {
+  const kf_mech_cfg_t k = {cfg->ts,
+                           cfg->pole_pairs,
+                           cfg->inertia,
+                           cfg->friction,
+                           {cfg->kf_q_omega, cfg->kf_q_theta, cfg->kf_q_load}};
+  return k;
+}
+
+static rls_ab_cfg_t rls_cfg_of(const drive_config_t *cfg) {
+  const rls_ab_cfg_t r = {cfg->rls_lambda, cfg->dfc_sigma * cfg->dfc_sigma, cfg->rls_p_min,
+                          cfg->rls_p_max};
+  return r;
+}
+
+/* The Kalman filter's covariance at a (re)start: speed within 30 rad/s,
+ * angle within 0.3 rad, load within 0.3 N m (1 sigma). */
+static const float kf_p0[3] = {900.0f, 0.09f, 0.09f};
+
 static void pdfc_init(pos_state_t *s, const drive_config_t *cfg) {
   angle_pll_init(&s->dfc.pll, cfg->pll_bw, cfg->ts);
+  s->dfc.track = track_of(cfg->pos_source);
+  s->dfc.rls_on = cfg->pos_source == POS_SOURCE_IVD_KF_RLS;
+  const kf_mech_cfg_t kc = kf_cfg_of(cfg);
+  (void)kf_mech_init(&s->dfc.kf, &kc); /* pdfc_check_cfg: usable */
+  const rls_ab_cfg_t rc = rls_cfg_of(cfg);
+  (void)rls_ab_init(&s->dfc.rls, &rc);
+  rls_ab_reset(&s->dfc.rls, cfg->dfc_a, cfg->dfc_b, cfg->rls_p_max);
+  s->dfc.r = 0.0f;
   s->dfc.dc = cfg_of(cfg);
   dfc_signals_reset(&s->dfc.sig);
   s->dfc.started = false;
@@ -67,6 +134,7 @@ static void pdfc_init(pos_state_t *s, const drive_config_t *cfg) {
 }
 
 static void pdfc_reset(pos_state_t *s) {
+  kf_mech_reset(&s->dfc.kf, 0.0f, 0.0f, kf_p0);
   dfc_signals_reset(&s->dfc.sig);
   s->dfc.started = false;
   s->dfc.n = 0u;
@@ -82,54 +150,135 @@ static float nearest_branch(float theta0, float ref) {
                                                          : theta0;
 }
 
+/* The tracker's angle and speed: the PLL's or the Kalman filter's. */
+static float trk_theta(const pos_state_t *s) {
+  return s->dfc.track == TRACK_PLL ? s->dfc.pll.theta : s->dfc.kf.x[1];
+}
+
+static float trk_omega(const pos_state_t *s) {
+  return s->dfc.track == TRACK_PLL ? s->dfc.pll.omega : s->dfc.kf.x[0];
+}
+
+static void trk_reset(pos_state_t *s, float theta, float omega) {
+  if (s->dfc.track == TRACK_PLL) {
+    angle_pll_reset(&s->dfc.pll, theta, omega);
+  } else {
+    kf_mech_reset(&s->dfc.kf, theta, omega, kf_p0);
+  }
+}
+
+/* The RLS of a, b (4.51)-(4.57) on this vector at the filter's predicted
+ * angle, and the IVD's a, b from it, within the guards (header). */
+#define POS_DFC_P_MAX 0.45f /* |b/a| the IVD is given at most (Theorem 1: < 1/2) */
+static void rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v, bool fresh) {
+  rls_ab_t *r = &s->dfc.rls;
+  r->cfg = rls_cfg_of(cfg); /* the live tuning */
+  if (fresh && s->dfc.aligned && fabsf(s->dfc.kf.x[0]) > cfg->rls_w_min) {
+    const sincos_t u = frames_sincos(2.0f * s->dfc.kf.x[1]);
+    (void)rls_ab_update(r, v->al, v->be, u.c, u.s, v->k);
+  }
+  const float a0 = fabsf(cfg->dfc_a);
+  const float am = fd_clampf(fabsf(r->x[0]), 0.25f * a0, 4.0f * a0);
+  const float a = cfg->dfc_a < 0.0f ? -am : am;
+  s->dfc.dc.a = a;
+  s->dfc.dc.b = fd_clampf(r->x[1], -POS_DFC_P_MAX * am, POS_DFC_P_MAX * am);
+}
+
+/* The measurement variance of the angle (4.29)-(4.31) or of the signals
+ * (4.38), with (4.42)/(4.43), times kf_r_scale. */
+static float meas_r(const pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v) {
+  const float s2 = cfg->dfc_sigma * cfg->dfc_sigma;
+  const float var =
+      kf_mech_r_speed(s2, cfg->kf_r_m * s2, cfg->kf_r_wf, cfg->kf_r_m2 * s2, s->dfc.kf.x[0]);
+  if (s->dfc.track == TRACK_EKF) {
+    return cfg->kf_r_scale * var; /* (4.38) */
+  }
+  /* (4.29): |Gamma|^2, the b term in it (4.31); the IVD has removed it (4.30) */
+  const float g2 =
+      is_ivd(cfg->pos_source) ? s->dfc.dc.a * s->dfc.dc.a : v->al * v->al + v->be * v->be;
+  return cfg->kf_r_scale * 0.25f * var / fd_maxf(g2, 1e-12f);
+}
+
 static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
-                        float i_q, pos_estimate_t *out) {
+                        const pos_input_t *in, pos_estimate_t *out) {
   angle_pll_t *pll = &s->dfc.pll;
+  kf_mech_t *kf = &s->dfc.kf;
+  const bool kalman = s->dfc.track != TRACK_PLL;
   /* the live parameters (b, iterations, phase shifts) in force */
   s->dfc.dc = cfg_of(cfg);
+  if (kalman) { /* one period ahead: this period's edge (header) */
+    kf->cfg.q[0] = cfg->kf_q_omega;
+    kf->cfg.q[1] = cfg->kf_q_theta;
+    kf->cfg.q[2] = cfg->kf_q_load;
+    kf_mech_predict(kf, in->torque);
+  }
   /* the component's instant: the edge, between the two samples; counted
    * in periods since the reset (isr) so that the held ones keep theirs */
   s->dfc.n++;
   const float t_edge = 0.5f * (smp->t_star[0] + smp->t_star[1]);
+  bool fresh = false;
   if (smp->n_star >= 2u && dfc_signals_push(&s->dfc.sig, smp->test_vector, smp->v_star[0],
                                             smp->v_star[1], smp->v_dc, t_edge)) {
     s->dfc.sig.t[s->dfc.sig.last] = (float)s->dfc.n * cfg->ts + t_edge;
     s->dfc.t = t_edge;
-  } else {
+    fresh = true;
+  } else if (!kalman) {
     s->dfc.t -= cfg->ts; /* the newest component ages by a period */
   }
-  out->t = s->dfc.t;
+  out->t = s->dfc.t; /* the filter's state is at the edge's point of this period */
+  out->load = kalman ? kf->x[2] : 0.0f;
   float c2 = 1.0f, s2 = 0.0f;
   dfc_vec_t v;
   const bool full = dfc_signals_complete(&s->dfc.sig);
   if (full) { /* sequentiality: the held components turned to the newest */
-    dfc_signals_vector(&s->dfc.sig, 2.0f * pll->omega, &v);
+    dfc_signals_vector(&s->dfc.sig, 2.0f * trk_omega(s), &v);
+    if (s->dfc.rls_on) {
+      rls_step(s, cfg, &v, fresh);
+    }
   }
-  const bool ok = full && dfc_vector2(&s->dfc.dc, s->dfc.sig.g, &v, i_q, &c2, &s2, s->dfc.trace);
+  const bool ok =
+      full && dfc_vector2(&s->dfc.dc, s->dfc.sig.g, &v, in->i_q, &c2, &s2, s->dfc.trace);
   out->valid = ok;
   if (!ok) {
-    angle_pll_update(pll, NAN); /* coast */
-    out->theta = pll->theta;
-    out->omega = pll->omega;
-    out->rate = pll->omega_rate;
+    if (!kalman) {
+      angle_pll_update(pll, NAN); /* coast */
+    }
+    out->theta = trk_theta(s);
+    out->omega = trk_omega(s);
+    out->rate = kalman ? out->omega : pll->omega_rate;
     out->health = 0.0f;
     return;
   }
   const float theta0 = 0.5f * fd_cordic_atan2f(s2, c2); /* (3.10), branch 0 */
   if (!s->dfc.started) {
-    angle_pll_reset(pll, theta0, 0.0f); /* polarity: the alignment decides */
+    trk_reset(s, theta0, 0.0f); /* polarity: the alignment decides */
     s->dfc.started = true;
   }
-  const float th = nearest_branch(theta0, pll->theta);
-  out->health = fabsf(frames_wrap_pi(th - pll->theta)); /* measured - predicted */
-  angle_pll_update(pll, th);
-  out->theta = th;
-  out->omega = pll->omega;
-  out->rate = pll->omega_rate;
+  const float th = nearest_branch(theta0, trk_theta(s));
+  out->health = fabsf(frames_wrap_pi(th - trk_theta(s))); /* measured - predicted */
+  if (!kalman) {
+    angle_pll_update(pll, th);
+    out->theta = th;
+    out->omega = pll->omega;
+    out->rate = pll->omega_rate;
+  } else {
+    if (fresh) {
+      s->dfc.r = meas_r(s, cfg, &v);
+      if (s->dfc.track == TRACK_EKF) {
+        (void)kf_mech_update_ekf(kf, v.al, v.be, s->dfc.dc.a, s->dfc.dc.b, s->dfc.r);
+      } else {
+        (void)kf_mech_update(kf, th, s->dfc.r);
+      }
+    }
+    out->theta = kf->x[1];
+    out->omega = kf->x[0];
+    out->rate = kf->x[0];
+    out->load = kf->x[2];
+  }
   /* the polarity evidence, until the alignment has used it */
   if (!s->dfc.aligned) {
-    s->dfc.pol_acc -= (pll->omega - s->dfc.w_prev) * frames_sincos(th).s;
-    s->dfc.w_prev = pll->omega;
+    s->dfc.pol_acc -= (out->omega - s->dfc.w_prev) * frames_sincos(th).s;
+    s->dfc.w_prev = out->omega;
   }
 }
 
@@ -140,17 +289,17 @@ static void pdfc_align(pos_state_t *s, const drive_config_t *cfg, const hal_samp
                        float theta) {
   (void)cfg;
   (void)smp;
-  angle_pll_t *pll = &s->dfc.pll;
   const float acc = s->dfc.pol_acc;
+  const float now = trk_theta(s);
   float th;
   if (acc > POS_DFC_POL_MIN) {
-    th = pll->theta; /* the estimate moved as the torque pulled: theta */
+    th = now; /* the estimate moved as the torque pulled: theta */
   } else if (acc < -POS_DFC_POL_MIN) {
-    th = frames_wrap_pi(pll->theta + FRAMES_PI); /* theta + pi */
+    th = frames_wrap_pi(now + FRAMES_PI); /* theta + pi */
   } else {
-    th = nearest_branch(pll->theta, theta);
+    th = nearest_branch(now, theta);
   }
-  angle_pll_reset(pll, th, pll->omega);
+  trk_reset(s, th, trk_omega(s));
   s->dfc.started = true;
   s->dfc.aligned = true;
   s->dfc.pol_acc = 0.0f;
@@ -163,6 +312,18 @@ static const char *pdfc_check_cfg(const drive_config_t *cfg, const char **field)
     *field = e == DFC_ERR_P ? "dfc_b" : (e == DFC_ERR_PHI ? "dfc_phi_a" : "dfc_a");
     return dfc_strerror(e);
   }
+  if (track_of(cfg->pos_source) != TRACK_PLL) {
+    const kf_mech_cfg_t kc = kf_cfg_of(cfg);
+    kf_mech_t k;
+    if (!kf_mech_init(&k, &kc)) {
+      *field = "inertia";
+      return "the Kalman filter's model needs a finite inertia, pole pairs and friction";
+    }
+  }
+  if (cfg->pos_source == POS_SOURCE_IVD_KF_RLS && !(cfg->rls_p_min <= cfg->rls_p_max)) {
+    *field = "rls_p_min";
+    return "the RLS covariance limits need rls_p_min <= rls_p_max";
+  }
   if (!(cfg->align_time > 0.0f)) {
     *field = "align_time";
     return "a star-point source resolves the magnet's polarity by the alignment: align_time > 0";
@@ -170,14 +331,15 @@ static const char *pdfc_check_cfg(const drive_config_t *cfg, const char **field)
   return NULL;
 }
 
-#define POS_DFC_ROW(n)                                                                             \
-  const pos_source_row_t pos_source_##n = {#n,                                                     \
-                                           POS_CAP_ALIGN | POS_CAP_GATED,                          \
-                                           pdfc_init,                                              \
-                                           pdfc_reset,                                             \
-                                           pdfc_update,                                            \
-                                           pdfc_align,                                             \
+#define POS_DFC_ROW(n, name)                                                                       \
+  const pos_source_row_t pos_source_##n = {name,          POS_CAP_ALIGN | POS_CAP_GATED,           \
+                                           pdfc_init,     pdfc_reset,                              \
+                                           pdfc_update,   pdfc_align,                              \
                                            pdfc_check_cfg}
-POS_DFC_ROW(dfc);
-POS_DFC_ROW(dfc_inv);
-POS_DFC_ROW(ivd);
+POS_DFC_ROW(dfc, "dfc");
+POS_DFC_ROW(dfc_inv, "dfc_inv");
+POS_DFC_ROW(ivd, "ivd");
+POS_DFC_ROW(dfc_kf, "dfc+kf");
+POS_DFC_ROW(ivd_kf, "ivd+kf");
+POS_DFC_ROW(ekf, "ekf");
+POS_DFC_ROW(ivd_kf_rls, "ivd+kf+rls");

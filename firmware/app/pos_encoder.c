@@ -36,10 +36,11 @@ static float enc_electrical(const pos_state_t *s, const drive_config_t *cfg,
 }
 
 static void enc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
-                       float i_q, pos_estimate_t *out) {
-  (void)i_q;
+                       const pos_input_t *in, pos_estimate_t *out) {
+  (void)in;
   angle_pll_t *pll = &s->enc.pll;
   out->t = smp->t_enc;
+  out->load = 0.0f;
   out->valid = smp->enc_valid && fd_isfinite(smp->enc_angle);
   if (!out->valid) {
     /* no measurement: the PLL coasts; the estimate is not usable */

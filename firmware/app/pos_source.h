@@ -2,8 +2,9 @@
  * pos_source.h - where the rotor angle comes from, behind one table of
  * sources {name, capabilities, init, reset, update, align}; one row per
  * entry of POS_SOURCE_LIST (drive_enums.h): the encoder (pos_encoder.c)
- * and the star point (pos_dfc.c: DFC, inverse DFC, IVD / Full IVD); the
- * Kalman filter comes as more rows with the same estimate.
+ * and the star point (pos_dfc.c: DFC, inverse DFC, IVD / Full IVD with a
+ * PLL; DFC or IVD with the Kalman filter, the EKF on the DFC signals, IVD
+ * with the Kalman filter and the RLS identification of a, b).
  *
  * Every period the source turns the HAL's sample set into an estimate
  * {theta, omega, t, valid, health}: the electrical angle at instant t of the
@@ -21,6 +22,8 @@
 #include "drive_config.h"
 #include "estimation/angle_pll.h"
 #include "estimation/dfc.h"
+#include "estimation/kf_mech.h"
+#include "estimation/rls_ab.h"
 #include "hal.h"
 
 typedef struct {
@@ -30,7 +33,14 @@ typedef struct {
   float t;      /* instant of theta after the period start [s] */
   bool valid;   /* false: no usable measurement this period */
   float health; /* |measurement - prediction| [rad electrical] */
+  float load;   /* load torque estimate [N m] (Kalman filter sources; 0 otherwise) */
 } pos_estimate_t;
+
+/* What the drive knows of the last period, for the sources' models. */
+typedef struct {
+  float i_q;    /* rotor-frame q current [A] (the Full IVD's phase shifts) */
+  float torque; /* electromagnetic torque estimate [N m] (the Kalman filter's input) */
+} pos_input_t;
 
 enum {
   POS_CAP_ALIGN = 1u << 0, /* the angle offset can be found by an alignment */
@@ -60,6 +70,13 @@ typedef union {
      * alignment pulls the rotor towards 0 (pos_dfc.c) */
     float pol_acc, w_prev;
     bool aligned; /* the alignment has resolved the polarity */
+    /* the tracker: the PLL above, or the Kalman filter (KF and EKF
+     * sources); the RLS of a, b (ivd+kf+rls) */
+    uint8_t track; /* pos_dfc.c: TRACK_* */
+    bool rls_on;
+    kf_mech_t kf;
+    rls_ab_t rls;
+    float r; /* the measurement variance of the last update (rad^2, or Gamma^2 for the EKF) */
   } dfc;
 } pos_state_t;
 
@@ -68,10 +85,8 @@ typedef struct {
   uint32_t caps; /* POS_CAP_* */
   void (*init)(pos_state_t *s, const drive_config_t *cfg);
   void (*reset)(pos_state_t *s);
-  /* i_q: the rotor-frame q current of the last period [A] (the Full
-   * IVD's phase shifts) */
-  void (*update)(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp, float i_q,
-                 pos_estimate_t *out);
+  void (*update)(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
+                 const pos_input_t *in, pos_estimate_t *out);
   /* The rotor is held at electrical angle theta: take it as the reference
    * (alignment). Only for POS_CAP_ALIGN. */
   void (*align)(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp, float theta);

@@ -7,17 +7,68 @@
 #include <string.h>
 
 /* Signal names, in column order. Units in docs/log-format.md. */
-static const char *const signals[] = {
-    "t",           "speed",       "speed_est",   "speed_ref",  "torque",     "torque_ref",
-    "torque_est",  "load_torque", "i_a",         "i_b",        "i_c",        "i_a_meas",
-    "i_b_meas",    "i_c_meas",    "i_d",         "i_q",        "i_ds",       "i_qs",
-    "i_qs_ref",    "flux",        "flux_ref",    "flux_est",   "delta",      "delta_est",
-    "v_dc",        "duty_a",      "duty_b",      "duty_c",     "gates",      "state",
-    "faults",      "theta_e",     "theta_e_est", "lc_cause",   "torque_max", "flux_mtpa",
-    "torque_mtpv", "gain_a",      "gain_b",      "mtpa_angle", "mtpv_angle", "theta_e_enc",
-    "dfc_t",       "dfc_ga",      "dfc_gb",      "dfc_gc",     "dfc_k0",     "dfc_k1",
-    "dfc_k2",      "dfc_k3",      "dfc_k4",      "dfc_k5",     "dfc_k6",     "dfc_k7",
-    "dfc_k8",      "torque_avg",  "i_d_avg",     "i_q_avg"};
+static const char *const signals[] = {"t",
+                                      "speed",
+                                      "speed_est",
+                                      "speed_ref",
+                                      "torque",
+                                      "torque_ref",
+                                      "torque_est",
+                                      "load_torque",
+                                      "i_a",
+                                      "i_b",
+                                      "i_c",
+                                      "i_a_meas",
+                                      "i_b_meas",
+                                      "i_c_meas",
+                                      "i_d",
+                                      "i_q",
+                                      "i_ds",
+                                      "i_qs",
+                                      "i_qs_ref",
+                                      "flux",
+                                      "flux_ref",
+                                      "flux_est",
+                                      "delta",
+                                      "delta_est",
+                                      "v_dc",
+                                      "duty_a",
+                                      "duty_b",
+                                      "duty_c",
+                                      "gates",
+                                      "state",
+                                      "faults",
+                                      "theta_e",
+                                      "theta_e_est",
+                                      "lc_cause",
+                                      "torque_max",
+                                      "flux_mtpa",
+                                      "torque_mtpv",
+                                      "gain_a",
+                                      "gain_b",
+                                      "mtpa_angle",
+                                      "mtpv_angle",
+                                      "theta_e_enc",
+                                      "dfc_t",
+                                      "dfc_ga",
+                                      "dfc_gb",
+                                      "dfc_gc",
+                                      "dfc_k0",
+                                      "dfc_k1",
+                                      "dfc_k2",
+                                      "dfc_k3",
+                                      "dfc_k4",
+                                      "dfc_k5",
+                                      "dfc_k6",
+                                      "dfc_k7",
+                                      "dfc_k8",
+                                      "torque_avg",
+                                      "i_d_avg",
+                                      "i_q_avg",
+                                      "load_torque_est",
+                                      "rls_a",
+                                      "rls_b",
+                                      "kf_r"};
 enum { NSIG = sizeof signals / sizeof signals[0], HEADER_LEN = 4096 };
 
 static void fill_row(const sil_step_t *st, double *r) {
@@ -37,6 +88,8 @@ static void fill_row(const sil_step_t *st, double *r) {
     k2[k] = dfc ? atan2((double)tr[(size_t)2 * k + 1u], (double)tr[(size_t)2 * k]) : 0.0;
   }
   const float *g = st->drive->pos_st.dfc.sig.g;
+  /* the a, b the IVD used (identified: ivd+kf+rls) */
+  const bool rls = dfc && st->drive->pos_st.dfc.rls_on;
   double ld = p->lambda_dq[0], lq = p->lambda_dq[1];
   double flux = hypot(ld, lq);
   /* True stator-flux frame currents: projection of i on lambda_s and its
@@ -100,7 +153,11 @@ static void fill_row(const sil_step_t *st, double *r) {
                     k2[8],
                     p->torque_avg,
                     p->i_dq_avg[0],
-                    p->i_dq_avg[1]};
+                    p->i_dq_avg[1],
+                    tm->load_est,
+                    rls ? (double)st->drive->pos_st.dfc.dc.a : 0.0,
+                    rls ? (double)st->drive->pos_st.dfc.dc.b : 0.0,
+                    dfc ? (double)st->drive->pos_st.dfc.r : 0.0};
   memcpy(r, v, sizeof v);
 }
 

@@ -139,6 +139,7 @@ void preset_apply(const machine_preset_t *p, plant_params_t *plant, drive_config
   drive->lq = (float)p->machine.lq;
   drive->lambda_m = (float)p->machine.lambda_m;
   drive->inertia = (float)p->inertia;
+  drive->friction = (float)p->friction;
   drive->i_max = (float)(p->i_rated * 1.41421356237);
   drive->i_trip = 2.0f * drive->i_max;
   drive->torque_max = (float)p->torque_rated;

@@ -413,7 +413,7 @@ static int parse_mechanics(ctx_t *c, const cJSON *o, scenario_t *sc) {
   int mode = (int)m->mode;
   if (get_enum(c, o, "mechanics", "mode", modes, &mode) ||
       get_param_num(c, o, "mechanics", "j", "inertia", &m->j) ||
-      get_num(c, o, "mechanics", "b", 0.0, 1e4, &m->b) ||
+      get_param_num(c, o, "mechanics", "b", "friction", &m->b) ||
       get_profile(c, o, "mechanics", "load_torque", &m->load_torque) ||
       get_profile(c, o, "mechanics", "speed", &m->speed) ||
       get_num(c, o, "mechanics", "theta0", -1e3, 1e3, &m->theta0) ||
@@ -425,6 +425,7 @@ static int parse_mechanics(ctx_t *c, const cJSON *o, scenario_t *sc) {
     return fail(c, "mechanics.speed", "required when mode is \"imposed\"");
   }
   sc->drive.inertia = (float)m->j;
+  sc->drive.friction = (float)m->b;
   return 0;
 }
 
@@ -503,9 +504,14 @@ static int get_param(ctx_t *c, const cJSON *o, const drive_param_t *p, drive_con
   }
   int idx = -1;
   if (p->type == DRIVE_PARAM_LAW || p->type == DRIVE_PARAM_MODE || p->type == DRIVE_PARAM_POS) {
-    const char *names[8];
+    enum { NAMES_MAX = 16 };
+    _Static_assert((int)DRIVE_LAW_COUNT < (int)NAMES_MAX &&
+                       (int)DRIVE_MODE_COUNT < (int)NAMES_MAX &&
+                       (int)POS_SOURCE_COUNT < (int)NAMES_MAX,
+                   "an enumeration outgrows the scenario's name list");
+    const char *names[NAMES_MAX];
     unsigned n = 0;
-    for (unsigned v = 0; v <= (unsigned)p->max && n + 1u < 8u; ++v) {
+    for (unsigned v = 0; v <= (unsigned)p->max && n + 1u < (unsigned)NAMES_MAX; ++v) {
       names[n++] = p->type == DRIVE_PARAM_LAW    ? drive_law_name(v)
                    : p->type == DRIVE_PARAM_MODE ? drive_mode_name(v)
                                                  : drive_pos_source_name(v);

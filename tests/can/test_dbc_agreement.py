@@ -107,8 +107,10 @@ def test_value_tables_agree(db, tables):
     req_choices = {int(k): str(v) for k, v in reply.get_signal_by_name("reply_req").choices.items()}
     assert req_choices == {i: m for i, m in enumerate(msgs) if msgs[m][2] and m != "HOST_HB"}
     par_choices = {int(k): str(v) for k, v in reply.get_signal_by_name("reply_param").choices.items()}
-    assert {k: v for k, v in par_choices.items() if k < 64} == params
-    assert {k for k in par_choices if k >= 64} == pparams
+    proto = range(64, 96)  # the protocol's ids (can_proto.h), the drive's around them
+    assert not set(params) & set(proto), "drive parameter ids in the protocol's range 64..95"
+    assert {k: v for k, v in par_choices.items() if k not in proto} == params
+    assert {k for k in par_choices if k in proto} == pparams
 
 
 def random_raws(s, rng: random.Random, n: int) -> list[int]:

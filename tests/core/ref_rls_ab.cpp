@@ -52,7 +52,7 @@ void test_against_eigen(void **state) {
       const double gb = a * std::sin(2 * th) + b * std::sin(4 * th) + sigma * n01(rng);
       const float c2 = static_cast<float>(std::cos(2 * th)),
                   s2 = static_cast<float>(std::sin(2 * th));
-      assert_true(rls_ab_update(&k, static_cast<float>(ga), static_cast<float>(gb), c2, s2));
+      assert_true(rls_ab_update(&k, static_cast<float>(ga), static_cast<float>(gb), c2, s2, nullptr));
       Eigen::Matrix2d H;
       H << -std::cos(2 * th), std::cos(4 * th), std::sin(2 * th), std::sin(4 * th);
       const Eigen::Matrix2d K = P * H.transpose() * (H * P * H.transpose() + R).inverse();

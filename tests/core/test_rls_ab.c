@@ -31,7 +31,7 @@ static void run(double lambda, double p_max, double *t_in, double *a_end, double
     const double th = we * ts * n;
     const double ga = -a * cos(2 * th) + b * cos(4 * th) + sigma * gauss(&seed);
     const double gb = a * sin(2 * th) + b * sin(4 * th) + sigma * gauss(&seed);
-    assert_true(rls_ab_update(&k, (float)ga, (float)gb, (float)cos(2 * th), (float)sin(2 * th)));
+    assert_true(rls_ab_update(&k, (float)ga, (float)gb, (float)cos(2 * th), (float)sin(2 * th), NULL));
     const bool in = fabs(k.x[0] / a - 1.0) < 0.05 && fabs(k.x[1] / b - 1.0) < 0.05;
     if (in && *t_in < 0.0) {
       *t_in = n * ts;
@@ -67,12 +67,12 @@ static void test_limits_and_refusals(void **state) {
   ASSERT_NEAR(k.p[0], 1e-3, 1e-9);
   /* at standstill (one angle) the forgetting would grow P: held at p_max */
   for (int n = 0; n < 100000; ++n) {
-    assert_true(rls_ab_update(&k, -0.05f, 0.0f, 1.0f, 0.0f));
+    assert_true(rls_ab_update(&k, -0.05f, 0.0f, 1.0f, 0.0f, NULL));
   }
   ASSERT_IN(k.p[0], 1e-6, 1e-3 * (1.0 + 1e-6));
   ASSERT_IN(k.p[2], 1e-6, 1e-3 * (1.0 + 1e-6));
   ASSERT_IN(k.p[1] * k.p[1], 0.0, k.p[0] * k.p[2]);
-  assert_false(rls_ab_update(&k, NAN, 0.0f, 1.0f, 0.0f));
+  assert_false(rls_ab_update(&k, NAN, 0.0f, 1.0f, 0.0f, NULL));
   c.lambda = 0.0f;
   assert_false(rls_ab_init(&k, &c));
   c.lambda = 1.0f;

@@ -5,6 +5,7 @@
 #include "rls_ab.h"
 
 #include <math.h>
+#include <stddef.h>
 
 #include "math/fd_math.h"
 
@@ -28,13 +29,18 @@ void rls_ab_reset(rls_ab_t *k, float a0, float b0, float p0) {
   k->p[2] = p;
 }
 
-bool rls_ab_update(rls_ab_t *k, float g_al, float g_be, float c2, float s2) {
+bool rls_ab_update(rls_ab_t *k, float g_al, float g_be, float c2, float s2, const float *km) {
   if (!(fd_isfinite(g_al) && fd_isfinite(g_be) && fd_isfinite(c2) && fd_isfinite(s2))) {
     return false;
   }
   /* H of (4.54): rows (alpha, beta), columns (a, b) */
   const float c4 = c2 * c2 - s2 * s2, s4 = 2.0f * s2 * c2;
-  const float h11 = -c2, h12 = c4, h21 = s2, h22 = s4;
+  float h12 = c4, h22 = s4;
+  if (km != NULL) { /* the 4theta term as the sequentiality maps it (dfc_vec_t.k) */
+    h12 = km[0] * c4 - km[1] * s4;
+    h22 = km[3] * s4 - km[2] * c4;
+  }
+  const float h11 = -c2, h21 = s2;
   const float p11 = k->p[0], p12 = k->p[1], p22 = k->p[2];
   /* M = P H^T (2x2), S = H M + R */
   const float m11 = p11 * h11 + p12 * h12, m12 = p11 * h21 + p12 * h22;

@@ -39,8 +39,11 @@ bool rls_ab_init(rls_ab_t *k, const rls_ab_cfg_t *cfg);
 /* From estimates a0, b0 with covariance p0 I (within the limits). */
 void rls_ab_reset(rls_ab_t *k, float a0, float b0, float p0);
 /* One update from the signal vector (g_al, g_be) (normalised as in
- * dfc.h) at the angle whose double is the unit vector (c2, s2). false
- * (nothing changed) for non-finite inputs. */
-bool rls_ab_update(rls_ab_t *k, float g_al, float g_be, float c2, float s2);
+ * dfc.h) at the angle whose double is the unit vector (c2, s2); km: the
+ * map of the 4theta term of a vector corrected for sequentiality
+ * (dfc_vec_t.k: the b column of (4.54) becomes the 4theta term as that
+ * vector carries it), NULL for the plain (4.54). false (nothing changed)
+ * for non-finite inputs. */
+bool rls_ab_update(rls_ab_t *k, float g_al, float g_be, float c2, float s2, const float *km);
 
 #endif

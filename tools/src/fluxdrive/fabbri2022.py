@@ -532,13 +532,20 @@ def plot_shift_loop(res: Results, path: Path) -> None:
 
 def main_fabbri(args) -> int:
     root, sil, out, figs = paper_paths(args, "fabbri2022")
+    from . import fabbri2022_kf as kf
     res = Results(sil, root, out)
     table = report(res)
     plot_harmonic(res, figs / "fabbri2022_harmonic.png")
     plot_shift_loop(res, figs / "fabbri2022_shift_loop.png")
+    res_kf = kf.ResultsKF(sil, root, out)
+    table_kf = kf.report(res_kf)
+    kf.plot(res_kf, figs / "fabbri2022_kalman.png")
     print(table)
+    print(table_kf)
     if args.doc and replace_table(Path(args.doc), "fabbri2022", table):
         print(f"updated {args.doc}")
+    if args.doc and replace_table(Path(args.doc), "fabbri2022_kf", table_kf):
+        print(f"updated {args.doc} (Kalman filter, RLS)")
     return 0
 
 

@@ -427,6 +427,11 @@ static void send_periodic(can_proto_t *p, can_period_t which, const drive_t *drv
     can_codec_set(CAN_SIG_DELTA, f.data, tm->law_tm.delta);
     can_codec_set(CAN_SIG_I_QS_REF, f.data, tm->law_tm.i_qs_ref);
     break;
+  case CAN_PERIOD_TM_POSITION:
+    frame_init(&f, CAN_MSG_TM_POSITION, node);
+    can_codec_set(CAN_SIG_LOAD_TORQUE_EST, f.data, tm->load_est);
+    can_codec_set(CAN_SIG_POS_ERR, f.data, tm->pos_health);
+    break;
   case CAN_PERIOD_TM_CPU:
   default: {
     /* the board's measured ISR cycles (hal_isr_stats, DWT): the figure

@@ -54,7 +54,8 @@
   X(TM_PHASE, tm_phase, 10)                                                                        \
   X(TM_DQ, tm_dq, 10)                                                                              \
   X(TM_FLUX, tm_flux, 10)                                                                          \
-  X(TM_CPU, tm_cpu, 100)
+  X(TM_CPU, tm_cpu, 100)                                                                           \
+  X(TM_POSITION, tm_position, 10)
 
 #define CAN_PERIOD_ENUM(E, n, ms) CAN_PERIOD_##E,
 typedef enum { CAN_PERIOD_LIST(CAN_PERIOD_ENUM) CAN_PERIOD_COUNT } can_period_t;

@@ -40,8 +40,8 @@ int ctrl_select(ctrl_t *c, drive_law_t law) {
   return 0;
 }
 
-int ctrl_init(ctrl_t *c, const drive_config_t *cfg, const machine_t *machine, float t_out,
-              drive_law_t law, const char **reason) {
+FD_COLD int ctrl_init(ctrl_t *c, const drive_config_t *cfg, const machine_t *machine, float t_out,
+                      drive_law_t law, const char **reason) {
   *c = (ctrl_t){0};
   c->su = (ctrl_setup_t){cfg, machine, t_out};
   for (unsigned k = 0; k < (unsigned)DRIVE_LAW_COUNT; ++k) {

@@ -71,6 +71,11 @@ typedef struct {
 typedef struct {
   current_ctrl_t cc;
   float t_mtpa_max; /* [N m] */
+  /* the last MTPA point: the torque reference changes at the speed loop's
+   * rate (slow_div periods) or with a command, so the MTPA solution (a few
+   * hundred instructions on a salient machine) is reused in between */
+  float mtpa_t; /* its torque [N m] (NaN: none) */
+  dq_t mtpa_i;  /* its currents [A] */
 } ctrl_foc_t;
 
 typedef union {

@@ -1,31 +1,23 @@
 /*
  * drive.c - the drive: state machine, ISR body, protections, loss-of-control
- * monitor, and the main loop's side of the concurrency contract (drive.h).
+ * monitor (drive.h).
  *
  * idle -> offset calibration -> [align] -> run -> (fault). The ISR takes the
  * main loop's requests at its start, evaluates the protections on the
  * sample just read, and a fault disables the gates in the same ISR,
- * latches its cause and keeps it until a clear request.
+ * latches its cause and keeps it until a clear request. The main loop's
+ * side of the concurrency contract is drive_host.c.
  */
 #include "drive.h"
+#include "drive_sync.h"
 
 #include <math.h>
-#include <stdatomic.h>
 #include <string.h>
 
 #include "control/dfc_window.h"
 #include "control/modulation.h"
 #include "math/fd_math.h"
 #include "math/frames.h"
-
-/* Orders the accesses of one context around a shared word. The ISR and the
- * main loop run on one core (the ISR preempts, is never preempted by the
- * main loop): a compiler barrier is all the ordering they need. */
-#define DRIVE_BARRIER() atomic_signal_fence(memory_order_seq_cst)
-
-/* Attempts of drive_telemetry_read: a copy takes far less than a period,
- * so at most one attempt is ever preempted. */
-#define DRIVE_TM_TRIES 4
 
 static bool gates_on_state(drive_state_t s) {
   return s == DRIVE_STATE_RUN || s == DRIVE_STATE_ALIGN;
@@ -72,8 +64,8 @@ void drive_machine_copy(machine_t *dm, flux_map_t *dmap, const machine_t *m,
   dm->map = m->kind == MACHINE_FLUX_MAP ? dmap : NULL;
 }
 
-int drive_config_usable(const drive_config_t *cfg, drive_law_t law, machine_t *m, flux_map_t *map,
-                        drive_config_err_t *err) {
+FD_COLD int drive_config_usable(const drive_config_t *cfg, drive_law_t law, machine_t *m,
+                                flux_map_t *map, drive_config_err_t *err) {
   if (drive_config_check(cfg, err) != 0) {
     return -1;
   }
@@ -113,7 +105,7 @@ int drive_config_usable(const drive_config_t *cfg, drive_law_t law, machine_t *m
 
 /* What the ISR would otherwise divide for every period (LIVE parameters
  * included: called again when they change). */
-static void drive_derive(drive_t *drv) {
+FD_COLD static void drive_derive(drive_t *drv) {
   const drive_config_t *c = &drv->cfg;
   /* the duty range: the board's, narrowed by a DFC window */
   drv->duty_lo = drv->caps->duty_min;
@@ -134,8 +126,8 @@ static void drive_derive(drive_t *drv) {
 }
 
 /* Everything derived from the parameter set (ISR-owned; gates off). */
-static int drive_configure(drive_t *drv, const drive_config_t *cfg, drive_law_t law,
-                           drive_config_err_t *err) {
+FD_COLD static int drive_configure(drive_t *drv, const drive_config_t *cfg, drive_law_t law,
+                                   drive_config_err_t *err) {
   machine_t m;
   flux_map_t map;
   if (drive_config_usable(cfg, law, &m, &map, err) != 0) {
@@ -180,7 +172,7 @@ static int drive_configure(drive_t *drv, const drive_config_t *cfg, drive_law_t 
  * may not be valid in part: its i_trip with the i_max in force); otherwise
  * nothing now. Returns true when something of cfg waits for the gates to
  * be off. */
-static bool configure_live(drive_t *drv, const drive_config_t *cfg) {
+FD_COLD static bool configure_live(drive_t *drv, const drive_config_t *cfg) {
   unsigned n;
   const drive_param_t *t = drive_params_table(&n);
   drive_config_t next = drv->cfg;
@@ -212,7 +204,7 @@ static bool configure_live(drive_t *drv, const drive_config_t *cfg) {
   return rest;
 }
 
-int drive_init(drive_t *drv, const drive_config_t *cfg, drive_config_err_t *err) {
+FD_COLD int drive_init(drive_t *drv, const drive_config_t *cfg, drive_config_err_t *err) {
   drive_config_err_t dummy;
   if (err == NULL) {
     err = &dummy;
@@ -683,184 +675,4 @@ void drive_isr(drive_t *drv) {
     drv->v_applied = (ab_t){0.0f, 0.0f};
   }
   drive_publish(drv, &s, i);
-}
-
-/* ------------------------------------------------------------ main loop */
-
-bool drive_telemetry_read(drive_t *drv, drive_telemetry_t *out) {
-  for (int n = 0; n < DRIVE_TM_TRIES; ++n) {
-    const uint32_t s1 = drv->tm_seq;
-    DRIVE_BARRIER();
-    *out = drv->tm;
-    DRIVE_BARRIER();
-    /* the ISR may have run between the two reads (volatile) */
-    // cppcheck-suppress knownConditionTrueFalse
-    if (drv->tm_seq == s1) {
-      return true;
-    }
-    drv->host.tm_retries++;
-  }
-  return false;
-}
-
-void drive_background(drive_t *drv) {
-  drive_telemetry_t tm;
-  if (drive_telemetry_read(drv, &tm)) {
-    drv->host.tm = tm;
-  }
-  const uint32_t n = drv->isr_count; /* one aligned word: read atomically */
-  if (n != drv->host.isr_seen) {
-    drv->host.isr_seen = n;
-    hal_watchdog_kick();
-  }
-}
-
-const drive_telemetry_t *drive_telemetry(const drive_t *drv) {
-  return &drv->host.tm;
-}
-
-const drive_cmd_t *drive_commands(const drive_t *drv) {
-  return &drv->req.cmd;
-}
-
-const drive_config_t *drive_requested_config(const drive_t *drv) {
-  return &drv->creq.cfg;
-}
-
-/* The command block is written between cmd_begin and cmd_end (seq odd). */
-static drive_cmd_t *cmd_begin(drive_t *drv) {
-  drv->req.seq++;
-  DRIVE_BARRIER();
-  return &drv->req.cmd;
-}
-
-static void cmd_end(drive_t *drv) {
-  drv->req.cmd.seq++;
-  DRIVE_BARRIER();
-  drv->req.seq++;
-}
-
-/* Command clamp: a non-finite command becomes 0 (not a limit). */
-static float command_clamp(float x, float lo, float hi) {
-  if (!fd_isfinite(x)) {
-    return 0.0f;
-  }
-  return x < lo ? lo : (x > hi ? hi : x);
-}
-
-void drive_cmd_enable(drive_t *drv, bool enable) {
-  drive_cmd_t *c = cmd_begin(drv);
-  c->enable = enable ? 1u : 0u;
-  cmd_end(drv);
-}
-
-void drive_cmd_clear_fault(drive_t *drv) {
-  drive_cmd_t *c = cmd_begin(drv);
-  c->clear_count++;
-  memcpy(c->clear_mark, c->fault_count, sizeof c->clear_mark);
-  c->enable = 0u;
-  cmd_end(drv);
-}
-
-static ctrl_setup_t host_setup(const drive_t *drv) {
-  const ctrl_setup_t su = {&drv->creq.cfg, &drv->host.machine, 1.5f * drv->creq.cfg.ts};
-  return su;
-}
-
-const char *drive_cmd_set_law(drive_t *drv, drive_law_t law) {
-  const ctrl_law_t *row = ctrl_law(law);
-  if (row == NULL) {
-    return "no such law";
-  }
-  const ctrl_setup_t su = host_setup(drv);
-  const char *why = row->check(&su); /* a static string, not into su */
-  if (why != NULL) {
-    // cppcheck-suppress returnDanglingLifetime
-    return why;
-  }
-  if (drv->req.cmd.mode == DRIVE_MODE_CURRENT && (row->caps & CTRL_CAP_CURRENT) == 0u) {
-    return "this law has no current mode: leave current mode first";
-  }
-  drive_cmd_t *c = cmd_begin(drv);
-  c->law = law;
-  cmd_end(drv);
-  return NULL;
-}
-
-const char *drive_cmd_set_mode(drive_t *drv, drive_mode_t mode) {
-  if ((unsigned)mode >= (unsigned)DRIVE_MODE_COUNT) {
-    return "no such mode";
-  }
-  const ctrl_law_t *row = ctrl_law(drv->req.cmd.law);
-  if (mode == DRIVE_MODE_CURRENT && (row->caps & CTRL_CAP_CURRENT) == 0u) {
-    return "the law has no current mode";
-  }
-  drive_cmd_t *c = cmd_begin(drv);
-  c->mode = mode;
-  cmd_end(drv);
-  return NULL;
-}
-
-void drive_cmd_torque(drive_t *drv, float torque) {
-  const float lim = drv->creq.cfg.torque_max;
-  drive_cmd_t *c = cmd_begin(drv);
-  c->torque = command_clamp(torque, -lim, lim);
-  cmd_end(drv);
-}
-
-void drive_cmd_speed(drive_t *drv, float speed_m) {
-  const float lim = drv->creq.cfg.speed_max;
-  drive_cmd_t *c = cmd_begin(drv);
-  c->speed = command_clamp(speed_m, -lim, lim);
-  cmd_end(drv);
-}
-
-void drive_cmd_current(drive_t *drv, float id, float iq) {
-  const float lim = drv->creq.cfg.i_max;
-  id = command_clamp(id, -lim, lim);
-  iq = command_clamp(iq, -lim, lim);
-  const float mag = sqrtf(id * id + iq * iq);
-  if (mag > lim) {
-    id *= lim / mag;
-    iq *= lim / mag;
-  }
-  drive_cmd_t *c = cmd_begin(drv);
-  c->id = id;
-  c->iq = iq;
-  cmd_end(drv);
-}
-
-void drive_cmd_flux(drive_t *drv, float flux) {
-  drive_cmd_t *c = cmd_begin(drv);
-  c->flux = command_clamp(flux, 0.0f, 10.0f);
-  cmd_end(drv);
-}
-
-void drive_request_fault(drive_t *drv, uint32_t fault_bits) {
-  drive_cmd_t *c = cmd_begin(drv);
-  for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {
-    if ((fault_bits & (1u << b)) != 0u) {
-      c->fault_count[b]++;
-    }
-  }
-  cmd_end(drv);
-}
-
-int drive_request_config(drive_t *drv, const drive_config_t *cfg, drive_config_err_t *err) {
-  drive_config_err_t dummy;
-  if (err == NULL) {
-    err = &dummy;
-  }
-  machine_t m;
-  flux_map_t map;
-  if (drive_config_usable(cfg, drv->req.cmd.law, &m, &map, err) != 0) {
-    return -1;
-  }
-  drive_machine_copy(&drv->host.machine, &drv->host.map, &m, &map);
-  drv->creq.seq++;
-  DRIVE_BARRIER();
-  drv->creq.cfg = *cfg;
-  DRIVE_BARRIER();
-  drv->creq.seq++;
-  return 0;
 }

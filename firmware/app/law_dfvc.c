@@ -15,7 +15,7 @@
 /* Largest relative difference of L_q from L_d an SPM law accepts. */
 #define DFVC_ISOTROPY_TOL 0.1f
 
-static const char *dfvc_check(const ctrl_setup_t *su) {
+FD_COLD static const char *dfvc_check(const ctrl_setup_t *su) {
   const machine_t *m = su->machine;
   if (m->kind != MACHINE_LINEAR) {
     return "DFVC of Rubino 2020 needs a linear machine model";
@@ -32,7 +32,7 @@ static const char *dfvc_check(const ctrl_setup_t *su) {
   return NULL;
 }
 
-static int dfvc_law_init(ctrl_state_t *s, const ctrl_setup_t *su) {
+FD_COLD static int dfvc_law_init(ctrl_state_t *s, const ctrl_setup_t *su) {
   const drive_config_t *cfg = su->cfg;
   dfvc_cfg_t d;
   dfvc_cfg_defaults(&d, su->machine);

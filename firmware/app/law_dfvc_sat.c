@@ -12,7 +12,7 @@
 #include "ctrl_laws.h"
 #include "math/fd_math.h"
 
-static const char *dfvc_sat_check(const ctrl_setup_t *su) {
+FD_COLD static const char *dfvc_sat_check(const ctrl_setup_t *su) {
   const drive_config_t *cfg = su->cfg;
   if (!(cfg->flux_min > 0.0f)) {
     return "decoupled DFVC needs flux_min > 0";
@@ -23,7 +23,7 @@ static const char *dfvc_sat_check(const ctrl_setup_t *su) {
   return NULL;
 }
 
-static int dfvc_sat_law_init(ctrl_state_t *s, const ctrl_setup_t *su) {
+FD_COLD static int dfvc_sat_law_init(ctrl_state_t *s, const ctrl_setup_t *su) {
   const drive_config_t *cfg = su->cfg;
   dfvc_sat_cfg_t d;
   dfvc_sat_cfg_defaults(&d, su->machine);

@@ -19,20 +19,32 @@ static float clamp_sym_nan(float x, float lim) {
   return x > lim ? lim : (x < -lim ? -lim : x);
 }
 
-static const char *foc_check(const ctrl_setup_t *su) {
+FD_COLD static const char *foc_check(const ctrl_setup_t *su) {
   (void)su;
   return NULL; /* any machine: current mode always, torque mode on its MTPA */
 }
 
-static int foc_init(ctrl_state_t *s, const ctrl_setup_t *su) {
+FD_COLD static int foc_init(ctrl_state_t *s, const ctrl_setup_t *su) {
   const current_ctrl_cfg_t ccfg = {su->machine, su->cfg->current_bw, su->cfg->ts};
   current_ctrl_init(&s->foc.cc, &ccfg);
   s->foc.t_mtpa_max = machine_mtpa_torque(su->machine, su->cfg->i_max);
+  s->foc.mtpa_t = NAN;
   return 0;
 }
 
 static void foc_reset(ctrl_state_t *s) {
   current_ctrl_reset(&s->foc.cc);
+  s->foc.mtpa_t = NAN;
+}
+
+/* machine_mtpa_current(m, t), computed again only when t changes. */
+static dq_t foc_mtpa(ctrl_foc_t *f, const machine_t *m, float t) {
+  /* a NaN on either side compares false: solved again (a NaN reference faults) */
+  if (!(fabsf(t - f->mtpa_t) <= 0.0f)) {
+    f->mtpa_i = machine_mtpa_current(m, t);
+    f->mtpa_t = t;
+  }
+  return f->mtpa_i;
 }
 
 static void foc_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *in,
@@ -46,7 +58,7 @@ static void foc_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *i
   if (in->mode == DRIVE_MODE_CURRENT) {
     i_ref = (dq_t){in->id_ref, in->iq_ref};
   } else {
-    i_ref = machine_mtpa_current(m, clamp_sym_nan(in->torque_ref, t_lim));
+    i_ref = foc_mtpa(&s->foc, m, clamp_sym_nan(in->torque_ref, t_lim));
   }
   const float mag = sqrtf(i_ref.d * i_ref.d + i_ref.q * i_ref.q);
   if (mag > i_max) {
@@ -64,10 +76,18 @@ static void foc_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *i
   out->torque_min = -t_lim;
   out->torque_max = t_lim;
   out->fault = 0u;
-  out->tm = (ctrl_telemetry_t){0};
   const dq_t flux = machine_flux(m, i); /* one lookup for both (a map's is not free) */
-  out->tm.torque = 1.5f * m->pole_pairs * (flux.d * i.q - flux.q * i.d);
-  out->tm.flux = sqrtf(flux.d * flux.d + flux.q * flux.q);
+  /* every field written (no zero-fill call in the ISR): FOC has no flux
+   * loop, load angle or observer */
+  ctrl_telemetry_t *tm = &out->tm;
+  tm->flux = sqrtf(flux.d * flux.d + flux.q * flux.q);
+  tm->flux_ref = 0.0f;
+  tm->delta = 0.0f;
+  tm->i_ds = 0.0f;
+  tm->i_qs = 0.0f;
+  tm->i_qs_ref = 0.0f;
+  tm->torque = 1.5f * m->pole_pairs * (flux.d * i.q - flux.q * i.d);
+  tm->obs_err = 0.0f;
 }
 
 const ctrl_law_t ctrl_law_foc = {"foc", CTRL_CAP_CURRENT, foc_check, foc_init, foc_reset, foc_step};

@@ -110,7 +110,7 @@ static rls_ab_cfg_t rls_cfg_of(const drive_config_t *cfg) {
  * angle within 0.3 rad, load within 0.3 N m (1 sigma). */
 static const float kf_p0[3] = {900.0f, 0.09f, 0.09f};
 
-static void pdfc_init(pos_state_t *s, const drive_config_t *cfg) {
+FD_COLD static void pdfc_init(pos_state_t *s, const drive_config_t *cfg) {
   angle_pll_init(&s->dfc.pll, cfg->pll_bw, cfg->ts);
   s->dfc.track = track_of(cfg->pos_source);
   s->dfc.rls_on = cfg->pos_source == POS_SOURCE_IVD_KF_RLS;
@@ -120,6 +120,7 @@ static void pdfc_init(pos_state_t *s, const drive_config_t *cfg) {
   (void)rls_ab_init(&s->dfc.rls, &rc);
   rls_ab_reset(&s->dfc.rls, cfg->dfc_a, cfg->dfc_b, cfg->rls_p_max);
   s->dfc.r = 0.0f;
+  s->dfc.miss = 0u;
   s->dfc.dc = cfg_of(cfg);
   dfc_signals_reset(&s->dfc.sig);
   s->dfc.started = false;
@@ -135,6 +136,7 @@ static void pdfc_init(pos_state_t *s, const drive_config_t *cfg) {
 
 static void pdfc_reset(pos_state_t *s) {
   kf_mech_reset(&s->dfc.kf, 0.0f, 0.0f, kf_p0);
+  s->dfc.miss = 0u;
   dfc_signals_reset(&s->dfc.sig);
   s->dfc.started = false;
   s->dfc.n = 0u;
@@ -149,6 +151,8 @@ static float nearest_branch(float theta0, float ref) {
   return (d > 0.5f * FRAMES_PI || d < -0.5f * FRAMES_PI) ? frames_wrap_pi(theta0 + FRAMES_PI)
                                                          : theta0;
 }
+
+#define POS_DFC_COAST 16u /* periods without a component before the filter holds */
 
 /* The tracker's angle and speed: the PLL's or the Kalman filter's. */
 static float trk_theta(const pos_state_t *s) {
@@ -168,12 +172,15 @@ static void trk_reset(pos_state_t *s, float theta, float omega) {
 }
 
 /* The RLS of a, b (4.51)-(4.57) on this vector at the filter's predicted
- * angle, and the IVD's a, b from it, within the guards (header). */
+ * angle, and the IVD's a, b from it, within the guards (header). One
+ * update per refresh of the whole vector (when component a is the newest:
+ * every third period, 5.3 kHz, the thesis's DFC rate): successive updates
+ * then share no sample, as the RLS's independent noise assumes. */
 #define POS_DFC_P_MAX 0.45f /* |b/a| the IVD is given at most (Theorem 1: < 1/2) */
 static void rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v, bool fresh) {
   rls_ab_t *r = &s->dfc.rls;
   r->cfg = rls_cfg_of(cfg); /* the live tuning */
-  if (fresh && s->dfc.aligned && fabsf(s->dfc.kf.x[0]) > cfg->rls_w_min) {
+  if (fresh && s->dfc.sig.last == 0u && s->dfc.aligned && fabsf(s->dfc.kf.x[0]) > cfg->rls_w_min) {
     const sincos_t u = frames_sincos(2.0f * s->dfc.kf.x[1]);
     (void)rls_ab_update(r, v->al, v->be, u.c, u.s, v->k);
   }
@@ -206,7 +213,10 @@ static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sam
   const bool kalman = s->dfc.track != TRACK_PLL;
   /* the live parameters (b, iterations, phase shifts) in force */
   s->dfc.dc = cfg_of(cfg);
-  if (kalman) { /* one period ahead: this period's edge (header) */
+  /* one period ahead: this period's edge (header); not without signals
+   * for POS_DFC_COAST periods (gates off: the state is held, not run away
+   * on a stale torque and load) */
+  if (kalman && s->dfc.miss < POS_DFC_COAST) {
     kf->cfg.q[0] = cfg->kf_q_omega;
     kf->cfg.q[1] = cfg->kf_q_theta;
     kf->cfg.q[2] = cfg->kf_q_load;
@@ -225,6 +235,7 @@ static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sam
   } else if (!kalman) {
     s->dfc.t -= cfg->ts; /* the newest component ages by a period */
   }
+  s->dfc.miss = fresh ? 0u : (s->dfc.miss < 255u ? (uint8_t)(s->dfc.miss + 1u) : 255u);
   out->t = s->dfc.t; /* the filter's state is at the edge's point of this period */
   out->load = kalman ? kf->x[2] : 0.0f;
   float c2 = 1.0f, s2 = 0.0f;
@@ -305,7 +316,7 @@ static void pdfc_align(pos_state_t *s, const drive_config_t *cfg, const hal_samp
   s->dfc.pol_acc = 0.0f;
 }
 
-static const char *pdfc_check_cfg(const drive_config_t *cfg, const char **field) {
+FD_COLD static const char *pdfc_check_cfg(const drive_config_t *cfg, const char **field) {
   const dfc_cfg_t d = cfg_of(cfg);
   const int e = dfc_check(&d);
   if (e != DFC_OK) {

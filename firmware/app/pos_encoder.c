@@ -19,7 +19,7 @@
 #include "math/frames.h"
 #include "pos_source.h"
 
-static void enc_init(pos_state_t *s, const drive_config_t *cfg) {
+FD_COLD static void enc_init(pos_state_t *s, const drive_config_t *cfg) {
   angle_pll_init(&s->enc.pll, cfg->pll_bw, cfg->ts);
   s->enc.offset = cfg->enc_offset;
   s->enc.half = cfg->enc_cpr > 0u ? FRAMES_PI / (float)cfg->enc_cpr : 0.0f;

@@ -73,6 +73,7 @@ typedef union {
     /* the tracker: the PLL above, or the Kalman filter (KF and EKF
      * sources); the RLS of a, b (ivd+kf+rls) */
     uint8_t track; /* pos_dfc.c: TRACK_* */
+    uint8_t miss;  /* periods since the last component (saturates) */
     bool rls_on;
     kf_mech_t kf;
     rls_ab_t rls;

@@ -100,12 +100,21 @@ def test_ebike_sensorless(res):
 
 
 def test_laws_on_ivd_kf(res):
-    """Acceptance 5: the decoupled DFVC and DB-DFVC on the IVD+KF position:
-    no fault, each torque step within 2 % of its reference (period-average
-    plant torque) and within 3 % of the encoder run's (itself 2.8 % low on
-    the decoupled DFVC's first step)."""
-    for st, enc in res.laws:
-        assert st.faults == [] and enc.faults == [], st.law
-        for got, ref, e in zip(st.torque, st.refs, enc.torque):
-            assert abs(got / ref - 1.0) < 0.02, (st.law, got, ref)
-            assert abs(got / e - 1.0) < 0.03, (st.law, got, e)
+    """Acceptance 5: the decoupled DFVC and DB-DFVC in speed control at
+    500 rpm on the IVD+KF position (36 V link) answer the brake steps with
+    torque steps: no fault, the settled torque within 2 % of load and
+    friction (the scenario's), the speed dip within 25 % (+ 3 rpm) of the
+    encoder run's and back within 0.5 % in at most twice its time. On 24 V
+    the window's halved voltage range is too small for the second step: the
+    star-point runs trip with the PLL as with the filter, the encoder (no
+    window) does not - the cause is the window, not the filter."""
+    for law, _, _ in kf.LAW_CASES_KF:
+        st, enc = res.law(law, "ivd+kf", 36.0), res.law(law, "encoder", 36.0)
+        assert st.faults == [] and enc.faults == [], law
+        for got, ld in zip(st.torque, st.load):
+            assert abs(got / ld - 1.0) < 0.02, (law, got, ld)
+        for d, de, b, be in zip(st.dip, enc.dip, st.recover, enc.recover):
+            assert d < 1.25 * de + 3.0, (law, d, de)
+            assert b < 2.0 * be, (law, b, be)
+        assert res.law(law, "encoder", 24.0).faults == []
+        assert "lost_control" in res.law(law, "ivd", 24.0).faults

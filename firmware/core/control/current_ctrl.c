@@ -24,7 +24,7 @@
 
 #include "math/fd_math.h"
 
-void current_ctrl_init(current_ctrl_t *cc, const current_ctrl_cfg_t *cfg) {
+FD_COLD void current_ctrl_init(current_ctrl_t *cc, const current_ctrl_cfg_t *cfg) {
   cc->cfg = *cfg;
   const float wc = cfg->bandwidth;
   const machine_t *m = cfg->machine;

@@ -32,7 +32,7 @@ void dfvc_cfg_defaults(dfvc_cfg_t *cfg, const machine_t *machine) {
   cfg->rot_advance = 0.5f;
 }
 
-int dfvc_init(dfvc_t *c, const dfvc_cfg_t *cfg) {
+FD_COLD int dfvc_init(dfvc_t *c, const dfvc_cfg_t *cfg) {
   memset(c, 0, sizeof(*c));
   c->cfg = *cfg;
   const dfvc_cfg_t *k = cfg;

@@ -87,7 +87,7 @@ void dfvc_sat_model(const machine_t *m, dq_t cm_scale, dq_t lambda, dq_t i, dfvc
   dfvc_sat_model_at(m, cm_scale, lambda, i, li, l, 1, 2, q);
 }
 
-int dfvc_sat_init(dfvc_sat_t *c, const dfvc_sat_cfg_t *cfg) {
+FD_COLD int dfvc_sat_init(dfvc_sat_t *c, const dfvc_sat_cfg_t *cfg) {
   memset(c, 0, sizeof(*c));
   c->cfg = *cfg;
   const dfvc_sat_cfg_t *k = cfg;

@@ -9,7 +9,7 @@
 
 #include "math/fd_math.h"
 
-int dfvc_sat_pi_init(dfvc_sat_pi_t *c, const dfvc_sat_pi_cfg_t *cfg) {
+FD_COLD int dfvc_sat_pi_init(dfvc_sat_pi_t *c, const dfvc_sat_pi_cfg_t *cfg) {
   memset(c, 0, sizeof(*c));
   const dfvc_sat_pi_cfg_t *k = cfg;
   if (!(fd_isfinite(k->ts) && k->ts > 0.0f && fd_isfinite(k->omega) && k->omega > 0.0f &&

@@ -27,7 +27,7 @@ static int dfvc_sat_refs_frac(float x) {
   return fd_isfinite(x) && x > 0.0f && x <= 1.0f;
 }
 
-int dfvc_sat_refs_init(dfvc_sat_refs_t *r, const dfvc_sat_refs_cfg_t *cfg) {
+FD_COLD int dfvc_sat_refs_init(dfvc_sat_refs_t *r, const dfvc_sat_refs_cfg_t *cfg) {
   memset(r, 0, sizeof(*r));
   const dfvc_sat_refs_cfg_t *c = cfg;
   if (!(c->machine != NULL &&

@@ -8,7 +8,7 @@
 
 #include "math/fd_math.h"
 
-void speed_ctrl_init(speed_ctrl_t *sc, const speed_ctrl_cfg_t *cfg) {
+FD_COLD void speed_ctrl_init(speed_ctrl_t *sc, const speed_ctrl_cfg_t *cfg) {
   sc->cfg = *cfg;
   const float tm = fabsf(cfg->torque_max);
   sc->cfg.torque_max = tm;

@@ -11,7 +11,7 @@
 
 #include "math/fd_math.h"
 
-void angle_pll_init(angle_pll_t *p, float bandwidth, float ts) {
+FD_COLD void angle_pll_init(angle_pll_t *p, float bandwidth, float ts) {
   p->kp = 2.0f * bandwidth; /* zeta = 1 */
   p->ki = bandwidth * bandwidth;
   p->ts = ts;

@@ -9,7 +9,7 @@
 
 #include "math/fd_math.h"
 
-int current_predictor_init(current_predictor_t *p, const current_predictor_cfg_t *cfg) {
+FD_COLD int current_predictor_init(current_predictor_t *p, const current_predictor_cfg_t *cfg) {
   memset(p, 0, sizeof(*p));
   if (cfg->machine == NULL ||
       (cfg->mode != CURRENT_PREDICTOR_EXACT && cfg->mode != CURRENT_PREDICTOR_EQ21)) {

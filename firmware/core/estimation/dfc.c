@@ -13,7 +13,7 @@
 #define DFC_SQRT3_INV 0.57735026918962576f
 #define DFC_PHI_MAX   1.0f /* rad/A: a phase shift model beyond this is a typo */
 
-int dfc_check(const dfc_cfg_t *c) {
+FD_COLD int dfc_check(const dfc_cfg_t *c) {
   if ((unsigned)c->method > (unsigned)DFC_FULL_IVD) {
     return DFC_ERR_METHOD;
   }
@@ -33,7 +33,7 @@ int dfc_check(const dfc_cfg_t *c) {
   return DFC_OK;
 }
 
-const char *dfc_strerror(int err) {
+FD_COLD const char *dfc_strerror(int err) {
   switch (err) {
   case DFC_OK:
     return "ok";

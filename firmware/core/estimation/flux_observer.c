@@ -32,7 +32,7 @@ static float flux_observer_polar(ab_t x, sincos_t *sc) {
   return a;
 }
 
-int flux_observer_init(flux_observer_t *o, const flux_observer_cfg_t *cfg) {
+FD_COLD int flux_observer_init(flux_observer_t *o, const flux_observer_cfg_t *cfg) {
   memset(o, 0, sizeof(*o));
   const flux_observer_cfg_t *c = cfg;
   if (!(c->machine != NULL && fd_isfinite(c->ts) && c->ts > 0.0f && fd_isfinite(c->omega_c) &&

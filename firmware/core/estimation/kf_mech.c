@@ -14,7 +14,7 @@ static bool finite_nonneg(float v) {
   return fd_isfinite(v) && v >= 0.0f;
 }
 
-bool kf_mech_init(kf_mech_t *k, const kf_mech_cfg_t *cfg) {
+FD_COLD bool kf_mech_init(kf_mech_t *k, const kf_mech_cfg_t *cfg) {
   const kf_mech_cfg_t *c = cfg;
   if (!(c->ts > 0.0f && fd_isfinite(c->ts) && c->inertia > 0.0f && fd_isfinite(c->inertia) &&
         c->pole_pairs > 0.0f && fd_isfinite(c->pole_pairs) && finite_nonneg(c->friction) &&

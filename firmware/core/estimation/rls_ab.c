@@ -9,7 +9,7 @@
 
 #include "math/fd_math.h"
 
-bool rls_ab_init(rls_ab_t *k, const rls_ab_cfg_t *cfg) {
+FD_COLD bool rls_ab_init(rls_ab_t *k, const rls_ab_cfg_t *cfg) {
   const rls_ab_cfg_t *c = cfg;
   if (!(c->lambda > 0.0f && c->lambda <= 1.0f && c->r > 0.0f && fd_isfinite(c->r) &&
         c->p_min > 0.0f && c->p_max >= c->p_min && fd_isfinite(c->p_max))) {

@@ -9,7 +9,6 @@
 #ifndef FD_MATH_FD_MATH_H
 #define FD_MATH_FD_MATH_H
 
-/* 1 if x is neither infinite nor NaN. */
 /* A function kept out of line so that the PIL trace counts it per call
  * (docs/benchmarks.md); a call costs a few instructions. */
 #if defined(__GNUC__)
@@ -18,6 +17,18 @@
 #define FD_NOINLINE
 #endif
 
+/* Initialisation and configuration code (runs at start-up or when a
+ * parameter set is taken, never in a normal period): on the Cortex-M builds
+ * in section .fd_cold, which the STM32G474 link leaves in flash so that the
+ * CCM SRAM holds the periodic ISR path (hal/stm32g4/stm32g474re.ld);
+ * nothing on the host. */
+#if defined(__GNUC__) && defined(__arm__)
+#define FD_COLD __attribute__((section(".fd_cold")))
+#else
+#define FD_COLD
+#endif
+
+/* 1 if x is neither infinite nor NaN. */
 static inline int fd_isfinite(float x) {
   return __builtin_isfinite(x);
 }

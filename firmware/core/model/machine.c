@@ -26,7 +26,7 @@ int machine_init_linear(machine_t *m, float pole_pairs, float rs, float ld, floa
   return 0;
 }
 
-int machine_init_map(machine_t *m, float rs, const flux_map_t *map) {
+FD_COLD int machine_init_map(machine_t *m, float rs, const flux_map_t *map) {
   if (map == NULL || !(fd_isfinite(rs) && rs > 0.0f)) {
     return -1;
   }

@@ -906,7 +906,7 @@ def stand_ins(prog: Program) -> frozenset[str]:
     return frozenset(out)
 
 #: The core's trig entry points, bound to the CORDIC on the board (cordic_bind.c).
-BOARD_TRIG = ("fd_sincosf", "fd_atan2f")
+BOARD_TRIG = ("fd_sincosf", "fd_atan2f", "fd_cordic_atan2_q31")
 ADC_WAIT_CHECKS = 200  # adc.c: for (t = 0; t < 200u && !(ADC2->ISR & JEOS); t++)
 
 
@@ -1048,7 +1048,11 @@ def bound_board(prog: Program, elf: str = "") -> BoardBound:
     trig = []
     for name in BOARD_TRIG:
         if name in prog.funcs:
-            tp = walk(prog, _entry(prog, name), lambda i, k, n: None, stop, False)
+            # no loops in the bindings: a backward branch joins a shared
+            # epilogue (not taken: the longer side); forward ones both ways
+            tp = walk(prog, _entry(prog, name),
+                      lambda i, k, n: False if i.target is not None and i.target <= i.addr
+                      else None, stop, False)
             part = _path_part(prog, name, tp, f"+ {CORDIC_LATENCY} CORDIC latency")
             part.bus += CORDIC_LATENCY
             trig.append(part)

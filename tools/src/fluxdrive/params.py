@@ -48,6 +48,10 @@ def mode_ids() -> dict[str, int]:
     return {n: i for i, n in enumerate(tables()["modes"])}
 
 
+def pos_source_ids() -> dict[str, int]:
+    return {n: i for i, n in enumerate(tables()["pos_sources"])}
+
+
 def state_names() -> dict[int, str]:
     return dict(enumerate(tables()["states"]))
 

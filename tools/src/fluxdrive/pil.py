@@ -86,7 +86,12 @@ BLOCKS = [
     ("drive (ISR body, commands, protections, offsets)", ("drive_", "hal_pwm_centred")),
     ("speed loop (speed_ctrl, every slow_div ISRs)", ("speed_ctrl_",)),
     ("position source (encoder, star point, PLL)", ("enc_", "pdfc_", "nearest_branch",
-                                                    "pos_source", "angle_pll_")),
+                                                    "pos_source", "angle_pll_", "trk_",
+                                                    "meas_r", "rls_step")),
+    ("Kalman filter (kf_mech_predict, kf_mech_update: (4.46)-(4.49))",
+     ("kf_mech_predict", "kf_mech_update", "kf_mech_reset", "kf_mech_r_speed")),
+    ("EKF update (kf_mech_update_ekf: (4.35)-(4.41))", ("kf_mech_update_ekf",)),
+    ("RLS of a, b (rls_ab_update: (4.51)-(4.57))", ("rls_ab_",)),
     ("DFC signals (dfc_signals_: (2.101), sequentiality)", ("dfc_signals_",)),
     ("IVD iteration (dfc_ivd_step, (3.76)/(3.100))", ("dfc_ivd_step",)),
     ("DFC / IVD angle (dfc_vector2, dfc_window)", ("dfc_",)),
@@ -573,6 +578,20 @@ def board_estimate(c: Counts, board: cm4_cycles.BoardBound) -> tuple[float, floa
             c.cycles_worst + base + w.hal_cycles + w.wrapper_cycles)
 
 
+def trig_on_cordic(c: Counts, board: cm4_cycles.BoardBound) -> float | None:
+    """Instructions per ISR with the core's software trigonometry
+    (fd_sincosf, fd_atan2f, the Q31 CORDIC: what cordic_bind.c binds to the
+    STM32G4's CORDIC co-processor) replaced by the board's bindings, per
+    call as traced; the rest as the PIL counts it (its replay HAL included).
+    None without the per-call counts (--functions)."""
+    if not c.calls:
+        return None
+    trig = {p.name: p.insns for p in board.trig}
+    sw = sum(k * v for f, (k, v) in c.calls.items() if f in trig)
+    hw = sum(c.calls[f][0] * n for f, n in trig.items() if f in c.calls)
+    return c.mean - sw + hw
+
+
 def traced_text(isrs: int, total: int) -> str:
     if isrs <= 0 or isrs >= total:
         return f"all {total} ISRs traced"
@@ -610,6 +629,12 @@ def format_report(runs: list[PilRun], isrs: int, cpi: float | None = None,
                 f"wrapper and exception, `fluxdrive cycles-board`): typical {bt:.0f} "
                 f"({_pct(bt)}), worst {bw:.0f} ({_pct(bw)})"
             )
+            tc = trig_on_cordic(c, board)
+            if tc is not None:
+                lines.append(
+                    f"instructions per ISR with the core's trigonometry on the board's CORDIC "
+                    f"co-processor (cordic_bind.c, per call as traced): mean {tc:.0f}"
+                )
         lines.append("  instr/ISR  share  cycles/ISR  cyc/instr  block")
         for b, v in sorted(c.blocks.items(), key=lambda kv: -kv[1]):
             y = c.block_cycles.get(b, 0.0)

@@ -33,7 +33,7 @@ from fluxdrive import params
 from fluxdrive.can.protocol import Protocol, Reply
 from fluxdrive.errors import FluxdriveError
 
-TELEMETRY = ("TM_SPEED", "TM_TORQUE", "TM_PHASE", "TM_DQ", "TM_FLUX")  # TM_CPU: 100 ms, ask for it
+TELEMETRY = ("TM_SPEED", "TM_TORQUE", "TM_PHASE", "TM_DQ", "TM_FLUX", "TM_POSITION")  # TM_CPU: 100 ms, ask for it
 # names and numbers from the firmware's tables (fluxdrive params)
 MODES = params.mode_ids()
 LAWS = params.law_ids()

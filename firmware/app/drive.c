@@ -23,10 +23,6 @@ static bool gates_on_state(drive_state_t s) {
   return s == DRIVE_STATE_RUN || s == DRIVE_STATE_ALIGN;
 }
 
-bool drive_state_enabled(drive_state_t s) {
-  return s == DRIVE_STATE_OFFSET_CAL || gates_on_state(s);
-}
-
 /* All gates off, the pattern back to the middle of the duty range (no
  * voltage when the gates come back). */
 static void drive_gates_off(const drive_t *drv) {
@@ -151,6 +147,7 @@ FD_COLD static int drive_configure(drive_t *drv, const drive_config_t *cfg, driv
   }
   drv->pos_src = pos_source(cfg->pos_source);
   drv->pos_src->init(&drv->pos_st, cfg);
+  drv->pos.out.load = 0.0f; /* written by the sources that estimate it (pos_source.h) */
   speed_ctrl_cfg_t scfg;
   speed_cfg_from(&scfg, cfg);
   speed_ctrl_init(&drv->speed, &scfg);
@@ -323,8 +320,8 @@ static uint32_t drive_protect(const drive_t *drv, const hal_sample_t *s, const f
   /* the position must be usable before the gates go on, and plausible
    * while they are */
   const bool need = drv->gated ? drv->state == DRIVE_STATE_RUN : drive_state_enabled(drv->state);
-  if (need &&
-      (!drv->pos.valid || (drv->state == DRIVE_STATE_RUN && drv->pos.health > c->pos_err_max))) {
+  if (need && (!drv->pos.out.valid ||
+               (drv->state == DRIVE_STATE_RUN && drv->pos.out.health > c->pos_err_max))) {
     f |= DRIVE_FAULT_POSITION;
   }
   return f;
@@ -488,8 +485,8 @@ static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
   in.i_ab = frames_clarke((abc_t){i[0], i[1], i[2]});
   in.v_applied = drv->v_applied;
   /* the angle at the current sample, from the source's timestamp */
-  in.theta_e = frames_wrap_pi(drv->pos.theta + drv->pos.omega * (s->t_i - drv->pos.t));
-  in.omega_e = drv->pos.omega;
+  in.theta_e = frames_wrap_pi(drv->pos.out.theta + drv->pos.out.omega * (s->t_i - drv->pos.out.t));
+  in.omega_e = drv->pos.out.omega;
   in.v_lin = drv->v_lin;
   in.mode = mode_in_force(drv);
   in.torque_ref = in.mode == DRIVE_MODE_SPEED ? drv->speed_torque : drv->cmd.torque;
@@ -516,6 +513,8 @@ static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
   tm->theta_e = in.theta_e;
   tm->torque_ref = in.torque_ref;
   tm->torque_est = out.tm.torque;
+  drv->pos.in.i_q = out.i_dq.q;
+  drv->pos.in.torque = out.tm.torque;
   tm->law_tm = out.tm;
   drive_monitor(drv, &in, &out);
 }
@@ -541,6 +540,7 @@ static void drive_align(drive_t *drv, const float i[3], const hal_sample_t *s) {
 
 static void drive_start(drive_t *drv) {
   ctrl_reset(&drv->ctrl);
+  drv->pos.in = (pos_input_t){0.0f, 0.0f}; /* no torque before the run */
   drv->speed_active = false;
   drv->speed_torque = 0.0f;
   memset(drv->lc_n, 0, sizeof drv->lc_n);
@@ -591,11 +591,11 @@ static void drive_publish(drive_t *drv, const hal_sample_t *s, const float i[3])
   tm->v_ab_applied[0] = drv->v_applied.alpha;
   tm->v_ab_applied[1] = drv->v_applied.beta;
   tm->omega_m = drv->omega_m;
-  tm->pos_health = drv->pos.health;
-  tm->load_est = drv->pos.load;
+  tm->pos_health = drv->pos.out.health;
+  tm->load_est = drv->pos.out.load;
   tm->cmd_seq = drv->cmd.seq;
   if (drv->state != DRIVE_STATE_RUN) {
-    tm->theta_e = drv->pos.theta;
+    tm->theta_e = drv->pos.out.theta;
   }
   tm->isr_count_end = drv->isr_count;
   DRIVE_BARRIER();
@@ -617,12 +617,9 @@ void drive_isr(drive_t *drv) {
     drive_window_sample(drv, i, s.v_dc);
   }
   drive_speed_loop(drv); /* on the rates of the previous slow_div periods */
-  /* the last period's q current and torque (no torque before the run) */
-  const pos_input_t pin = {drv->tm.i_dq[1],
-                           drv->state == DRIVE_STATE_RUN ? drv->tm.torque_est : 0.0f};
-  drv->pos_src->update(&drv->pos_st, &drv->cfg, &s, &pin, &drv->pos);
-  drv->omega_m = drv->pos.omega * drv->inv_pole_pairs;
-  drv->rate_acc += drv->pos.rate;
+  drv->pos_src->update(&drv->pos_st, &drv->cfg, &s, &drv->pos);
+  drv->omega_m = drv->pos.out.omega * drv->inv_pole_pairs;
+  drv->rate_acc += drv->pos.out.rate;
   drv->rate_n++;
   /* modulation_v_max() of the duty range in force, its span precomputed */
   drv->v_lin = (s.v_dc > 0.0f && fd_isfinite(s.v_dc)) ? drv->v_lin_k * s.v_dc : 0.0f;

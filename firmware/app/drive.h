@@ -126,7 +126,8 @@ typedef struct {
   /* position */
   const pos_source_row_t *pos_src;
   pos_state_t pos_st;
-  pos_estimate_t pos;
+  pos_io_t pos;   /* the source's estimate (out), and its input (in): the last run
+                     period's q current and torque (0 from a start) */
   float omega_m;  /* mechanical speed (source, per ISR) [rad/s] */
   float rate_acc; /* sum of the angle rate over the speed-loop period */
   uint32_t rate_n;
@@ -189,8 +190,11 @@ int drive_config_usable(const drive_config_t *cfg, drive_law_t law, machine_t *m
 void drive_machine_copy(machine_t *dm, flux_map_t *dmap, const machine_t *m, const flux_map_t *map);
 
 /* States in which the drive is enabled: offset calibration, alignment, run
- * (non-LIVE parameters are refused then). */
-bool drive_state_enabled(drive_state_t s);
+ * (non-LIVE parameters are refused then). Inline: the ISR asks every
+ * period. */
+static inline bool drive_state_enabled(drive_state_t s) {
+  return s == DRIVE_STATE_OFFSET_CAL || s == DRIVE_STATE_RUN || s == DRIVE_STATE_ALIGN;
+}
 
 /* The PWM-period interrupt body. Bounded time, never blocks. */
 void drive_isr(drive_t *drv);

@@ -207,7 +207,9 @@ static float meas_r(const pos_state_t *s, const drive_config_t *cfg, const dfc_v
 }
 
 static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
-                        const pos_input_t *in, pos_estimate_t *out) {
+                        pos_io_t *io) {
+  const pos_input_t *in = &io->in;
+  pos_estimate_t *out = &io->out;
   angle_pll_t *pll = &s->dfc.pll;
   kf_mech_t *kf = &s->dfc.kf;
   const bool kalman = s->dfc.track != TRACK_PLL;

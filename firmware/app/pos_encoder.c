@@ -36,11 +36,12 @@ static float enc_electrical(const pos_state_t *s, const drive_config_t *cfg,
 }
 
 static void enc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
-                       const pos_input_t *in, pos_estimate_t *out) {
+                       pos_io_t *io) {
+  const pos_input_t *in = &io->in;
+  pos_estimate_t *out = &io->out;
   (void)in;
   angle_pll_t *pll = &s->enc.pll;
-  out->t = smp->t_enc;
-  out->load = 0.0f;
+  out->t = smp->t_enc; /* out->load: 0 from the source's start (drive.c) */
   out->valid = smp->enc_valid && fd_isfinite(smp->enc_angle);
   if (!out->valid) {
     /* no measurement: the PLL coasts; the estimate is not usable */

@@ -33,7 +33,8 @@ typedef struct {
   float t;      /* instant of theta after the period start [s] */
   bool valid;   /* false: no usable measurement this period */
   float health; /* |measurement - prediction| [rad electrical] */
-  float load;   /* load torque estimate [N m] (Kalman filter sources; 0 otherwise) */
+  float load;   /* load torque estimate [N m]: written by the Kalman filter sources only
+                   (the drive zeroes it when it starts a source) */
 } pos_estimate_t;
 
 /* What the drive knows of the last period, for the sources' models. */
@@ -41,6 +42,13 @@ typedef struct {
   float i_q;    /* rotor-frame q current [A] (the Full IVD's phase shifts) */
   float torque; /* electromagnetic torque estimate [N m] (the Kalman filter's input) */
 } pos_input_t;
+
+/* A source's input and estimate, one argument (the update's fourth: all
+ * in registers) */
+typedef struct {
+  pos_input_t in;
+  pos_estimate_t out;
+} pos_io_t;
 
 enum {
   POS_CAP_ALIGN = 1u << 0, /* the angle offset can be found by an alignment */
@@ -86,8 +94,7 @@ typedef struct {
   uint32_t caps; /* POS_CAP_* */
   void (*init)(pos_state_t *s, const drive_config_t *cfg);
   void (*reset)(pos_state_t *s);
-  void (*update)(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
-                 const pos_input_t *in, pos_estimate_t *out);
+  void (*update)(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp, pos_io_t *io);
   /* The rotor is held at electrical angle theta: take it as the reference
    * (alignment). Only for POS_CAP_ALIGN. */
   void (*align)(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp, float theta);

@@ -395,7 +395,7 @@ static void angle_extrapolated_from_timestamps(void **state) {
   const float want = remainderf(
       p * (hal.sample.enc_angle + half) - drv.cfg.enc_offset - p * w_m * t_enc, 6.2831853f);
   assert_float_equal(remainderf(drv.tm.theta_e - want, 6.2831853f), 0.0f, 2e-4f);
-  assert_float_equal(drv.pos.omega, p * w_m, 0.01f * p * w_m);
+  assert_float_equal(drv.pos.out.omega, p * w_m, 0.01f * p * w_m);
 }
 
 static void bad_config_is_named(void **state) {

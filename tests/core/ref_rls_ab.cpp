@@ -3,8 +3,11 @@
  * amplitudes (estimation/rls_ab.h, Fabbri 2022 (4.54)-(4.57) with a
  * forgetting factor): K = P H^T (H P H^T + R)^-1 by Eigen's inverse, x +=
  * K (Gamma - H x), P = (P - K H P) / lambda, over random angles, speeds
- * and noisy signals; limits set wide so that they do not act. The float
- * version within the stated bounds.
+ * and noisy signals; limits set wide so that they do not act. Every other
+ * run carries a sequentiality map K (dfc_vec_t.k, random near the
+ * identity): the b column of H is then M (cos 4theta, sin 4theta) with
+ * M = [k0 -k1; -k2 k3] (C K C undone), the signals built the same way.
+ * The float version within the stated bounds.
  */
 #include <cmath>
 #include <cstdio>
@@ -44,17 +47,27 @@ void test_against_eigen(void **state) {
     Eigen::Vector2d x(0.7 * a, 1.3 * b);
     Eigen::Matrix2d P = p0 * Eigen::Matrix2d::Identity();
     const Eigen::Matrix2d R = sigma * sigma * Eigen::Matrix2d::Identity();
+    float km[4] = {1.0f, 0.0f, 0.0f, 1.0f};
+    if (run % 2 == 1) {
+      for (float &v : km) {
+        v += static_cast<float>(0.2 * (u01(rng) - 0.5));
+      }
+    }
+    Eigen::Matrix2d M;
+    M << km[0], -km[1], -km[2], km[3];
     double th = 6.28 * u01(rng);
     const double dth = 0.002 + 0.05 * u01(rng);
     for (int n = 0; n < 20000; ++n) {
       th += dth;
-      const double ga = -a * std::cos(2 * th) + b * std::cos(4 * th) + sigma * n01(rng);
-      const double gb = a * std::sin(2 * th) + b * std::sin(4 * th) + sigma * n01(rng);
+      const Eigen::Vector2d h4 = M * Eigen::Vector2d(std::cos(4 * th), std::sin(4 * th));
+      const double ga = -a * std::cos(2 * th) + b * h4(0) + sigma * n01(rng);
+      const double gb = a * std::sin(2 * th) + b * h4(1) + sigma * n01(rng);
       const float c2 = static_cast<float>(std::cos(2 * th)),
                   s2 = static_cast<float>(std::sin(2 * th));
-      assert_true(rls_ab_update(&k, static_cast<float>(ga), static_cast<float>(gb), c2, s2, nullptr));
+      assert_true(rls_ab_update(&k, static_cast<float>(ga), static_cast<float>(gb), c2, s2,
+                                run % 2 == 1 ? km : nullptr));
       Eigen::Matrix2d H;
-      H << -std::cos(2 * th), std::cos(4 * th), std::sin(2 * th), std::sin(4 * th);
+      H << -std::cos(2 * th), h4(0), std::sin(2 * th), h4(1);
       const Eigen::Matrix2d K = P * H.transpose() * (H * P * H.transpose() + R).inverse();
       x += K * (Eigen::Vector2d(ga, gb) - H * x);
       P = (P - K * H * P) / lambda;

@@ -31,7 +31,8 @@ static void run(double lambda, double p_max, double *t_in, double *a_end, double
     const double th = we * ts * n;
     const double ga = -a * cos(2 * th) + b * cos(4 * th) + sigma * gauss(&seed);
     const double gb = a * sin(2 * th) + b * sin(4 * th) + sigma * gauss(&seed);
-    assert_true(rls_ab_update(&k, (float)ga, (float)gb, (float)cos(2 * th), (float)sin(2 * th), NULL));
+    assert_true(
+        rls_ab_update(&k, (float)ga, (float)gb, (float)cos(2 * th), (float)sin(2 * th), NULL));
     const bool in = fabs(k.x[0] / a - 1.0) < 0.05 && fabs(k.x[1] / b - 1.0) < 0.05;
     if (in && *t_in < 0.0) {
       *t_in = n * ts;

@@ -118,3 +118,23 @@ def test_laws_on_ivd_kf(res):
             assert b < 2.0 * be, (law, b, be)
         assert res.law(law, "encoder", 24.0).faults == []
         assert "lost_control" in res.law(law, "ivd", 24.0).faults
+
+
+@pytest.mark.parametrize("keys, field, why", [
+    ({"pos_source": "ivd+kf+rls", "rls_p_min": 1e-3, "rls_p_max": 1e-5}, "controller.rls_p_min",
+     "rls_p_min <= rls_p_max"),
+    ({"pos_source": "ivd+kf", "kf_q_omega": -1.0}, "controller.kf_q_omega", "must be in"),
+    ({"pos_source": "ekf", "dfc_sigma": 0.0}, "controller.dfc_sigma", "must be in"),
+    ({"pos_source": "ivd+kf+"}, "controller.pos_source", "ivd+kf+rls"),
+])
+def test_bad_filter_settings_are_refused(tmp_path, keys, field, why):
+    """Bad input: the SIL refuses the scenario, naming the field (exit 2)."""
+    import json
+    import subprocess
+    sc = json.loads((REPO_ROOT / "sil" / "scenarios" / "fabbri_speed.json").read_text())
+    sc["controller"].update(keys)
+    p = tmp_path / "bad.json"
+    p.write_text(json.dumps(sc))
+    r = subprocess.run([str(REAL_SIL), str(p), "--print-config"], capture_output=True, text=True,
+                       timeout=60)
+    assert r.returncode == 2 and f"{field}: " in r.stderr and why in r.stderr, r.stderr

@@ -252,6 +252,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="fail when the DB-DFVC worst case reaches N instructions")
     p.add_argument("--check-mean", type=_positive_int, metavar="N",
                    help="fail when a run's mean reaches N instructions per law ISR")
+    p.add_argument("--check-mean-cordic", type=_positive_int, metavar="N",
+                   help="fail when a run's mean with the core's trigonometry on the board's "
+                   "CORDIC co-processor reaches N instructions (needs --board-elf, --functions)")
     p.add_argument("--check-call", action="append", default=[], metavar="FUNC=N",
                    help="fail when FUNC's mean instructions per call (callees included) "
                    "exceed N, or FUNC was not called (repeatable; needs the trace)")

@@ -371,10 +371,7 @@ LAW_CASES = (
 )  # the last: the star channel's range [V] (310 V link for rubino2020_spm)
 
 
-def law_run(sil, root, out, case, source: str, controller: dict | None = None,
-            sensors: dict | None = None, tag: str = "") -> LawRun:
-    """One case of LAW_CASES on `source`; controller / sensors: keys added
-    to the scenario's (the Kalman filter's tuning, the star noise)."""
+def law_run(sil, root, out, case, source: str) -> LawRun:
     law, machine, star, src, rpm, steps, fs = case
     sc = base(root, "dyno")
     sc["sensors"]["star_full_scale"] = fs
@@ -389,9 +386,7 @@ def law_run(sil, root, out, case, source: str, controller: dict | None = None,
     sc["references"] = {"torque": [{"type": "step", "t": 0.3, "value": steps[0]},
                                    {"type": "step", "t": 0.55, "value": steps[1] - steps[0]}]}
     sc["duration"] = 0.8
-    sc["controller"].update(controller or {})
-    sc["sensors"].update(sensors or {})
-    r = _run(sil, sc, out, f"law_{law}_{source}{tag}")
+    r = _run(sil, sc, out, f"law_{law}_{source}")
     lg = r.log
     tq = []
     for a in (0.4, 0.65):

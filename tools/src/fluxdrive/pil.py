@@ -796,8 +796,19 @@ def main(args) -> int:
     if args.markdown:
         update_markdown(Path(args.markdown), md)
         print(f"markdown: {args.markdown} (section '{SECTION[3:]}')")
-    return check_runs(runs, args.check_worst, getattr(args, "check_cycles", None),
-                      getattr(args, "check_mean", None), getattr(args, "check_call", None))
+    rc = check_runs(runs, args.check_worst, getattr(args, "check_cycles", None),
+                    getattr(args, "check_mean", None), getattr(args, "check_call", None))
+    lim = getattr(args, "check_mean_cordic", None)
+    if lim:
+        for r in runs:
+            tc = trig_on_cordic(r.counts, board) if board is not None else None
+            ok = tc is not None and tc < lim
+            got = "not measured (needs --board-elf and --functions)" if tc is None else \
+                f"{tc:.0f} instructions"
+            print(f"{'check' if ok else 'FAIL'}: {r.scenario}/{r.law}: mean with the trigonometry "
+                  f"on the CORDIC co-processor {got}, limit {lim}")
+            rc |= 0 if ok else 1
+    return rc
 
 
 def parse_call_limits(items: list[str] | None) -> dict[str, float]:

@@ -46,6 +46,9 @@ def test_table52_headline_and_no_fault(res):
         assert r.faults == [], (r.source, r.rpm)
         assert abs(r.mean) < 0.005 * r.rpm, (r.source, r.rpm, r.mean)
         assert r.sd > 0.0
+        # the angle the laws run on has no offset against the plant's (1
+        # degree: the issue-11 bound of the Full IVD)
+        assert abs(r.pos_mean) < 1.0, (r.source, r.rpm, r.pos_mean)
     for rpm, _ in P.table52_sd:
         dk, ik = res.sd("dfc+kf", rpm), res.sd("ivd+kf", rpm)
         assert ik.sd <= P.headline_ratio * dk.sd, (rpm, ik.sd, dk.sd)
@@ -62,31 +65,36 @@ def test_rls_converges_from_30_percent(res):
     slow, fast = res.rls
     for r in res.rls:
         assert r.faults == []
+        # started 30 % off (a up, b down), ended within the band, stayed there
+        assert r.a[0] / r.a_true == pytest.approx(1 + P.rls_off, abs=1e-3)
+        assert r.b[0] / r.b_true == pytest.approx(1 - P.rls_off, abs=1e-3)
         assert r.t_in < P.rls_time, (r.label, r.t_in)
+        assert abs(r.a_mean / r.a_true - 1) < P.rls_tol and abs(r.b_mean / r.b_true - 1) < P.rls_tol
         assert abs(r.speed_mean - P.rls_rpm) < 0.005 * P.rls_rpm
-        # started off: the estimates did move
-        assert abs(r.a[len(r.a) // 20] / r.a_true - 1) > 0.1 or r.t_in > 0.05
     assert fast.t_in < slow.t_in
     assert fast.b_sd > slow.b_sd
 
 
 def test_load_torque_estimate(res):
-    """Acceptance 3: the brake step of 0.1 N m: the estimate settles on the
-    plant's load within 10 % (mean) for DFC+KF and IVD+KF, IVD+KF the
-    smoother (Fig. 5.13); the 10 Hz load is tracked: gain and lag
-    reported, the gain within (0.2, 1.5) and the raised Q_33 tracks it
-    better."""
+    """Acceptance 3: the load estimate behaves as the filter's own
+    equations say it must (fabbri2022_kf.kf_load_response: the
+    steady-state Kalman filter of (4.46)-(4.49) with the run's Q and R): the
+    brake step settles on the plant's load (within 3 %) with the predicted
+    90 % rise time (within 20 %: the estimate is noisy), IVD+KF the
+    smoother (Fig. 5.13); the 10 Hz load comes through with the predicted
+    gain (within 5 %) and delay (within 1 ms), and the raised Q_33 tracks
+    it (gain within 5 % of 1)."""
     step_dfc, step_ivd, sine, sine_q = res.loads
     for r in (step_dfc, step_ivd):
         assert r.faults == []
-        assert abs(r.err_mean) < 0.1 * P.brake, r.label
-        assert r.lag < 0.2, r.label
+        assert abs(r.err_mean) < 0.03 * P.brake, r.label
+        assert abs(r.lag / r.pred_lag - 1.0) < 0.2, (r.label, r.lag, r.pred_lag)
     assert step_ivd.err_sd < step_dfc.err_sd
     for r in (sine, sine_q):
         assert r.faults == []
-        assert 0.2 < r.gain < 1.5, r.label
-        assert 0.0 < r.lag < 0.05, r.label
-    assert abs(sine_q.gain - 1.0) < abs(sine.gain - 1.0)
+        assert abs(r.gain / r.pred_gain - 1.0) < 0.05, (r.label, r.gain, r.pred_gain)
+        assert abs(r.lag - r.pred_lag) < 1e-3, (r.label, r.lag, r.pred_lag)
+    assert abs(sine_q.gain - 1.0) < 0.05
 
 
 def test_ebike_sensorless(res):
@@ -111,6 +119,7 @@ def test_laws_on_ivd_kf(res):
     for law, _, _ in kf.LAW_CASES_KF:
         st, enc = res.law(law, "ivd+kf", 36.0), res.law(law, "encoder", 36.0)
         assert st.faults == [] and enc.faults == [], law
+        assert res.law(law, "ivd", 36.0).faults == [], law
         for got, ld in zip(st.torque, st.load):
             assert abs(got / ld - 1.0) < 0.02, (law, got, ld)
         for d, de, b, be in zip(st.dip, enc.dip, st.recover, enc.recover):
@@ -118,6 +127,7 @@ def test_laws_on_ivd_kf(res):
             assert b < 2.0 * be, (law, b, be)
         assert res.law(law, "encoder", 24.0).faults == []
         assert "lost_control" in res.law(law, "ivd", 24.0).faults
+        assert "lost_control" in res.law(law, "ivd+kf", 24.0).faults
 
 
 @pytest.mark.parametrize("keys, field, why", [

@@ -76,12 +76,20 @@ def sigma_of(noise: float) -> float:
     return float(np.sqrt(2.0 * 2.0 / 3.0) * noise / V_DC)
 
 
-def speed_sc(root: Path, source: str, rpm: float, noise: float, r_scale: float = 1.0) -> dict:
+def speed_sc(root: Path, source: str, rpm: float, noise: float, r_scale: float = 1.0,
+             enc_align: bool = False) -> dict:
     sc = json.loads((root / "sil" / "scenarios" / "fabbri_speed.json").read_text())
     sc["name"] = f"{source} at {rpm:g} rpm, R x{r_scale:g}"
+    sc["description"] = (f"FOC speed control 0 -> {rpm:g} rpm of the Table 5.1 motor on the "
+                         f"{source} position, star noise {noise:.4g} V, R_k x{r_scale:g} "
+                         "(fluxdrive fabbri2022, chapter 4)")
     sc["sensors"]["star_noise"] = noise
     sc["controller"].update({"pos_source": source, "dfc_sigma": sigma_of(noise),
                              "kf_r_scale": r_scale})
+    if source == "encoder" and not enc_align:
+        # the plant's encoder offset is known: a light free rotor still
+        # swings when an alignment ends, and its offset would be taken there
+        sc["controller"]["align_time"] = 0.0
     sc["references"]["speed"]["terms"][0]["value"] = rpm
     return sc
 
@@ -94,20 +102,28 @@ class SpeedRun:
     faults: list
     mean: float  # speed reference - estimate [rpm]
     sd: float
-    pos_sd: float  # angle - plant's angle, std [deg electrical]
+    pos_mean: float  # angle - plant's angle, mean [deg electrical]
+    pos_sd: float  # its std
+    speed_align_end: float  # the rotor's speed when the alignment ends [rpm]
     t: np.ndarray
     speed_est: np.ndarray  # [rpm]
 
 
-def speed_run(sil, root, out, source, rpm, noise, r_scale=1.0, tag="") -> SpeedRun:
-    r = run(sil, speed_sc(root, source, rpm, noise, r_scale), out,
+def speed_run(sil, root, out, source, rpm, noise, r_scale=1.0, tag="",
+              enc_align: bool = False) -> SpeedRun:
+    r = run(sil, speed_sc(root, source, rpm, noise, r_scale, enc_align), out,
             f"kf_{source}_{rpm:g}_{r_scale:g}{tag}")
     lg = r.log
     m = lg["t"] >= SETTLED
     e = (lg["speed_ref"][m] - lg["speed_est"][m]) / RPM
     th = np.degrees(wrap(lg["theta_e_est"][m] - lg["theta_e"][m]))
+    # the state leaves the alignment (4) for the run (2): the rotor's speed then
+    st = lg["state"]
+    k = np.nonzero((st[:-1] == 4) & (st[1:] == 2))[0]
+    w_end = float(lg["speed"][k[0] + 1] / RPM) if len(k) else float("nan")
     return SpeedRun(source, rpm, r_scale, r.summary.get("faults_seen", []), float(np.mean(e)),
-                    float(np.std(e)), float(np.std(th)), lg["t"], lg["speed_est"] / RPM)
+                    float(np.std(e)), float(np.mean(th)), float(np.std(th)), w_end, lg["t"],
+                    lg["speed_est"] / RPM)
 
 
 def calibrate(sil, root, out) -> tuple[float, list]:
@@ -137,6 +153,8 @@ class RlsRun:
     t_in: float  # last instant either estimate is outside the 5 % band [s after the step]
     ls_a: float  # the signals' own a, b: least squares of the logged signals on the
     ls_b: float  # plant's true angle (the plain Clarke vector, from 1 s)
+    a_mean: float  # the estimates' means from 1 s
+    b_mean: float
     a_sd: float  # after settling, relative
     b_sd: float
     speed_mean: float
@@ -179,6 +197,7 @@ def rls_run(sil, root, out, noise: float, label: str, p_min: float) -> RlsRun:
     sp = lg["speed"][m] / RPM
     ls_a, ls_b = signals_ab(lg, m)
     return RlsRun(label, p_min, r.summary.get("faults_seen", []), t, a, b, a0, b0, t_in, ls_a, ls_b,
+                  float(np.mean(a[m])), float(np.mean(b[m])),
                   float(np.std(a[m]) / a0), float(np.std(b[m]) / abs(b0)), float(np.mean(sp)),
                   float(np.std(sp)))
 
@@ -193,8 +212,51 @@ class LoadRun:
     est: np.ndarray
     err_mean: float  # estimate - load, settled [N m]
     err_sd: float
-    lag: float  # step: 90 % rise time [s]; sine: delay at 10 Hz [s]
-    gain: float  # sine: amplitude ratio (1 for the step)
+    lag: float  # step: 90 % rise time of the 5 ms mean [s]; sine: delay at 10 Hz [s]
+    gain: float  # sine: amplitude ratio; step: settled estimate / brake
+    pred_lag: float  # the same from the filter's own model (kf_load_response)
+    pred_gain: float
+
+
+# The filter's model of the Table 5.1 motor (the preset: sil/runner/presets.c)
+KF_MODEL = {"ts": 6.25e-5, "pole_pairs": 8.0, "inertia": 2e-4, "friction": 1e-5, "a": 0.05}
+
+
+def kf_load_response(noise: float, q_load: float, kind: str,
+                     q_omega: float = 1.0, r_scale: float = 1.0) -> tuple[float, float]:
+    """What the steady-state Kalman filter (4.46)-(4.49) of the IVD sources
+    makes of a load it does not know, from its own equations and the
+    run's tuning (R_k = r_scale sigma_v^2 / (4 a^2), (4.30)): the estimation
+    error e+(k+1) = (I - K H) F e+(k) + (I - K H) e_3 dT_l(k), so
+    T_l_hat / T_l = 1 - (z - 1) [(zI - A)^-1 B]_3. kind "sine": (delay [s],
+    gain) at PAPER_KF.sine_hz; "step": (90 % rise time [s], 1)."""
+    m = KF_MODEL
+    t = m["ts"]
+    f = np.array([[1.0 - t * m["friction"] / m["inertia"], 0.0, -t * m["pole_pairs"] / m["inertia"]],
+                  [t, 1.0, 0.0], [0.0, 0.0, 1.0]])
+    h = np.array([[0.0, 1.0, 0.0]])
+    q = np.diag([q_omega, 0.0, q_load])
+    r = r_scale * sigma_of(noise) ** 2 / (4.0 * m["a"] ** 2)
+    p = np.diag([900.0, 0.09, 0.09])
+    for _ in range(200000):  # the Riccati recursion to its fixed point
+        pm = f @ p @ f.T + q
+        k = pm @ h.T / (h @ pm @ h.T + r)
+        p_new = (np.eye(3) - k @ h) @ pm
+        if np.max(np.abs(p_new - p)) <= 1e-12 * np.max(np.abs(p)):
+            break
+        p = p_new
+    a = (np.eye(3) - k @ h) @ f
+    b = (np.eye(3) - k @ h) @ np.array([0.0, 0.0, 1.0])
+    if kind == "sine":
+        z = np.exp(1j * 2 * np.pi * PAPER_KF.sine_hz * t)
+        g = 1.0 - (z - 1.0) * np.linalg.solve(z * np.eye(3) - a, b)[2]
+        return float(-np.angle(g) / (2 * np.pi * PAPER_KF.sine_hz)), float(abs(g))
+    e = b.copy()  # the step: dT_l = 1 at k = 0
+    for n in range(1, 200000):
+        if 1.0 - e[2] >= 0.9:
+            return n * t, 1.0
+        e = a @ e
+    return float("inf"), 1.0
 
 
 LOAD_T = 0.8  # s: the load is applied at 500 rpm
@@ -220,7 +282,10 @@ def load_run(sil, root, out, noise: float, source: str, kind: str, q_load: float
     m = t >= LOAD_T + 0.2
     err = est[m] - ld[m]
     if kind == "step":
-        after = np.nonzero((t >= LOAD_T) & (est >= 0.9 * PAPER_KF.brake))[0]
+        # the 90 % rise of the estimate's centred 5 ms mean (the raw one is noisy)
+        nw = max(1, int(round(0.005 / (t[1] - t[0]))))
+        sm = np.convolve(est, np.ones(nw) / nw, mode="same")
+        after = np.nonzero((t >= LOAD_T) & (sm >= 0.9 * PAPER_KF.brake))[0]
         lag = float(t[after[0]] - LOAD_T) if len(after) else float("inf")
         gain = float(np.mean(est[m]) / PAPER_KF.brake)
     else:
@@ -232,8 +297,10 @@ def load_run(sil, root, out, noise: float, source: str, kind: str, q_load: float
         gain = float(abs(got) / abs(ref))
         lag = float(-np.angle(got / ref) / w)
     q = f", Q_33 {q_load:g}" if q_load else ""
+    ql = q_load or sc["controller"].get("kf_q_load", 1e-6)
+    p_lag, p_gain = kf_load_response(noise, ql, kind)
     return LoadRun(f"{kind}, {source}{q}", source, r.summary.get("faults_seen", []), t, ld, est,
-                   float(np.mean(err)), float(np.std(err)), lag, gain)
+                   float(np.mean(err)), float(np.std(err)), lag, gain, p_lag, p_gain)
 
 
 @dataclass
@@ -290,8 +357,9 @@ class LawStep:
     faults: list
     torque: tuple  # period-average plant torque, settled after each step [N m]
     load: tuple  # plant load + friction at the same time [N m]
-    dip: tuple  # largest speed drop after each step [rpm]
-    recover: tuple  # time back within 0.5 % of the reference [s]
+    dip: tuple  # largest speed drop after each step [rpm] (NaN: tripped before or during)
+    recover: tuple  # time back within 0.5 % of the reference [s] (NaN: likewise)
+    trip: float  # first instant with a fault [s] (NaN: none)
 
 
 def law_step_run(sil, root, out, noise: float, case: tuple, source: str, v_dc: float) -> LawStep:
@@ -314,6 +382,8 @@ def law_step_run(sil, root, out, noise: float, case: tuple, source: str, v_dc: f
     t, sp = lg["t"], lg["speed"] / RPM
     tq, ld, dip, rec = [], [], [], []
     ends = LAW_STEPS[1:] + (sc["duration"],)
+    f = np.nonzero(lg["faults"] != 0)[0]
+    trip = float(t[f[0]]) if len(f) else float("nan")
     for a, e in zip(LAW_STEPS, ends):
         m = (t >= a + 0.15) & (t < e)
         tq.append(float(np.mean(lg["torque_avg"][m])))
@@ -323,8 +393,10 @@ def law_step_run(sil, root, out, noise: float, case: tuple, source: str, v_dc: f
         dip.append(float(500.0 - np.min(sp[w])))
         out_ = np.nonzero(w & (np.abs(sp - 500.0) > 2.5))[0]
         rec.append(float(t[out_[-1]] - a) if len(out_) else 0.0)
+        if trip < e:  # not a response: the drive tripped before the window ended
+            dip[-1], rec[-1] = float("nan"), float("nan")
     return LawStep(law, machine, source, v_dc, r.summary.get("faults_seen", []), tuple(tq),
-                   tuple(ld), tuple(dip), tuple(rec))
+                   tuple(ld), tuple(dip), tuple(rec), trip)
 
 
 class ResultsKF:
@@ -348,6 +420,12 @@ class ResultsKF:
                     rows.append(speed_run(self.sil, self.root, self.out, src, rpm, self.noise, rs))
         return rows
 
+    @functools.cached_property
+    def enc_aligned(self) -> SpeedRun:
+        """The encoder at 100 rpm with the scenario's 0.1 s alignment."""
+        return speed_run(self.sil, self.root, self.out, "encoder", 100.0, self.noise,
+                         tag="_aligned", enc_align=True)
+
     def sd(self, src: str, rpm: float, rs: float = 1.0) -> SpeedRun:
         return next(r for r in self.table if r.source == src and r.rpm == rpm and r.r_scale == rs)
 
@@ -369,12 +447,12 @@ class ResultsKF:
 
     @functools.cached_property
     def laws(self) -> list:
-        """LawStep per case: IVD+KF and encoder at 36 V; IVD+KF, IVD and the
-        encoder (no window) at 24 V."""
+        """LawStep per case and link (36 V, 24 V): IVD+KF, IVD (PLL) and the
+        encoder (no window)."""
         res = []
         for c in LAW_CASES_KF:
-            for v, srcs in ((LAW_V[0], ("ivd+kf", "encoder")),
-                            (LAW_V[1], ("ivd+kf", "ivd", "encoder"))):
+            for v in LAW_V:
+                srcs = ("ivd+kf", "ivd", "encoder")
                 res += [law_step_run(self.sil, self.root, self.out, self.noise, c, s, v)
                         for s in srcs]
         return res
@@ -400,37 +478,49 @@ def report(res: ResultsKF) -> str:
     L += ["", f"Ratio 1/2 at **{n:.4f} V** (sigma_v = {sigma_of(n):.3g} of Gamma / v_dc), "
           "used below.", "",
           "### Table 5.2 analogue: speed error (reference - estimate) in speed control", "",
-          "| speed | R_k | source | faults | mean [rpm] | sD [rpm] | thesis sD | position std |",
+          "| speed | R_k | source | faults | mean [rpm] | sD [rpm] | thesis sD | "
+          "position error, mean and std |",
           "|---|---|---|---|---|---|---|---|"]
     for r in res.table:
         rk = f"{r.r_scale:g} sigma^2" if r.source in KALMAN else "-"
         L.append(f"| {r.rpm:g} rpm | {rk} | {r.source} | {', '.join(r.faults) or 'none'} | "
                  f"{r.mean:+.3f} | {r.sd:.2f} | {_paper(r.source, r.rpm, r.r_scale)} | "
-                 f"{r.pos_sd:.3f} deg |")
+                 f"{r.pos_mean:+.3f}, {r.pos_sd:.3f} deg |")
+    ea = res.enc_aligned
+    L += ["", "The encoder rows start without an alignment (the plant's encoder offset is "
+          f"known). With the scenario's 0.1 s alignment instead, at 100 rpm: position error "
+          f"{ea.pos_mean:+.1f} deg mean, speed error sD {ea.sd:.2f} rpm, faults "
+          f"{', '.join(ea.faults) or 'none'}; the rotor turns at {ea.speed_align_end:+.1f} rpm "
+          "when the alignment ends and the offset is taken (the light free rotor swings about "
+          "the axis, nearly undamped)."]
     L += ["", "IVD+KF / DFC+KF sD (the issue: at most 1/2): " + ", ".join(
         f"{rpm:g} rpm R {rs:g} sigma^2: {res.sd('ivd+kf', rpm, rs).sd / res.sd('dfc+kf', rpm, rs).sd:.2f}"
         for rpm, _ in PAPER_KF.table52_sd for rs in PAPER_KF.r_scales), "",
           "### RLS of a, b (Figs. 5.11-5.12): 500 rpm, started 30 % off (a +30 %, b -30 %)", "",
           "| bandwidth | rls_p_min | faults | within 5 % after the step | a sD | b sD | "
-          "a, b at 1.6 s (3.7: 0.05, -0.00466) | the signals' own a, b | speed |",
+          "a, b: mean from 1 s (3.7: 0.05, -0.00466) | the signals' own a, b | speed |",
           "|---|---|---|---|---|---|---|---|---|"]
     for r in res.rls:
         L.append(f"| {r.label} | {r.p_min:g} | {', '.join(r.faults) or 'none'} | "
                  f"{r.t_in:.3f} s | {100 * r.a_sd:.2f} % | {100 * r.b_sd:.2f} % | "
-                 f"{r.a[-1]:.5f}, {r.b[-1]:.6f} | {r.ls_a:.5f}, {r.ls_b:.6f} | "
+                 f"{r.a_mean:.5f}, {r.b_mean:.6f} | {r.ls_a:.5f}, {r.ls_b:.6f} | "
                  f"{r.speed_mean:.2f} +- {r.speed_sd:.2f} rpm |")
     L += ["", "The signals' own a, b: a least-squares fit of the logged signals (plain "
           "Clarke vector) on the plant's true angle, from 1 s."]
     L += ["", "### Load torque (Figs. 4.1, 5.13): 500 rpm, load from 0.8 s", "",
-          "| load | source | faults | estimate - load, mean | sD | lag | gain |",
-          "|---|---|---|---|---|---|---|"]
+          "| load | source | faults | estimate - load, mean | sD | lag | gain | the filter's "
+          "model: lag, gain |",
+          "|---|---|---|---|---|---|---|---|"]
     for r in res.loads:
-        lag = f"{1e3 * r.lag:.1f} ms" + (" (90 % rise)" if r.label.startswith("step") else
+        lag = f"{1e3 * r.lag:.1f} ms" + (" (90 % rise, 5 ms mean)" if r.label.startswith("step") else
                                           f" (at {PAPER_KF.sine_hz:g} Hz)")
         if r.label.startswith("sine"):
             lag += f", amplitude {PAPER_KF.sine_amp:g} N m"
-        L.append(f"| {r.label.split(',')[0]}{r.label[len(r.label.split(',')[0]) + len(r.source) + 2:]} | {r.source} | {', '.join(r.faults) or 'none'} | "
-                 f"{r.err_mean:+.4f} N m | {r.err_sd:.4f} N m | {lag} | {r.gain:.3f} |")
+        kind = r.label.split(",")[0]
+        extra = r.label[len(kind) + len(r.source) + 2:]
+        L.append(f"| {kind}{extra} | {r.source} | {', '.join(r.faults) or 'none'} | "
+                 f"{r.err_mean:+.4f} N m | {r.err_sd:.4f} N m | {lag} | {r.gain:.3f} | "
+                 f"{1e3 * r.pred_lag:.1f} ms, {r.pred_gain:.3f} |")
     e = res.ebike
     L += ["", "### E-bike motor (Table 5.4, p = -0.1825), IVD (4 iterations) + KF, speed "
           "control", "", "| speed | faults | speed (true) | angle - plant |", "|---|---|---|---|",
@@ -439,15 +529,16 @@ def report(res: ResultsKF) -> str:
           "", "### The other laws on the IVD+KF position: speed control at 500 rpm, brake steps",
           "", f"Brake steps of {LAW_BRAKE:g} N m at " + " and ".join(f"{t:g} s" for t in LAW_STEPS)
           + "; torque = period-average plant torque once settled (load + friction beside it); "
-          "dip = largest speed drop after the step; back = time until within 0.5 % of 500 rpm.",
-          "", "| law | machine | link | source | faults | torque (load) [N m] | dip [rpm] | back [s] |",
-          "|---|---|---|---|---|---|---|---|"]
+          "dip = largest speed drop after the step; back = time until within 0.5 % of 500 rpm "
+          "(- when the drive tripped first).",
+          "", "| law | machine | link | source | faults (first at) | torque (load) [N m] | dip [rpm] | "
+          "back [s] |", "|---|---|---|---|---|---|---|---|"]
     for r in res.laws:
         tq = ", ".join(f"{a:.4f} ({b:.4f})" for a, b in zip(r.torque, r.load))
-        L.append(f"| {r.law} | {r.machine} | {r.v_dc:g} V | {r.source} | "
-                 f"{', '.join(r.faults) or 'none'} | {tq} | "
-                 + ", ".join(f"{d:.1f}" for d in r.dip) + " | "
-                 + ", ".join(f"{x:.3f}" for x in r.recover) + " |")
+        fl = f"{', '.join(r.faults)} ({r.trip:.3f} s)" if r.faults else "none"
+        L.append(f"| {r.law} | {r.machine} | {r.v_dc:g} V | {r.source} | {fl} | {tq} | "
+                 + ", ".join("-" if np.isnan(d) else f"{d:.1f}" for d in r.dip) + " | "
+                 + ", ".join("-" if np.isnan(x) else f"{x:.3f}" for x in r.recover) + " |")
     return "\n".join(L)
 
 

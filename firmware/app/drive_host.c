@@ -186,6 +186,14 @@ int drive_request_config(drive_t *drv, const drive_config_t *cfg, drive_config_e
     return -1;
   }
   drive_machine_copy(&drv->host.machine, &drv->host.map, &m, &map);
+  /* first the command block within the new limits (a LIVE speed_max or
+   * torque_max lowered while running): the ISR takes it before or with the
+   * set, never an old reference beyond the limits in force; the ISR's
+   * command block stays the published one */
+  drive_cmd_t *c = cmd_begin(drv);
+  c->torque = command_clamp(c->torque, -cfg->torque_max, cfg->torque_max);
+  c->speed = command_clamp(c->speed, -cfg->speed_max, cfg->speed_max);
+  cmd_end(drv);
   drv->creq.seq++;
   DRIVE_BARRIER();
   drv->creq.cfg = *cfg;

@@ -51,6 +51,71 @@ static void join(char *out, size_t n, const char *path, const char *key) {
   }
 }
 
+/* A key given twice in one object (JSON leaves it open; cJSON keeps both and
+ * the lookups see the first): refused, with its path, anywhere in the
+ * tree. Depth is bounded by cJSON's nesting limit. */
+static int check_duplicates(ctx_t *c, const cJSON *node, const char *path) {
+  for (const cJSON *it = node->child; it != NULL; it = it->next) {
+    char p[160];
+    if (cJSON_IsObject(node)) {
+      for (const cJSON *jt = it->next; jt != NULL; jt = jt->next) {
+        if (strcmp(it->string, jt->string) == 0) {
+          join(p, sizeof p, path, it->string);
+          return fail(c, p, "given twice (a key may appear once)");
+        }
+      }
+      join(p, sizeof p, path, it->string);
+    } else {
+      int k = 0;
+      for (const cJSON *jt = node->child; jt != it; jt = jt->next) {
+        ++k;
+      }
+      snprintf(p, sizeof p, "%s[%d]", path, k);
+    }
+    if ((cJSON_IsObject(it) || cJSON_IsArray(it)) && check_duplicates(c, it, p) != 0) {
+      return -1;
+    }
+  }
+  return 0;
+}
+
+/* s made valid UTF-8 in place: a sequence cut by a truncation at the end is
+ * dropped, any other invalid byte becomes '?' (the summary is JSON, and
+ * JSON is UTF-8). */
+static void utf8_clean(char *s) {
+  size_t i = 0;
+  const size_t n = strlen(s);
+  while (i < n) {
+    const unsigned char b = (unsigned char)s[i];
+    size_t len = b < 0x80u                    ? 1u
+                 : (b >= 0xC2u && b <= 0xDFu) ? 2u
+                 : (b >= 0xE0u && b <= 0xEFu) ? 3u
+                 : (b >= 0xF0u && b <= 0xF4u) ? 4u
+                                              : 0u;
+    /* the second byte's range: no overlong forms, no surrogates, nothing
+     * beyond U+10FFFF (RFC 3629) */
+    const unsigned char lo = b == 0xE0u ? 0xA0u : (b == 0xF0u ? 0x90u : 0x80u);
+    const unsigned char hi = b == 0xEDu ? 0x9Fu : (b == 0xF4u ? 0x8Fu : 0xBFu);
+    size_t k = 1u;
+    while (len > 1u && k < len && i + k < n) {
+      const unsigned char x = (unsigned char)s[i + k];
+      if (k == 1u ? (x < lo || x > hi) : (x & 0xC0u) != 0x80u) {
+        break;
+      }
+      ++k;
+    }
+    if (len > 1u && k < len && i + k == n) {
+      s[i] = '\0'; /* cut at the end: drop the partial sequence */
+      return;
+    }
+    if (len == 0u || k < len) {
+      s[i] = '?';
+      len = 1u;
+    }
+    i += len;
+  }
+}
+
 /* Rejects keys of obj that are not in the NULL-terminated list. */
 static int check_keys(ctx_t *c, const cJSON *obj, const char *path, const char *const *allowed) {
   if (!cJSON_IsObject(obj)) {
@@ -682,27 +747,35 @@ static void scenario_defaults(scenario_t *sc) {
 int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *err, size_t errlen) {
   ctx_t c = {err, errlen, origin, 0};
   scenario_defaults(sc);
-  cJSON *root = cJSON_Parse(json);
+  /* the whole text is the one object: nothing but white space after it */
+  cJSON *root = cJSON_ParseWithOpts(json, NULL, 1);
   if (root == NULL) {
     const char *at = cJSON_GetErrorPtr();
     int line = 1;
     for (const char *p = json; at != NULL && p < at && *p; ++p) {
       line += *p == '\n';
     }
-    snprintf(err, errlen, "%s: line %d: not valid JSON", origin, line);
+    snprintf(err, errlen, "%s: line %d: not valid JSON (or text after the top-level object)",
+             origin, line);
     return -1;
   }
   static const char *const keys[] = {
       "name",    "description", "duration",   "machine", "inverter", "dc_link", "mechanics",
       "sensors", "controller",  "references", "inject",  "log",      "board",   NULL};
   int r = check_keys(&c, root, "", keys);
+  r = r ? r : check_duplicates(&c, root, "");
   const cJSON *name = cJSON_GetObjectItemCaseSensitive(root, "name");
   if (r == 0 && name != NULL) {
     if (!cJSON_IsString(name)) {
       r = fail(&c, "name", "must be a string");
     } else {
       snprintf(sc->name, sizeof sc->name, "%s", name->valuestring);
+      utf8_clean(sc->name);
     }
+  }
+  const cJSON *desc = cJSON_GetObjectItemCaseSensitive(root, "description");
+  if (r == 0 && desc != NULL && !cJSON_IsString(desc)) {
+    r = fail(&c, "description", "must be a string");
   }
   if (r == 0 && !cJSON_GetObjectItemCaseSensitive(root, "duration")) {
     r = fail(&c, "duration", "required (simulated time in seconds)");

@@ -264,6 +264,37 @@ static void commands_are_clamped_and_posted(void **state) {
   assert_non_null(drive_cmd_set_mode(&drv, DRIVE_MODE_CURRENT));
 }
 
+/* Issue 13, defect 8: a LIVE limit written while running re-clamps the
+ * references in force at once (and a command block taken later cannot
+ * bring an old reference back); the speed reference then follows at
+ * accel_max. */
+static void live_limits_reclamp_the_references(void **state) {
+  (void)state;
+  start_running();
+  const drive_param_t *tmax = drive_params_by_name("torque_max");
+  const drive_param_t *wmax = drive_params_by_name("speed_max");
+  drive_cmd_torque(&drv, 15.0f);
+  run_isrs(2);
+  assert_float_equal(drv.tm.torque_ref, 15.0f, 0.0f);
+  assert_int_equal(drive_params_set(&drv, tmax->id, 5.0f, NULL), DRIVE_PARAM_OK);
+  drive_isr(&drv);
+  assert_float_equal(drv.cmd.torque, 5.0f, 0.0f);
+  assert_float_equal(drv.tm.torque_ref, 5.0f, 0.0f);
+  drive_cmd_flux(&drv, 0.0f); /* another command: the block is taken again */
+  run_isrs(2);
+  assert_float_equal(drv.cmd.torque, 5.0f, 0.0f);
+  /* speed: 100 rad/s, then the limit to 50 */
+  assert_null(drive_cmd_set_mode(&drv, DRIVE_MODE_SPEED));
+  drive_cmd_speed(&drv, 100.0f);
+  run_isrs(16 * 1000); /* 1 s: the ramp (accel_max 125.7 rad/s^2) reaches 100 */
+  assert_float_equal(drv.tm.speed_ref, 100.0f, 1e-3f);
+  assert_int_equal(drive_params_set(&drv, wmax->id, 50.0f, NULL), DRIVE_PARAM_OK);
+  drive_isr(&drv);
+  assert_float_equal(drv.cmd.speed, 50.0f, 0.0f);
+  run_isrs(16 * 500); /* 0.5 s > 50 / 125.7 */
+  assert_float_equal(drv.tm.speed_ref, 50.0f, 1e-3f);
+}
+
 static void law_change_waits_for_gates_off(void **state) {
   (void)state;
   start_running();
@@ -427,6 +458,7 @@ int main(void) {
                                      cmocka_unit_test(bad_samples_fault),
                                      cmocka_unit_test(invalid_position_faults),
                                      cmocka_unit_test(commands_are_clamped_and_posted),
+                                     cmocka_unit_test(live_limits_reclamp_the_references),
                                      cmocka_unit_test(law_change_waits_for_gates_off),
                                      cmocka_unit_test(syr_machine_runs_foc_only),
                                      cmocka_unit_test(parameter_requests_are_applied_by_the_isr),

@@ -79,6 +79,17 @@ static const bad_case_t cases[] = {
     {"{\"duration\": 1, \"inverter\": {\"dead_time\": 5e-5}}",
      "inverter.dead_time: invalid plant parameter"},
     {"{\"duration\": 1, \"log\": {\"decimation\": 0}}", "log.decimation: must be in"},
+    /* issue 13, defect 10: duplicate keys at any depth, text after the
+     * object, a description that is not a string */
+    {"{\"duration\": 1, \"duration\": 2}", "duration: given twice"},
+    {"{\"duration\": 1, \"machine\": {\"rs\": 1, \"ld\": 0.01, \"rs\": -5}}",
+     "machine.rs: given twice"},
+    {"{\"duration\": 1, \"mechanics\": {\"load_torque\": [{\"type\": \"step\", \"t\": 0, "
+     "\"value\": 1, \"t\": 2}]}}",
+     "mechanics.load_torque[0].t: given twice"},
+    {"{\"duration\": 1} trailing", "line 1: not valid JSON (or text after the top-level object)"},
+    {"{\"duration\": 1}{\"duration\": 2}", "not valid JSON"},
+    {"{\"duration\": 1, \"description\": 5}", "description: must be a string"},
 };
 
 static void bad_scenarios_name_the_field(void **state) {
@@ -114,6 +125,59 @@ static void truncated_inputs_never_crash(void **state) {
   }
 }
 
+/* 1 if s is valid UTF-8 (RFC 3629). */
+static int utf8_valid(const char *s) {
+  const unsigned char *p = (const unsigned char *)s;
+  while (*p) {
+    const unsigned b = *p;
+    size_t len = b < 0x80u                    ? 1u
+                 : (b >= 0xC2u && b <= 0xDFu) ? 2u
+                 : (b >= 0xE0u && b <= 0xEFu) ? 3u
+                 : (b >= 0xF0u && b <= 0xF4u) ? 4u
+                                              : 0u;
+    if (len == 0u) {
+      return 0;
+    }
+    for (size_t k = 1; k < len; ++k) {
+      if ((p[k] & 0xC0u) != 0x80u) {
+        return 0;
+      }
+    }
+    if ((b == 0xE0u && p[1] < 0xA0u) || (b == 0xEDu && p[1] > 0x9Fu) ||
+        (b == 0xF0u && p[1] < 0x90u) || (b == 0xF4u && p[1] > 0x8Fu)) {
+      return 0;
+    }
+    p += len;
+  }
+  return 1;
+}
+
+/* Issue 13, defect 6: a name cut inside a multi-byte character, or with
+ * bytes that are not UTF-8, is kept as valid UTF-8 (the summary is JSON). */
+static void scenario_name_stays_utf8(void **state) {
+  (void)state;
+  static scenario_t sc;
+  char err[512];
+  char js[512];
+  for (size_t pad = 90; pad < 100; ++pad) { /* the 2- and 3-byte characters across the cut */
+    char name[200];
+    memset(name, 'x', pad);
+    snprintf(name + pad, sizeof name - pad, "%s", "\xc3\xa9\xe2\x82\xac\xf0\x9f\x98\x80");
+    snprintf(js, sizeof js, "{\"duration\": 0.01, \"name\": \"%s\"}", name);
+    assert_int_equal(scenario_parse(js, "n.json", &sc, err, sizeof err), 0);
+    assert_true(utf8_valid(sc.name));
+    assert_true(strlen(sc.name) >= sizeof sc.name - 4u); /* only the partial character dropped */
+  }
+  /* invalid bytes (a lone continuation, an overlong form) become '?' */
+  snprintf(js, sizeof js,
+           "{\"duration\": 0.01, \"name\": \"a\x80"
+           "b\xc0\xaf"
+           "c\"}");
+  assert_int_equal(scenario_parse(js, "n.json", &sc, err, sizeof err), 0);
+  assert_true(utf8_valid(sc.name));
+  assert_string_equal(sc.name, "a?b??c");
+}
+
 static void good_scenario_sets_fields(void **state) {
   (void)state;
   static scenario_t sc;
@@ -133,6 +197,7 @@ static void good_scenario_sets_fields(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {cmocka_unit_test(bad_scenarios_name_the_field),
                                      cmocka_unit_test(truncated_inputs_never_crash),
-                                     cmocka_unit_test(good_scenario_sets_fields)};
+                                     cmocka_unit_test(good_scenario_sets_fields),
+                                     cmocka_unit_test(scenario_name_stays_utf8)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

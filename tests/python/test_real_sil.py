@@ -28,3 +28,25 @@ def test_real_sil_default_scenario(tmp_path, capsys):
     assert np.all(np.diff(log["t"]) > 0)
     assert (out / "summary.json").is_file()
     assert_png(out / "plot.png")
+
+
+@pytest.mark.real_sil
+def test_multibyte_name_cut_by_the_limit_gives_a_readable_summary(tmp_path, capsys):
+    """Issue 13, defect 6: a scenario name longer than the runner keeps,
+    cut inside a multi-byte character, still gives a summary the tool reads
+    (it is JSON: UTF-8)."""
+    if not REAL_SIL.is_file():
+        pytest.skip("real runner not built")
+    import json
+    sc = json.loads(DEFAULT_SCENARIO.read_text())
+    sc["duration"] = 0.02
+    for pad in (94, 95):  # the cut inside the 2-byte and the 3-byte character
+        sc["name"] = "x" * pad + "\u00e9\u20ac\U0001f600"
+        path = tmp_path / f"name{pad}.json"
+        path.write_text(json.dumps(sc, ensure_ascii=False), encoding="utf-8")
+        out = tmp_path / f"out{pad}"
+        rc = main(["run", str(path), "--sil", str(REAL_SIL), "--out", str(out), "--no-plot"])
+        captured = capsys.readouterr()
+        assert rc == 0, captured.err
+        summary = json.loads((out / "summary.json").read_bytes().decode("utf-8"))
+        assert summary["scenario"].startswith("x" * pad)

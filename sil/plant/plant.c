@@ -17,6 +17,17 @@
 #include <math.h>
 #include <string.h>
 
+int plant_substeps_needed(const plant_params_t *p) {
+  const double lmin = p->machine.map != NULL
+                          ? plant_fluxmap_l_min(p->machine.map)
+                          : (p->machine.ld < p->machine.lq ? p->machine.ld : p->machine.lq);
+  const double n = ceil(p->ts * p->machine.rs / (PLANT_HR_MAX * lmin));
+  if (!(n < 1e6)) { /* NaN, inf: beyond any limit */
+    return 1000000;
+  }
+  return n < 1.0 ? 1 : (int)n;
+}
+
 int plant_check(const plant_params_t *p, const char **field) {
   const char *dummy = NULL;
   const char **f = field != NULL ? field : &dummy;
@@ -27,6 +38,10 @@ int plant_check(const plant_params_t *p, const char **field) {
   if (plant_machine_check(&p->machine, f) != 0 ||
       plant_inverter_check(&p->inverter, p->ts, f) != 0 || plant_dclink_check(&p->dclink, f) != 0 ||
       plant_mech_check(&p->mech, f) != 0 || plant_sensors_check(&p->sensors, f) != 0) {
+    return -1;
+  }
+  if (p->inverter.substeps < plant_substeps_needed(p)) { /* unstable: NaN within periods */
+    *f = "inverter.substeps";
     return -1;
   }
   return 0;

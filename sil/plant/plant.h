@@ -215,6 +215,14 @@ typedef struct {
 /* Validates the parameters; on error returns a negative number and sets
  * *field to the name of the offending parameter (static string). */
 int plant_check(const plant_params_t *p, const char **field);
+/* The fewest integration steps per period that keep the explicit RK4
+ * stable and monotone on the machine's fastest electrical mode: h R_s /
+ * L_min <= PLANT_HR_MAX (L_min the smallest incremental inductance, the
+ * flux map's for a map machine). plant_check refuses fewer (field
+ * "inverter.substeps"). Needs a valid machine and ts. */
+#define PLANT_HR_MAX 0.5
+#define PLANT_SUBSTEPS_MAX 64
+int plant_substeps_needed(const plant_params_t *p);
 /* Initialises (calls plant_check first). Returns 0 or the error. */
 int plant_init(plant_t *pl, const plant_params_t *p, const char **field);
 /* Advances one PWM period with the given duties (clamped to [0, 1]),

@@ -27,6 +27,7 @@ typedef struct {
   size_t errlen;
   const char *origin;
   int failed;
+  int ls_given; /* machine.ls set both inductances (for the error's key) */
 } ctx_t;
 
 static int fail(ctx_t *c, const char *path, const char *fmt, ...) {
@@ -369,6 +370,7 @@ static int parse_machine(ctx_t *c, const cJSON *m, scenario_t *sc) {
       return fail(c, "machine.ls", "give either ls (SPM) or ld and lq, not both");
     }
     pm->ld = pm->lq = ls;
+    c->ls_given = 1;
   }
   /* the star point's inductance matrix (3.3), plant.h */
   const int star = cJSON_GetObjectItemCaseSensitive(m, "star_m0") != NULL ||
@@ -437,7 +439,7 @@ static int parse_inverter(ctx_t *c, const cJSON *o, scenario_t *sc) {
   const drive_param_t *pts = drive_params_by_name("ts");
   if (get_enum(c, o, "inverter", "model", models, &model) ||
       get_param_num(c, o, "inverter", "dead_time", "dead_time", &sc->plant.inverter.dead_time) ||
-      get_int(c, o, "inverter", "substeps", 1, 64, &sc->plant.inverter.substeps) ||
+      get_int(c, o, "inverter", "substeps", 1, PLANT_SUBSTEPS_MAX, &sc->plant.inverter.substeps) ||
       get_num(c, o, "inverter", "pwm_frequency", 1.0 / (double)pts->max, 1.0 / (double)pts->min,
               &f) ||
       get_num(c, o, "inverter", "hw_trip", 0.0, 1e5, &sc->hw_trip)) {
@@ -730,7 +732,8 @@ static void scenario_defaults(scenario_t *sc) {
   drive_config_default(&sc->drive);
   preset_apply(preset_find("rubino2020_spm"), &sc->plant, &sc->drive);
   sc->plant.ts = 1.0 / 16000.0;
-  sc->plant.inverter = (plant_inverter_t){PLANT_INV_AVERAGE, 1e-6, 1};
+  /* substeps 0: chosen from the machine after parsing (resolve_substeps) */
+  sc->plant.inverter = (plant_inverter_t){PLANT_INV_AVERAGE, 1e-6, 0};
   sc->plant.dclink.kind = PLANT_DC_IDEAL;
   sc->plant.dclink.r = 0.1;
   sc->plant.dclink.c = 470e-6;
@@ -744,8 +747,41 @@ static void scenario_defaults(scenario_t *sc) {
   sc->log_decimation = 16;
 }
 
+/* The plant's integration steps per period: the fewest that keep it stable
+ * on this machine (plant_substeps_needed: h R / L_min <= 0.5) unless the
+ * scenario gives them; too few given, or more needed than the plant
+ * allows, is an error naming the key to change. */
+static int resolve_substeps(ctx_t *c, scenario_t *sc) {
+  plant_params_t *p = &sc->plant;
+  const int need = plant_substeps_needed(p);
+  const double lmin = p->machine.map != NULL
+                          ? plant_fluxmap_l_min(p->machine.map)
+                          : (p->machine.ld < p->machine.lq ? p->machine.ld : p->machine.lq);
+  if (p->inverter.substeps == 0) {
+    if (need > PLANT_SUBSTEPS_MAX) {
+      const char *key = p->machine.map != NULL           ? "machine.map"
+                        : c->ls_given                    ? "machine.ls"
+                        : p->machine.ld <= p->machine.lq ? "machine.ld"
+                                                         : "machine.lq";
+      return fail(c, key,
+                  "the plant cannot integrate this machine at this PWM period: its electrical "
+                  "time constant L/R_s (%.3g s with L = %.3g H) needs %d integration steps per "
+                  "period, at most %d",
+                  lmin / p->machine.rs, lmin, need, PLANT_SUBSTEPS_MAX);
+    }
+    p->inverter.substeps = need;
+  } else if (p->inverter.substeps < need) {
+    return fail(c, "inverter.substeps",
+                "%d steps per period are unstable for this machine (h R_s / L_min = %.2f > %g): "
+                "at least %d, or leave it out (chosen automatically)",
+                p->inverter.substeps, p->ts / p->inverter.substeps * p->machine.rs / lmin,
+                PLANT_HR_MAX, need);
+  }
+  return 0;
+}
+
 int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *err, size_t errlen) {
-  ctx_t c = {err, errlen, origin, 0};
+  ctx_t c = {err, errlen, origin, 0, 0};
   scenario_defaults(sc);
   /* the whole text is the one object: nothing but white space after it */
   cJSON *root = cJSON_ParseWithOpts(json, NULL, 1);
@@ -823,6 +859,9 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
   }
   if (ps != NULL && (ps->caps & POS_CAP_GATED) != 0u && !sc->board.asym_edges) {
     return fail(&c, "board", "a star-point position source needs a board with asymmetric edges");
+  }
+  if (resolve_substeps(&c, sc) != 0) {
+    return -1;
   }
   const char *field = "";
   if (plant_check(&sc->plant, &field) != 0) {

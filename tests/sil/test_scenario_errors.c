@@ -90,6 +90,14 @@ static const bad_case_t cases[] = {
     {"{\"duration\": 1} trailing", "line 1: not valid JSON (or text after the top-level object)"},
     {"{\"duration\": 1}{\"duration\": 2}", "not valid JSON"},
     {"{\"duration\": 1, \"description\": 5}", "description: must be a string"},
+    /* issue 13, defect 7: the integration step against the machine's L/R */
+    {"{\"duration\": 1, \"machine\": {\"ls\": 1e-5}}",
+     "machine.ls: the plant cannot integrate this machine at this PWM period"},
+    {"{\"duration\": 1, \"machine\": {\"ld\": 2e-5, \"lq\": 1e-5}}",
+     "machine.lq: the plant cannot integrate"},
+    {"{\"duration\": 1, \"machine\": {\"ls\": 1e-4}, \"inverter\": {\"substeps\": 1}}",
+     "inverter.substeps: 1 steps per period are unstable for this machine (h R_s / L_min = 4.44 > "
+     "0.5): at least 9"},
 };
 
 static void bad_scenarios_name_the_field(void **state) {
@@ -178,6 +186,34 @@ static void scenario_name_stays_utf8(void **state) {
   assert_string_equal(sc.name, "a?b??c");
 }
 
+/* Issue 13, defect 7: a small inductance that one RK4 step per period
+ * would take to NaN is integrated in as many steps as it needs (9 for
+ * 0.1 mH and 7.1 Ohm at 16 kHz: h R / L <= 0.5), and stays finite. */
+static void small_inductance_is_substepped(void **state) {
+  (void)state;
+  static scenario_t sc;
+  static plant_t pl;
+  char err[512];
+  const char *js = "{\"duration\": 0.01, \"machine\": {\"ls\": 1e-4}}";
+  assert_int_equal(scenario_parse(js, "l.json", &sc, err, sizeof err), 0);
+  assert_int_equal(sc.plant.inverter.substeps, 9);
+  const char *field = NULL;
+  assert_int_equal(plant_init(&pl, &sc.plant, &field), 0);
+  const double d[3] = {0.9, 0.1, 0.5};
+  for (int k = 0; k < 2000; ++k) {
+    plant_step(&pl, d, true);
+  }
+  plant_state_t st;
+  plant_get_state(&pl, &st);
+  assert_true(isfinite(st.i_dq[0]) && isfinite(st.i_dq[1]) && isfinite(st.omega_m));
+  /* bounded by the RL circuit: |v| / R at most, |v| <= v_dc */
+  assert_true(hypot(st.i_dq[0], st.i_dq[1]) < 310.0 / 7.1);
+  /* one step per period on the same machine is refused by the plant */
+  sc.plant.inverter.substeps = 1;
+  assert_int_not_equal(plant_init(&pl, &sc.plant, &field), 0);
+  assert_string_equal(field, "inverter.substeps");
+}
+
 static void good_scenario_sets_fields(void **state) {
   (void)state;
   static scenario_t sc;
@@ -195,9 +231,9 @@ static void good_scenario_sets_fields(void **state) {
 }
 
 int main(void) {
-  const struct CMUnitTest tests[] = {cmocka_unit_test(bad_scenarios_name_the_field),
-                                     cmocka_unit_test(truncated_inputs_never_crash),
-                                     cmocka_unit_test(good_scenario_sets_fields),
-                                     cmocka_unit_test(scenario_name_stays_utf8)};
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(bad_scenarios_name_the_field),
+      cmocka_unit_test(truncated_inputs_never_crash), cmocka_unit_test(good_scenario_sets_fields),
+      cmocka_unit_test(scenario_name_stays_utf8), cmocka_unit_test(small_inductance_is_substepped)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

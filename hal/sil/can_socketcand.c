@@ -129,6 +129,7 @@ static void accept_clients(can_socketcand_t *s) {
     setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
     c->fd = fd;
     c->phase = 0;
+    c->since = wall_now();
     c->in_len = c->out_len = 0;
     out_put(c, "< hi >", 6);
     flush_client(c);
@@ -337,6 +338,14 @@ static void read_client(can_socketcand_t *s, can_scd_client_t *c, hal_sil_t *hal
 void can_socketcand_poll(can_socketcand_t *s, hal_sil_t *hal, double t) {
   if (s->listen_fd < 0) {
     return;
+  }
+  /* first free the slots of clients that never finished the handshake */
+  const double now = wall_now();
+  for (int i = 0; i < CAN_SCD_CLIENTS; ++i) {
+    if (s->cl[i].fd >= 0 && s->cl[i].phase != 2 && now - s->cl[i].since > CAN_SCD_HANDSHAKE_S) {
+      s->handshake_timeouts++;
+      drop_client(&s->cl[i]);
+    }
   }
   accept_clients(s);
   for (int i = 0; i < CAN_SCD_CLIENTS; ++i) {

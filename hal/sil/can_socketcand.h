@@ -27,14 +27,19 @@
 #include "hal_sil.h"
 
 #define CAN_SCD_CLIENTS 4
-#define CAN_SCD_IN      4096
-#define CAN_SCD_OUT     65536
-#define CAN_SCD_CMD_MAX 128 /* longest command accepted [chars] */
+/* A client that has not reached raw mode this long after its connection
+ * (wall time) is dropped: half-open or idle connections cannot hold the
+ * slots (a client's handshake takes milliseconds). */
+#define CAN_SCD_HANDSHAKE_S 2.0
+#define CAN_SCD_IN          4096
+#define CAN_SCD_OUT         65536
+#define CAN_SCD_CMD_MAX     128 /* longest command accepted [chars] */
 
 typedef struct {
   int fd;        /* -1: free slot */
   int phase;     /* 0 greeted, 1 bus open, 2 raw mode */
   double raw_at; /* wall time raw mode was acknowledged */
+  double since;  /* wall time of the connection */
   size_t in_len, out_len;
   char in[CAN_SCD_IN];
   char out[CAN_SCD_OUT];
@@ -43,10 +48,11 @@ typedef struct {
 typedef struct {
   int listen_fd;
   uint16_t port;
-  uint32_t rx_frames;    /* frames from clients pushed to the drive */
-  uint32_t tx_frames;    /* frames from the drive */
-  uint32_t bad_commands; /* malformed or unknown commands, garbage */
-  uint32_t dropped;      /* frames lost on a full client buffer */
+  uint32_t rx_frames;          /* frames from clients pushed to the drive */
+  uint32_t tx_frames;          /* frames from the drive */
+  uint32_t bad_commands;       /* malformed or unknown commands, garbage */
+  uint32_t dropped;            /* frames lost on a full client buffer */
+  uint32_t handshake_timeouts; /* clients dropped before raw mode (CAN_SCD_HANDSHAKE_S) */
   can_scd_client_t cl[CAN_SCD_CLIENTS];
 } can_socketcand_t;
 

@@ -220,7 +220,7 @@ int plant_check(const plant_params_t *p, const char **field);
  * L_min <= PLANT_HR_MAX (L_min the smallest incremental inductance, the
  * flux map's for a map machine). plant_check refuses fewer (field
  * "inverter.substeps"). Needs a valid machine and ts. */
-#define PLANT_HR_MAX 0.5
+#define PLANT_HR_MAX       0.5
 #define PLANT_SUBSTEPS_MAX 64
 int plant_substeps_needed(const plant_params_t *p);
 /* Initialises (calls plant_check first). Returns 0 or the error. */

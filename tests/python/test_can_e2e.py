@@ -298,3 +298,38 @@ def test_sensorless_load_torque_over_can(sil_sensorless):
         assert abs(sum(est) / len(est) - LOAD) < 0.15 * LOAD
         assert abs(sum(spd) / len(spd) - 300.0) < 0.01 * 300.0
     assert proc.poll() is None, "the SIL ended"
+
+
+def test_half_open_connections_time_out(sil):
+    """Issue 13, defect 9: four idle connections that never complete the
+    socketcand handshake take every slot; they are dropped after the
+    handshake timeout (2 s, hal/sil/can_socketcand.h) and a real client gets
+    in."""
+    proc, port = sil
+    idle = [socket.create_connection(("127.0.0.1", port), timeout=5.0) for _ in range(4)]
+    try:
+        time.sleep(0.3)
+        # every slot is held: a fifth connection is closed at once
+        extra = socket.create_connection(("127.0.0.1", port), timeout=5.0)
+        extra.settimeout(2.0)
+        try:
+            assert extra.recv(64) == b""  # closed without a greeting
+        finally:
+            extra.close()
+        time.sleep(2.5)  # past the handshake timeout
+        with Drive("vcan0", "socketcand", node=NODE, port=port, reply_timeout=3.0) as drv:
+            assert drv.status(timeout=5.0)["state_name"] == "idle"
+            assert drv.get_param("speed_bw") == pytest.approx(60.0)
+        for s in idle:  # the server closed them: the greeting, then the end
+            s.settimeout(2.0)
+            got = b""
+            while True:
+                chunk = s.recv(64)
+                if not chunk:
+                    break
+                got += chunk
+            assert got == b"< hi >"
+    finally:
+        for s in idle:
+            s.close()
+    assert proc.poll() is None, "the SIL ended"

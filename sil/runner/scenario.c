@@ -747,6 +747,27 @@ static void scenario_defaults(scenario_t *sc) {
   sc->log_decimation = 16;
 }
 
+/* The scenario key of a plant parameter plant_check names (its fields are
+ * the plant's struct members; errors name what the user wrote). */
+static const char *scenario_key_of(const char *plant_field) {
+  static const char *const map[][2] = {{"ts", "inverter.pwm_frequency"},
+                                       {"dclink.kind", "dc_link.kind"},
+                                       {"dclink.v_source", "dc_link.voltage"},
+                                       {"dclink.r", "dc_link.r"},
+                                       {"dclink.c", "dc_link.c"},
+                                       {"mech.b", "mechanics.b"},
+                                       {"mech.j", "mechanics.j"},
+                                       {"mech.mode", "mechanics.mode"},
+                                       {"mech.omega0", "mechanics.speed0"},
+                                       {"mech.theta0", "mechanics.theta0"}};
+  for (size_t i = 0; i < sizeof map / sizeof map[0]; ++i) {
+    if (strcmp(plant_field, map[i][0]) == 0) {
+      return map[i][1];
+    }
+  }
+  return plant_field; /* machine.*, inverter.*, sensors.*: the same names */
+}
+
 /* The plant's integration steps per period: the fewest that keep it stable
  * on this machine (plant_substeps_needed: h R / L_min <= 0.5) unless the
  * scenario gives them; too few given, or more needed than the plant
@@ -851,6 +872,11 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
                 (profile_term_t){.kind = PROFILE_CONST, .value = sc->plant.dclink.v_source});
   }
   sc->plant.dclink.v_source = profile_eval(&sc->v_source, 0.0);
+  /* the drive's protection range (v_dc_max at most 1e4 V) bounds the link */
+  if (!(sc->plant.dclink.v_source > 0.0 && sc->plant.dclink.v_source <= 1e4)) {
+    return fail(&c, "dc_link.voltage", "must be in (0, 10000] V at t = 0 (got %g)",
+                sc->plant.dclink.v_source);
+  }
   const pos_source_row_t *ps = pos_source(sc->drive.pos_source);
   if (ps != NULL && (ps->caps & POS_CAP_GATED) != 0u &&
       sc->plant.inverter.model != PLANT_INV_SWITCHING) {
@@ -865,7 +891,7 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
   }
   const char *field = "";
   if (plant_check(&sc->plant, &field) != 0) {
-    return fail(&c, field, "invalid plant parameter (see docs/scenarios.md)");
+    return fail(&c, scenario_key_of(field), "invalid plant parameter (see docs/scenarios.md)");
   }
   /* the set as a whole, reported under the scenario key that sets the
    * field (drive_param_table.h) */

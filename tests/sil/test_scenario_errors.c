@@ -90,6 +90,12 @@ static const bad_case_t cases[] = {
     {"{\"duration\": 1} trailing", "line 1: not valid JSON (or text after the top-level object)"},
     {"{\"duration\": 1}{\"duration\": 2}", "not valid JSON"},
     {"{\"duration\": 1, \"description\": 5}", "description: must be a string"},
+    /* issue 13, defect 11: errors name the scenario's keys; the link within
+     * the drive's protection range */
+    {"{\"duration\": 1, \"dc_link\": {\"voltage\": -5}}", "dc_link.voltage: must be in (0, 10000]"},
+    {"{\"duration\": 1, \"dc_link\": {\"voltage\": 1e9}}",
+     "dc_link.voltage: must be in (0, 10000]"},
+    {"{\"duration\": 1, \"dc_link\": {\"kind\": \"rc\", \"r\": 0.1, \"c\": -1}}", "dc_link.c: "},
     /* issue 13, defect 7: the integration step against the machine's L/R */
     {"{\"duration\": 1, \"machine\": {\"ls\": 1e-5}}",
      "machine.ls: the plant cannot integrate this machine at this PWM period"},

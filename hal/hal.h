@@ -33,16 +33,18 @@
  * HAL never clamps a request and the voltage the observers integrate is
  * the voltage applied. */
 typedef struct {
-  float ts;          /* PWM period [s] */
-  float t_count;     /* timer resolution: one compare step [s] of pulse width */
-  float dead_time;   /* inserted by the timer [s] */
-  float duty_min;    /* smallest duty that is not 0 (gate driver, bootstrap) */
-  float duty_max;    /* largest duty: the low side must stay on t_i_clear around the valley */
-  float t_i;         /* current / DC-link sampling instant after the period start [s] */
-  float t_i_clear;   /* zero-vector time the current sample needs around t_i [s] */
-  float t_enc;       /* encoder sampling instant after the period start [s] */
-  float cpu_hz;      /* CPU clock for hal_isr_stats() [Hz] (0: no cycle counter) */
-  uint32_t features; /* HAL_CAP_* */
+  float ts;           /* PWM period [s] */
+  float t_count;      /* timer resolution: one compare step [s] of pulse width */
+  float dead_time;    /* inserted by the timer [s] */
+  float duty_min;     /* smallest duty that is not 0 (gate driver, bootstrap) */
+  float duty_max;     /* largest duty: the low side must stay on t_i_clear around the valley */
+  float t_i;          /* current / DC-link sampling instant after the period start [s] */
+  float t_i_clear;    /* zero-vector time the current sample needs around t_i [s] */
+  float t_enc;        /* encoder sampling instant after the period start [s] */
+  float cpu_hz;       /* CPU clock for hal_isr_stats() [Hz] (0: no cycle counter) */
+  float i_full_scale; /* largest phase current the ADC reads, either sign [A] (0: not known) */
+  float v_full_scale; /* largest DC-link voltage the ADC reads [V] (0: not known) */
+  uint32_t features;  /* HAL_CAP_* */
 } hal_caps_t;
 
 enum {

@@ -121,12 +121,30 @@ FD_COLD static void drive_derive(drive_t *drv) {
   drv->inv_pole_pairs = 1.0f / c->pole_pairs;
 }
 
+FD_COLD int drive_config_fits_board(const drive_config_t *cfg, const hal_caps_t *caps,
+                                    drive_config_err_t *err) {
+  if (caps->i_full_scale > 0.0f && !(cfg->i_trip < caps->i_full_scale)) {
+    err->field = "i_trip";
+    err->reason = "must be below the current ADC's full scale (hal_caps: i_full_scale); a "
+                  "current beyond it reads as the full scale and would never trip";
+    return -1;
+  }
+  if (caps->v_full_scale > 0.0f && !(cfg->v_dc_max < caps->v_full_scale)) {
+    err->field = "v_dc_max";
+    err->reason = "must be below the DC-link ADC's full scale (hal_caps: v_full_scale); a "
+                  "voltage beyond it reads as the full scale and would never trip";
+    return -1;
+  }
+  return 0;
+}
+
 /* Everything derived from the parameter set (ISR-owned; gates off). */
 FD_COLD static int drive_configure(drive_t *drv, const drive_config_t *cfg, drive_law_t law,
                                    drive_config_err_t *err) {
   machine_t m;
   flux_map_t map;
-  if (drive_config_usable(cfg, law, &m, &map, err) != 0) {
+  if (drive_config_usable(cfg, law, &m, &map, err) != 0 ||
+      drive_config_fits_board(cfg, drv->caps, err) != 0) {
     return -1;
   }
   const uint32_t need = HAL_CAP_STAR_POINT | HAL_CAP_ASYM_EDGES;
@@ -185,8 +203,10 @@ FD_COLD static bool configure_live(drive_t *drv, const drive_config_t *cfg) {
   }
   const char *pf = NULL;
   const pos_source_row_t *ps = pos_source(next.pos_source);
+  drive_config_err_t e;
   if (drive_config_check(&next, NULL) != 0 ||
-      (ps->check != NULL && ps->check(&next, &pf) != NULL)) {
+      (ps->check != NULL && ps->check(&next, &pf) != NULL) ||
+      drive_config_fits_board(&next, drv->caps, &e) != 0) {
     return true; /* all of it when the gates are off */
   }
   drv->cfg = next;

@@ -186,6 +186,13 @@ int drive_init(drive_t *drv, const drive_config_t *cfg, drive_config_err_t *err)
  * drive_machine_copy). */
 int drive_config_usable(const drive_config_t *cfg, drive_law_t law, machine_t *m, flux_map_t *map,
                         drive_config_err_t *err);
+/* Whether cfg's protections can see what they protect on this board: the
+ * current trip below the current ADC's full scale, the overvoltage trip
+ * below the DC-link ADC's (a quantity beyond its ADC's range reads as the
+ * full scale and would never trip). 0, or -1 with *err. Ranges not known
+ * (0 in hal_caps_t) are not checked. */
+int drive_config_fits_board(const drive_config_t *cfg, const hal_caps_t *caps,
+                            drive_config_err_t *err);
 /* *dm, *dmap = *m, *map with dm's map pointer on dmap. */
 void drive_machine_copy(machine_t *dm, flux_map_t *dmap, const machine_t *m, const flux_map_t *map);
 

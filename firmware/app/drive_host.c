@@ -182,7 +182,8 @@ int drive_request_config(drive_t *drv, const drive_config_t *cfg, drive_config_e
   }
   machine_t m;
   flux_map_t map;
-  if (drive_config_usable(cfg, drv->req.cmd.law, &m, &map, err) != 0) {
+  if (drive_config_usable(cfg, drv->req.cmd.law, &m, &map, err) != 0 ||
+      drive_config_fits_board(cfg, drv->caps, err) != 0) {
     return -1;
   }
   drive_machine_copy(&drv->host.machine, &drv->host.map, &m, &map);

@@ -19,6 +19,8 @@ void hal_sil_init(hal_sil_t *h, const hal_sil_board_t *board) {
   h->caps.t_i_clear = 0.0f; /* an ideal sampler */
   h->caps.t_enc = 0.0f;
   h->caps.cpu_hz = 0.0f;
+  h->caps.i_full_scale = board->i_full_scale;
+  h->caps.v_full_scale = board->v_full_scale;
   h->caps.features =
       HAL_CAP_ENCODER | HAL_CAP_STAR_POINT | (board->asym_edges ? HAL_CAP_ASYM_EDGES : 0u);
   h->timer_counts = board->timer_counts;

@@ -27,12 +27,13 @@ typedef struct {
 
 /* The board the SIL models. */
 typedef struct {
-  float duty_min, duty_max; /* hal_caps_t */
-  uint32_t timer_counts;    /* compare steps per period (ARR); 0: exact duties */
-  float dead_time;          /* [s] */
-  float ts;                 /* [s] */
-  uint32_t watchdog_ms;     /* watchdog timeout; 0: none */
-  bool asym_edges;          /* HAL_CAP_ASYM_EDGES */
+  float duty_min, duty_max;         /* hal_caps_t */
+  uint32_t timer_counts;            /* compare steps per period (ARR); 0: exact duties */
+  float dead_time;                  /* [s] */
+  float ts;                         /* [s] */
+  uint32_t watchdog_ms;             /* watchdog timeout; 0: none */
+  bool asym_edges;                  /* HAL_CAP_ASYM_EDGES */
+  float i_full_scale, v_full_scale; /* the ADC ranges (hal_caps_t; 0: not known) */
 } hal_sil_board_t;
 
 typedef struct {

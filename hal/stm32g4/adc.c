@@ -299,6 +299,12 @@ const hal_caps_t *hal_caps(void) {
     caps.t_i_clear = (1.0f - BOARD_DUTY_MAX) * ts; /* low sides on around the valley */
     caps.t_enc = 0.0f;
     caps.cpu_hz = (float)BOARD_SYSCLK_HZ;
+    /* the ADC's ranges through the board's amplifiers: the current either
+     * side of the mid-point, the link from 0 */
+    const float i_span =
+        BOARD_I_MID_V < BOARD_VDDA - BOARD_I_MID_V ? BOARD_I_MID_V : BOARD_VDDA - BOARD_I_MID_V;
+    caps.i_full_scale = i_span * (BOARD_I_A_PER_V < 0.0f ? -BOARD_I_A_PER_V : BOARD_I_A_PER_V);
+    caps.v_full_scale = BOARD_VDDA * BOARD_VDC_RATIO;
 #if BOARD_HAS_STAR_WINDOW
     /* the DFC window: independent edges, two star-point samples */
     caps.features = HAL_CAP_DWT_CYCLES | HAL_CAP_ASYM_EDGES | HAL_CAP_STAR_POINT;

@@ -24,7 +24,7 @@
 #include "drive.h"
 
 #define ISR_STREAM_MAGIC   0x52534946u /* "FISR" */
-#define ISR_STREAM_VERSION 3u
+#define ISR_STREAM_VERSION 4u
 
 /* isr_stream_header_t.flags: the replay sets the drive's applied-voltage
  * memory (drive_t.v_applied) to the host's before each ISR, see
@@ -144,15 +144,16 @@ static inline void isr_stream_config_get(drive_config_t *c,
 
 /* The HAL capabilities as words (hal_caps_t field by field), plus the
  * timer's compare steps per period (the SIL board's rounding). */
-enum { ISR_STREAM_CAPS_WORDS = 12 };
+enum { ISR_STREAM_CAPS_WORDS = 13 };
 
 static inline void isr_stream_caps_put(const hal_caps_t *c, uint32_t counts,
                                        uint32_t w[ISR_STREAM_CAPS_WORDS]) {
   const float f[10] = {c->ts,  c->t_count,   c->dead_time, c->duty_min, c->duty_max,
-                       c->t_i, c->t_i_clear, c->t_enc,     c->cpu_hz,   0.0f};
+                       c->t_i, c->t_i_clear, c->t_enc,     c->cpu_hz,   c->i_full_scale};
   memcpy(w, f, sizeof f);
   w[10] = c->features;
   w[11] = counts;
+  memcpy(&w[12], &c->v_full_scale, sizeof(float));
 }
 
 static inline void isr_stream_caps_get(hal_caps_t *c, uint32_t *counts,
@@ -168,8 +169,10 @@ static inline void isr_stream_caps_get(hal_caps_t *c, uint32_t *counts,
   c->t_i_clear = f[6];
   c->t_enc = f[7];
   c->cpu_hz = f[8];
+  c->i_full_scale = f[9];
   c->features = w[10];
   *counts = w[11];
+  memcpy(&c->v_full_scale, &w[12], sizeof(float));
 }
 
 /* The command block and back. */

@@ -893,6 +893,21 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
   if (plant_check(&sc->plant, &field) != 0) {
     return fail(&c, scenario_key_of(field), "invalid plant parameter (see docs/scenarios.md)");
   }
+  /* the ADC ranges the drive's HAL reports (hal_caps_t): the sensors' */
+  sc->board.i_full_scale = (float)sc->plant.sensors.i_full_scale;
+  sc->board.v_full_scale = (float)sc->plant.sensors.v_full_scale;
+  if (!(sc->drive.i_trip < sc->board.i_full_scale)) {
+    return fail(&c, "controller.i_trip",
+                "must be below the current ADC's full scale sensors.i_full_scale (%g A): a current "
+                "beyond it reads as the full scale and would never trip (got %g A)",
+                sc->plant.sensors.i_full_scale, (double)sc->drive.i_trip);
+  }
+  if (!(sc->drive.v_dc_max < sc->board.v_full_scale)) {
+    return fail(&c, "controller.v_dc_max",
+                "must be below the DC-link ADC's full scale sensors.v_full_scale (%g V): a voltage "
+                "beyond it reads as the full scale and would never trip (got %g V)",
+                sc->plant.sensors.v_full_scale, (double)sc->drive.v_dc_max);
+  }
   /* the set as a whole, reported under the scenario key that sets the
    * field (drive_param_table.h) */
   drive_config_err_t e;

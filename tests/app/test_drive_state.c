@@ -36,7 +36,7 @@ static void sample(float ia, float ib, float ic, float vdc) {
 }
 
 static void setup_with(const drive_config_t *cfg) {
-  const hal_sil_board_t board = {0.0f, 1.0f, 0u, 1e-6f, 62.5e-6f, 50u, false};
+  const hal_sil_board_t board = {0.0f, 1.0f, 0u, 1e-6f, 62.5e-6f, 50u, false, 0.0f, 0.0f};
   hal_sil_init(&hal, &board);
   hal_sil_bind(&hal);
   drive_config_err_t err;
@@ -295,6 +295,30 @@ static void live_limits_reclamp_the_references(void **state) {
   assert_float_equal(drv.tm.speed_ref, 50.0f, 1e-3f);
 }
 
+/* Issue 13, item 1: a trip the board's ADC cannot see is refused, at
+ * start-up and as a parameter write (a current beyond the ADC's range reads
+ * as the full scale and would never reach i_trip). */
+static void protections_must_fit_the_adc_ranges(void **state) {
+  (void)state;
+  const hal_sil_board_t board = {0.0f, 1.0f, 0u, 1e-6f, 62.5e-6f, 50u, false, 8.0f, 500.0f};
+  hal_sil_init(&hal, &board);
+  hal_sil_bind(&hal);
+  drive_config_t cfg;
+  drive_config_default(&cfg); /* i_trip 7.07 A, v_dc_max 400 V: fit */
+  drive_config_err_t err;
+  assert_int_equal(drive_init(&drv, &cfg, &err), 0);
+  const drive_param_t *itrip = drive_params_by_name("i_trip");
+  const drive_param_t *vmax = drive_params_by_name("v_dc_max");
+  assert_int_equal(drive_params_set(&drv, itrip->id, 8.0f, &err), DRIVE_PARAM_INCONSISTENT);
+  assert_string_equal(err.field, "i_trip");
+  assert_int_equal(drive_params_set(&drv, vmax->id, 600.0f, &err), DRIVE_PARAM_INCONSISTENT);
+  assert_string_equal(err.field, "v_dc_max");
+  assert_int_equal(drive_params_set(&drv, itrip->id, 7.9f, &err), DRIVE_PARAM_OK);
+  cfg.i_trip = 9.0f;
+  assert_int_equal(drive_init(&drv, &cfg, &err), -1);
+  assert_string_equal(err.field, "i_trip");
+}
+
 static void law_change_waits_for_gates_off(void **state) {
   (void)state;
   start_running();
@@ -459,6 +483,7 @@ int main(void) {
                                      cmocka_unit_test(invalid_position_faults),
                                      cmocka_unit_test(commands_are_clamped_and_posted),
                                      cmocka_unit_test(live_limits_reclamp_the_references),
+                                     cmocka_unit_test(protections_must_fit_the_adc_ranges),
                                      cmocka_unit_test(law_change_waits_for_gates_off),
                                      cmocka_unit_test(syr_machine_runs_foc_only),
                                      cmocka_unit_test(parameter_requests_are_applied_by_the_isr),

@@ -96,6 +96,13 @@ static const bad_case_t cases[] = {
     {"{\"duration\": 1, \"dc_link\": {\"voltage\": 1e9}}",
      "dc_link.voltage: must be in (0, 10000]"},
     {"{\"duration\": 1, \"dc_link\": {\"kind\": \"rc\", \"r\": 0.1, \"c\": -1}}", "dc_link.c: "},
+    /* issue 13, item 1: protections blind beyond their ADC's range */
+    {"{\"duration\": 1, \"sensors\": {\"i_full_scale\": 2}, \"controller\": {\"i_max\": 1, "
+     "\"i_trip\": 2.2}}",
+     "controller.i_trip: must be below the current ADC's full scale sensors.i_full_scale (2 A)"},
+    {"{\"duration\": 1, \"sensors\": {\"v_full_scale\": 200}}",
+     "controller.v_dc_max: must be below the DC-link ADC's full scale sensors.v_full_scale (200 "
+     "V)"},
     /* issue 13, defect 7: the integration step against the machine's L/R */
     {"{\"duration\": 1, \"machine\": {\"ls\": 1e-5}}",
      "machine.ls: the plant cannot integrate this machine at this PWM period"},

@@ -52,7 +52,10 @@ enum {
   HAL_CAP_ASYM_EDGES = 1u << 1, /* hal_pwm_t.on/off placed independently (else
                                    centred pulses only: on = 1 - off) */
   HAL_CAP_STAR_POINT = 1u << 2, /* star-point samples at requested instants */
-  HAL_CAP_DWT_CYCLES = 1u << 3  /* hal_isr_stats() measures cycles */
+  HAL_CAP_DWT_CYCLES = 1u << 3, /* hal_isr_stats() measures cycles */
+  HAL_CAP_I_ABC = 1u << 4       /* all three phase currents measured (not one
+                                   reconstructed from the others): their sum
+                                   is a check (drive: current_sensor fault) */
 };
 
 const hal_caps_t *hal_caps(void);

@@ -464,11 +464,37 @@ static FD_NOINLINE void drive_window_sample(const drive_t *drv, float i[3], floa
 
 /* The speed loop, every slow_div ISRs, on the angle rate averaged over that
  * period (no lag under acceleration). */
+/* The three measured phase currents sum to zero (Kirchhoff, star
+ * connection): a gain error, an offset drift or a lost channel shows as a
+ * sum beyond i_sum_rel of the largest current (and the noise floor
+ * i_sum_abs). Checked at the slow rate with a leaky count (a single
+ * channel's error vanishes where its current crosses zero): the fault after
+ * DRIVE_I_SUM_TRIP more slow periods over than under. Only where the board
+ * measures all three (HAL_CAP_I_ABC) and the gates are on. */
+#define DRIVE_I_SUM_TRIP 8
+static FD_NOINLINE void drive_current_sum_check(drive_t *drv) {
+  const float *i = drv->tm.i_abc; /* the last period's offset-corrected currents */
+  const drive_config_t *c = &drv->cfg;
+  if ((drv->caps->features & HAL_CAP_I_ABC) == 0u || !gates_on_state(drv->state)) {
+    drv->i_sum_n = 0;
+    return;
+  }
+  const float big = fd_maxf(fabsf(i[0]), fd_maxf(fabsf(i[1]), fabsf(i[2])));
+  if (fabsf(i[0] + i[1] + i[2]) > fd_maxf(c->i_sum_abs, c->i_sum_rel * big)) {
+    if (++drv->i_sum_n >= DRIVE_I_SUM_TRIP) {
+      drive_trip(drv, DRIVE_FAULT_CURRENT_SENSOR);
+    }
+  } else if (drv->i_sum_n > 0) {
+    drv->i_sum_n--;
+  }
+}
+
 static void drive_speed_loop(drive_t *drv) {
   const drive_config_t *c = &drv->cfg;
   if ((drv->isr_count - 1u) % c->slow_div != 0u) {
     return;
   }
+  drive_current_sum_check(drv);
   const float w =
       drv->rate_n > 0u ? drv->rate_acc / ((float)drv->rate_n * c->pole_pairs) : drv->omega_m;
   drv->rate_acc = 0.0f;

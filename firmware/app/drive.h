@@ -107,9 +107,7 @@ typedef struct {
   drive_state_t state;
   uint32_t faults;
   uint32_t isr_count;
-  drive_cmd_t cmd;     /* the commands in force (the ISR's copy of req) */
-  uint32_t clear_seen; /* req.clear_count taken */
-  uint32_t fault_seen[DRIVE_FAULT_COUNT];
+  drive_cmd_t cmd;   /* the commands in force (the ISR's copy of req) */
   uint32_t cfg_seen; /* creq.seq taken */
   bool cfg_pending;  /* a parameter set waits for the gates to go off */
   bool armed;        /* enable seen low since the last clear */
@@ -171,6 +169,13 @@ typedef struct {
     drive_telemetry_t tm; /* last consistent telemetry copy */
     uint32_t tm_retries;  /* copies that had to be retried (preemption) */
   } host;
+
+  /* ===== ISR-owned, used at the slow rate or on a command (last: the
+   * periodic path's fields stay within the load offsets of the Cortex-M's
+   * single instructions from the drive's base) ===== */
+  uint32_t clear_seen; /* req.clear_count taken */
+  uint32_t fault_seen[DRIVE_FAULT_COUNT];
+  int32_t i_sum_n; /* the current-sensor check's leaky count (drive.c) */
 } drive_t;
 
 /* Validates cfg, initialises everything and latches DRIVE_FAULT_WATCHDOG

@@ -81,6 +81,10 @@
     "loss of control: load angle beyond delta_max + lc_delta (DFVC laws)")                                  \
   X(25, lc_track,       F32,  "",       0.5f,        0.05f,   10.0f,    LIVE, "controller.lc_track",       \
     "loss of control: torque, flux or observer error above lc_track times its scale")                      \
+  X(109, i_sum_rel,     F32,  "",       0.2f,        0.01f,   1.0f,     LIVE, "controller.i_sum_rel",      \
+    "current-sensor check: |i_a + i_b + i_c| above i_sum_rel times the largest |i_x| (and i_sum_abs) trips current_sensor") \
+  X(110, i_sum_abs,     F32,  "A",      0.05f,       0.0f,    1e3f,     LIVE, "controller.i_sum_abs",      \
+    "current-sensor check: the noise floor of |i_a + i_b + i_c|")                                          \
   X(26, lc_track_time,  F32,  "s",      0.02f,       1e-4f,   1.0f,     LIVE, "controller.lc_track_time",  \
     "loss of control: time a tracking condition may persist (a reversal at the voltage limit takes ms)")   \
   /* controller */                                                                                          \

@@ -21,8 +21,8 @@ void hal_sil_init(hal_sil_t *h, const hal_sil_board_t *board) {
   h->caps.cpu_hz = 0.0f;
   h->caps.i_full_scale = board->i_full_scale;
   h->caps.v_full_scale = board->v_full_scale;
-  h->caps.features =
-      HAL_CAP_ENCODER | HAL_CAP_STAR_POINT | (board->asym_edges ? HAL_CAP_ASYM_EDGES : 0u);
+  h->caps.features = HAL_CAP_ENCODER | HAL_CAP_STAR_POINT | HAL_CAP_I_ABC |
+                     (board->asym_edges ? HAL_CAP_ASYM_EDGES : 0u);
   h->timer_counts = board->timer_counts;
   h->watchdog_timeout_us = board->watchdog_ms * 1000u;
   h->pwm = hal_pwm_centred(0.5f, 0.5f, 0.5f);

@@ -311,6 +311,9 @@ const hal_caps_t *hal_caps(void) {
 #else
     caps.features = HAL_CAP_DWT_CYCLES; /* centred pulses, no encoder, star point at the valley */
 #endif
+    if (k_sig[SIG_IA].adc != 0u && k_sig[SIG_IB].adc != 0u && k_sig[SIG_IC].adc != 0u) {
+      caps.features |= HAL_CAP_I_ABC; /* three shunts: none reconstructed */
+    }
     done = true;
   }
   return &caps;

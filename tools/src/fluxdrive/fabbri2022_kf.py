@@ -372,6 +372,7 @@ def law_step_run(sil, root, out, noise: float, case: tuple, source: str, v_dc: f
         sc["controller"]["align_time"] = 0.0
     sc["dc_link"] = {"voltage": v_dc}
     sc["controller"]["v_dc_max"] = 1.5 * v_dc
+    sc["sensors"]["v_full_scale"] = 2.0 * v_dc  # as the presets: the trip within the ADC
     sc["sensors"]["star_full_scale"] = 13.0 * v_dc / V_DC
     sc["controller"]["dfc_sigma"] = sigma_of(noise) * V_DC / v_dc
     sc["mechanics"]["load_torque"] = [{"type": "step", "t": t, "value": LAW_BRAKE}

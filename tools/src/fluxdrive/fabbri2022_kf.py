@@ -260,8 +260,9 @@ def kf_load_response(noise: float, q_load: float, kind: str,
 
 
 LOAD_T = 0.8  # s: the load is applied at 500 rpm
-# (5.1)'s Q_33 = 1e-6 puts the load estimate's pole near 40 rad/s (6 Hz):
-# the 10 Hz load is also run with Q_33 raised a hundredfold
+# (5.1)'s Q_33 = 1e-6 makes the load estimate slow (kf_load_response: half
+# the amplitude at 10 Hz): the 10 Hz load is also run with Q_33 raised a
+# hundredfold
 SINE_Q_LOAD = 1e-4
 
 

@@ -33,11 +33,11 @@
  * vector of the last window, hal_sample_t.test_vector, and the star-point
  * samples around its edge); the others are held, so the vector mixes three
  * consecutive periods. The held components are turned to the newest one's
- * instant with the PLL's speed (dfc_signals_vector: the sequentiality
+ * instant with the tracker's speed (dfc_signals_vector: the sequentiality
  * effect, docs/dfc.md); the estimate is dated at that edge, and the drive
  * extrapolates the angle from it to the current sample.
  * The estimate is 2 theta_e. The branch (theta or theta + pi) follows the
- * PLL's prediction; the magnet's polarity is resolved once, by the
+ * tracker's (PLL's or filter's) prediction; the magnet's polarity is resolved once, by the
  * alignment (Fabbri 2022, 3.1.3; hence align_time > 0): the d current
  * along theta = 0 pulls the rotor with a torque of the sign of
  * -sin(theta). The tracked estimate is theta or theta + pi; over the
@@ -239,7 +239,9 @@ static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sam
   }
   s->dfc.miss = fresh ? 0u : (s->dfc.miss < 255u ? (uint8_t)(s->dfc.miss + 1u) : 255u);
   out->t = s->dfc.t; /* the filter's state is at the edge's point of this period */
-  out->load = kalman ? kf->x[2] : 0.0f;
+  if (kalman) {
+    out->load = kf->x[2]; /* the prediction's, until an update below */
+  }
   float c2 = 1.0f, s2 = 0.0f;
   dfc_vec_t v;
   const bool full = dfc_signals_complete(&s->dfc.sig);
@@ -344,15 +346,17 @@ FD_COLD static const char *pdfc_check_cfg(const drive_config_t *cfg, const char 
   return NULL;
 }
 
-#define POS_DFC_ROW(n, name)                                                                       \
-  const pos_source_row_t pos_source_##n = {name,          POS_CAP_ALIGN | POS_CAP_GATED,           \
-                                           pdfc_init,     pdfc_reset,                              \
-                                           pdfc_update,   pdfc_align,                              \
+#define POS_DFC_ROW(n)                                                                             \
+  const pos_source_row_t pos_source_##n = {POS_CAP_ALIGN | POS_CAP_GATED,                          \
+                                           pdfc_init,                                              \
+                                           pdfc_reset,                                             \
+                                           pdfc_update,                                            \
+                                           pdfc_align,                                             \
                                            pdfc_check_cfg}
-POS_DFC_ROW(dfc, "dfc");
-POS_DFC_ROW(dfc_inv, "dfc_inv");
-POS_DFC_ROW(ivd, "ivd");
-POS_DFC_ROW(dfc_kf, "dfc+kf");
-POS_DFC_ROW(ivd_kf, "ivd+kf");
-POS_DFC_ROW(ekf, "ekf");
-POS_DFC_ROW(ivd_kf_rls, "ivd+kf+rls");
+POS_DFC_ROW(dfc);
+POS_DFC_ROW(dfc_inv);
+POS_DFC_ROW(ivd);
+POS_DFC_ROW(dfc_kf);
+POS_DFC_ROW(ivd_kf);
+POS_DFC_ROW(ekf);
+POS_DFC_ROW(ivd_kf_rls);

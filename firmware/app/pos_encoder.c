@@ -71,5 +71,5 @@ static void enc_align(pos_state_t *s, const drive_config_t *cfg, const hal_sampl
   s->enc.started = false;
 }
 
-const pos_source_row_t pos_source_encoder = {"encoder",  POS_CAP_ALIGN, enc_init, enc_reset,
-                                             enc_update, enc_align,     NULL};
+const pos_source_row_t pos_source_encoder = {POS_CAP_ALIGN, enc_init,  enc_reset,
+                                             enc_update,    enc_align, NULL};

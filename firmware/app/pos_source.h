@@ -1,6 +1,6 @@
 /*
  * pos_source.h - where the rotor angle comes from, behind one table of
- * sources {name, capabilities, init, reset, update, align}; one row per
+ * sources {capabilities, init, reset, update, align, check}; one row per
  * entry of POS_SOURCE_LIST (drive_enums.h): the encoder (pos_encoder.c)
  * and the star point (pos_dfc.c: DFC, inverse DFC, IVD / Full IVD with a
  * PLL; DFC or IVD with the Kalman filter, the EKF on the DFC signals, IVD
@@ -90,7 +90,6 @@ typedef union {
 } pos_state_t;
 
 typedef struct {
-  const char *name;
   uint32_t caps; /* POS_CAP_* */
   void (*init)(pos_state_t *s, const drive_config_t *cfg);
   void (*reset)(pos_state_t *s);

@@ -112,6 +112,14 @@ void hal_pwm_write(const hal_pwm_t *p, hal_pwm_t *applied);
 void hal_pwm_enable(void);
 void hal_pwm_disable(void);
 bool hal_pwm_is_enabled(void);
+/* Active short circuit (ASC): the three low-side switches on, the high
+ * sides off, at once. A PM machine's back-EMF then drives its short-circuit
+ * current in the windings and none into the DC link (the safe state above
+ * the rectifier speed: docs/faults.md). Ended by hal_pwm_disable() or
+ * hal_pwm_enable(); refused by the hardware while the break input is
+ * active. hal_pwm_is_enabled() is false while shorted. */
+void hal_pwm_short(void);
+bool hal_pwm_is_shorted(void);
 
 /* Classic CAN frame. */
 typedef struct {

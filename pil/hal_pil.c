@@ -12,6 +12,7 @@ static hal_sample_t sample;
 static hal_pwm_t pwm;
 static bool gates_on;
 static bool hw_tripped;
+static bool shorted; /* hal_pwm_short: not in the stream (no PIL scenario trips) */
 static uint32_t time_us;
 
 void hal_pil_set_caps(const hal_caps_t *c, uint32_t timer_counts) {
@@ -39,6 +40,7 @@ void hal_pil_set_input(const isr_stream_in_t *in) {
   hw_tripped = (in->flags & ISR_IN_HW_TRIPPED) != 0u;
   if (hw_tripped) {
     gates_on = false; /* the break input turns the gates off in hardware */
+    shorted = false;
   }
   time_us = in->time_us;
 }
@@ -68,11 +70,24 @@ void hal_pwm_write(const hal_pwm_t *p, hal_pwm_t *applied) {
 void hal_pwm_enable(void) {
   if (!hw_tripped) {
     gates_on = true;
+    shorted = false;
   }
 }
 
 void hal_pwm_disable(void) {
   gates_on = false;
+  shorted = false;
+}
+
+void hal_pwm_short(void) {
+  if (!hw_tripped) {
+    gates_on = false;
+    shorted = true;
+  }
+}
+
+bool hal_pwm_is_shorted(void) {
+  return shorted;
 }
 
 bool hal_pwm_is_enabled(void) {

@@ -9,6 +9,7 @@
  * side of the concurrency contract is drive_host.c.
  */
 #include "drive.h"
+#include "drive_safe.h"
 #include "drive_sync.h"
 
 #include <math.h>
@@ -32,8 +33,13 @@ static void drive_gates_off(const drive_t *drv) {
   hal_pwm_write(&p, NULL);
 }
 
+/* A fault: gates off now (unless already shorted), the safe state chosen
+ * in this ISR (drive_safe.c), the cause latched. */
 static void drive_trip(drive_t *drv, uint32_t bits) {
-  drive_gates_off(drv);
+  if (!drv->safe.asc) {
+    drive_gates_off(drv);
+    drive_safe_leave_gates(drv);
+  }
   drv->faults |= bits;
   drv->state = DRIVE_STATE_FAULT;
 }
@@ -178,6 +184,10 @@ FD_COLD static int drive_configure(drive_t *drv, const drive_config_t *cfg, driv
       machine_mtpa_current(&drv->machine, machine_mtpa_torque(&drv->machine, cfg->i_max));
   const dq_t l_rated = machine_flux(&drv->machine, i_rated);
   drv->torque_scale = machine_torque(&drv->machine, i_rated);
+  const dq_t l_pm = machine_flux(&drv->machine, (dq_t){0.0f, 0.0f});
+  drv->psi_pm = sqrtf(l_pm.d * l_pm.d + l_pm.q * l_pm.q);
+  const dq_t i_sc = machine_current(&drv->machine, (dq_t){0.0f, 0.0f});
+  drv->i_sc = sqrtf(i_sc.d * i_sc.d + i_sc.q * i_sc.q);
   drv->flux_scale = sqrtf(l_rated.d * l_rated.d + l_rated.q * l_rated.q);
   return 0;
 }
@@ -684,7 +694,7 @@ void drive_isr(drive_t *drv) {
     if (drv->cmd.law != drv->ctrl.law) {
       (void)ctrl_select(&drv->ctrl, drv->cmd.law); /* refused: the law in force stays */
     }
-    if (enable) {
+    if (enable && !drv->safe.asc) { /* the short first ends (drive_safe.c) */
       drv->offset_acc[0] = drv->offset_acc[1] = drv->offset_acc[2] = 0.0f;
       drv->offset_n = 0u;
       drv->pos_src->reset(&drv->pos_st);
@@ -702,6 +712,7 @@ void drive_isr(drive_t *drv) {
   case DRIVE_STATE_RUN:
     if (!enable) {
       drive_gates_off(drv);
+      drive_safe_leave_gates(drv);
       drv->state = DRIVE_STATE_IDLE;
     } else if (drv->state == DRIVE_STATE_ALIGN) {
       drive_align(drv, i, &s);
@@ -711,11 +722,11 @@ void drive_isr(drive_t *drv) {
     break;
   case DRIVE_STATE_FAULT:
   default:
-    hal_pwm_disable();
-    break;
+    break; /* all off or shorted: drive_safe_step */
   }
   if (!gates_on_state(drv->state)) {
     drv->v_applied = (ab_t){0.0f, 0.0f};
+    drive_safe_step(drv, i, &s);
   }
   drive_publish(drv, &s, i);
 }

@@ -98,6 +98,18 @@ typedef struct {
   uint32_t clear_mark[DRIVE_FAULT_COUNT];  /* fault_count at the last clear */
 } drive_cmd_t;
 
+/* The safe state while the gates do not modulate (idle, fault): all
+ * switches off, or the active short circuit (drive_safe.c). ISR-owned. */
+typedef struct {
+  bool decide;     /* the gates just left modulation: choose at this ISR */
+  bool asc;        /* active short circuit engaged */
+  float w_i;       /* electrical speed from the current vector's rotation [rad/s] */
+  float i_prev[2]; /* the previous current vector (alpha, beta) [A] */
+  uint32_t n;      /* periods since the short began */
+  uint32_t n_low;  /* consecutive periods below the exit speed */
+  uint32_t n_high; /* consecutive periods above the entry speed (gates off) */
+} drive_safe_t;
+
 typedef struct {
   /* ===== owned by the ISR ===== */
   drive_config_t cfg; /* in force */
@@ -175,7 +187,10 @@ typedef struct {
    * single instructions from the drive's base) ===== */
   uint32_t clear_seen; /* req.clear_count taken */
   uint32_t fault_seen[DRIVE_FAULT_COUNT];
-  int32_t i_sum_n; /* the current-sensor check's leaky count (drive.c) */
+  int32_t i_sum_n;   /* the current-sensor check's leaky count (drive.c) */
+  drive_safe_t safe; /* the safe state with the gates not modulating (drive_safe.c) */
+  float psi_pm;      /* |flux linkage at zero current| of the model [Vs] */
+  float i_sc;        /* |current at zero flux|: the steady short-circuit current at speed [A] */
 } drive_t;
 
 /* Validates cfg, initialises everything and latches DRIVE_FAULT_WATCHDOG

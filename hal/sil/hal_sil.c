@@ -59,11 +59,24 @@ void hal_pwm_enable(void) {
   /* Like TIM1 MOE: cannot be set while the break input is latched. */
   if (!bound->hw_tripped) {
     bound->gates_on = true;
+    bound->asc = false;
   }
 }
 
 void hal_pwm_disable(void) {
   bound->gates_on = false;
+  bound->asc = false;
+}
+
+void hal_pwm_short(void) {
+  if (!bound->hw_tripped) {
+    bound->gates_on = false;
+    bound->asc = true;
+  }
+}
+
+bool hal_pwm_is_shorted(void) {
+  return bound->asc;
 }
 
 bool hal_pwm_is_enabled(void) {

@@ -43,8 +43,9 @@ typedef struct {
   hal_pwm_t pwm;        /* preloaded pattern (acts from the next period) */
   uint32_t pwm_clamped; /* writes with a leg outside the duty range (caps): the
                          * drive asked for what the board cannot do */
-  bool gates_on;
-  bool hw_tripped; /* break input latch (set by the runner) */
+  bool gates_on;        /* modulating (the preloaded pattern) */
+  bool asc;             /* active short circuit: all low sides on (hal_pwm_short) */
+  bool hw_tripped;      /* break input latch (set by the runner) */
   uint32_t time_us;
   /* watchdog: the runner calls hal_sil_watchdog_expired() every period */
   uint32_t watchdog_timeout_us;

@@ -213,7 +213,20 @@ HOT void hal_pwm_write(const hal_pwm_t *p, hal_pwm_t *applied) {
   }
 }
 
+/* Output compare mode m on channels 1-3 (OCxM[2:0]; OCxM[3] stays 0; the
+ * mode is not preloaded: it acts at once), preload kept. */
+static void set_oc_modes(uint32_t m) {
+  const uint32_t mask = (7u << TIM_CCMR_OC1M_Pos) | (7u << (TIM_CCMR_OC1M_Pos + 8u));
+  TIM1->CCMR1 = (TIM1->CCMR1 & ~mask) | (m << TIM_CCMR_OC1M_Pos) | (m << (TIM_CCMR_OC1M_Pos + 8u));
+  TIM1->CCMR2 = (TIM1->CCMR2 & ~(7u << TIM_CCMR_OC1M_Pos)) | (m << TIM_CCMR_OC1M_Pos);
+}
+
+static bool oc_forced(void) {
+  return ((TIM1->CCMR1 >> TIM_CCMR_OC1M_Pos) & 7u) == TIM_OCM_FORCE_LOW;
+}
+
 void hal_pwm_enable(void) {
+  set_oc_modes(TIM_OCM_PWM2);
   TIM1->BDTR |= TIM_BDTR_MOE; /* refused by hardware while the break is active */
 }
 
@@ -222,7 +235,19 @@ HOT void hal_pwm_disable(void) {
 }
 
 bool hal_pwm_is_enabled(void) {
-  return (TIM1->BDTR & TIM_BDTR_MOE) != 0u;
+  return (TIM1->BDTR & TIM_BDTR_MOE) != 0u && !oc_forced();
+}
+
+/* ASC: OCxREF forced low (RM0440 28.6.7 OCxM = 0100), so OCx (high side)
+ * is inactive and the complementary OCxN (low side) active, after the dead
+ * time; MOE set (refused by hardware while the break is active). */
+void hal_pwm_short(void) {
+  set_oc_modes(TIM_OCM_FORCE_LOW);
+  TIM1->BDTR |= TIM_BDTR_MOE;
+}
+
+bool hal_pwm_is_shorted(void) {
+  return (TIM1->BDTR & TIM_BDTR_MOE) != 0u && oc_forced();
 }
 
 bool hal_fault_hw_tripped(void) {

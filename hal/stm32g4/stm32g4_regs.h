@@ -192,6 +192,7 @@ typedef struct {
 #define TIM_CCMR_OC2PE      (1u << 11)
 #define TIM_CCMR_OC2M_Pos   12u /* OC2M[2:0]; OC2M[3] is bit 24 */
 #define TIM_OCM_PWM2        7u
+#define TIM_OCM_FORCE_LOW   4u /* OCxREF forced low (inactive) */
 #define TIM_CCER_CC1E       (1u << 0)
 #define TIM_CCER_CC1P       (1u << 1)
 #define TIM_CCER_CC1NE      (1u << 2)

@@ -64,8 +64,9 @@ int plant_init(plant_t *pl, const plant_params_t *p, const char **field) {
                ? plant_mag_map(p->machine.map)
                : plant_mag_linear(p->machine.ld, p->machine.lq, p->machine.lambda_m);
   a->inv_j = 1.0 / p->mech.j;
-  a->inv_r = p->dclink.kind == PLANT_DC_RC ? 1.0 / p->dclink.r : 0.0;
-  a->inv_c = p->dclink.kind == PLANT_DC_RC ? 1.0 / p->dclink.c : 0.0;
+  a->inv_r = p->dclink.kind != PLANT_DC_IDEAL ? 1.0 / p->dclink.r : 0.0;
+  a->inv_c = p->dclink.kind != PLANT_DC_IDEAL ? 1.0 / p->dclink.c : 0.0;
+  a->one_way = p->dclink.kind == PLANT_DC_RECTIFIER;
   a->kdt = p->inverter.dead_time / p->ts;
   a->inv_ts = 1.0 / p->ts;
   plant_inverter_init(pl);
@@ -118,6 +119,7 @@ void plant_step_pattern(plant_t *pl, const double on_in[3], const double off_in[
   }
   const double ts = pl->p.ts;
   plant_mech_input_refresh(pl);
+  plant_dclink_chopper(pl);
   double x[X_N] = {pl->lambda_d, pl->lambda_q, pl->theta_m, pl->omega_m, pl->v_dc, 0, 0, 0, 0};
   const int avg = pl->p.inverter.model == PLANT_INV_AVERAGE;
   double cs_end[2] = {NAN, NAN}; /* cos, sin of the end angle (average model) */

@@ -59,13 +59,22 @@ typedef struct {
   int substeps;     /* integration steps per PWM period (average model), >= 1 */
 } plant_inverter_t;
 
-typedef enum { PLANT_DC_IDEAL, PLANT_DC_RC } plant_dc_kind_t;
+/* IDEAL: stiff source. RC: source behind r charging c, both ways.
+ * RECTIFIER: the same through a diode (a diode rectifier): the source only
+ * supplies, braking energy stays in c. An optional braking chopper (a
+ * resistor r_chop switched on above v_chop_on, off below v_chop_off, by
+ * the board's own comparator, decided at each period start) acts on RC and
+ * RECTIFIER links. */
+typedef enum { PLANT_DC_IDEAL, PLANT_DC_RC, PLANT_DC_RECTIFIER } plant_dc_kind_t;
 
 typedef struct {
   plant_dc_kind_t kind;
-  double v_source; /* source voltage [V] */
-  double r;        /* source resistance [Ohm] (RC only) */
-  double c;        /* DC-link capacitance [F] (RC only) */
+  double v_source;   /* source voltage [V] */
+  double r;          /* source resistance [Ohm] (RC only) */
+  double c;          /* DC-link capacitance [F] (RC only) */
+  double r_chop;     /* braking chopper resistance [Ohm], 0: none */
+  double v_chop_on;  /* the chopper switches on above [V] */
+  double v_chop_off; /* and off below [V] (< v_chop_on) */
 } plant_dclink_t;
 
 typedef enum { PLANT_MECH_FREE, PLANT_MECH_IMPOSED } plant_mech_mode_t;
@@ -162,6 +171,9 @@ typedef struct {
   /* constants */
   plant_mag_t mag;            /* the magnetic model (plant_magnetics.h) */
   double inv_j, inv_c, inv_r; /* 1/J, 1/C, 1/R */
+  int one_way;                /* the link's source only supplies (RECTIFIER) */
+  int chop_on;                /* the braking chopper conducts this period */
+  double g_chop;              /* its conductance this period [S] */
   double kdt;                 /* dead_time / ts */
   double inv_ts;              /* 1 / ts */
   double inv_band;  /* 1 / width of the smooth sign of the average-model dead time [1/A] */

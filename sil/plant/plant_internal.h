@@ -95,12 +95,22 @@ static inline double plant_dclink_voltage(const plant_t *pl, const double *x) {
   return x[X_VC] > 0.0 ? x[X_VC] : 0.0;
 }
 
-/* dv_C/dt for a current i_dc drawn by the inverter: C dv/dt = (Vs - v)/R - i_dc. */
+/* The source's current into the link at capacitor voltage v: (Vs - v)/R,
+ * not negative through a rectifier's diode. */
+static inline double plant_dclink_source(double vs, double v, double inv_r, int one_way) {
+  const double i = (vs - v) * inv_r;
+  return one_way && i < 0.0 ? 0.0 : i;
+}
+
+/* dv_C/dt for a current i_dc drawn by the inverter:
+ * C dv/dt = i_source(v) - v g_chop - i_dc. */
 static inline double plant_dclink_deriv(const plant_t *pl, const double *x, double idc) {
   if (pl->p.dclink.kind == PLANT_DC_IDEAL) {
     return 0.0;
   }
-  return ((pl->p.dclink.v_source - x[X_VC]) * pl->aux.inv_r - idc) * pl->aux.inv_c;
+  return (plant_dclink_source(pl->p.dclink.v_source, x[X_VC], pl->aux.inv_r, pl->aux.one_way) -
+          x[X_VC] * pl->aux.g_chop - idc) *
+         pl->aux.inv_c;
 }
 
 /* plant_machine.c */
@@ -132,6 +142,9 @@ void plant_inverter_sw_period(plant_t *pl, const double on[3], const double off[
 
 /* plant_dclink.c */
 int plant_dclink_check(const plant_dclink_t *d, const char **field);
+/* The braking chopper's state for the period starting now (hysteresis on
+ * the capacitor voltage). */
+void plant_dclink_chopper(plant_t *pl);
 
 /* plant_mech.c */
 int plant_mech_check(const plant_mech_t *m, const char **field);

@@ -64,7 +64,8 @@ static inline void stage_cos_sin(const angle_ref_t *r, double th, double *c, dou
 /* Constants of one period, in locals (no reloads through pl in the stages). */
 typedef struct {
   plant_mag_t mag;
-  double pp, rs, nb, b, inv_j, vsrc, inv_r, inv_c;
+  double pp, rs, nb, b, inv_j, vsrc, inv_r, inv_c, g_chop;
+  int one_way;        /* rectifier link */
   double d[3], kd[3]; /* duties; td/Ts for a switching leg (0 < d < 1), else 0 */
   int imposed, ideal; /* mech.mode == IMPOSED, dclink.kind == IDEAL */
 } avg_k_t;
@@ -110,7 +111,10 @@ static inline void avg_deriv(const avg_k_t *restrict k, int ideal, int imposed, 
     dx[X_W] = (te - k->b * x[X_W] - m) * k->inv_j;
   }
   const double idc = da * ia + db * ib + dc * ic;
-  dx[X_VC] = ideal ? 0.0 : ((k->vsrc - x[X_VC]) * k->inv_r - idc) * k->inv_c;
+  dx[X_VC] = ideal ? 0.0
+                   : (plant_dclink_source(k->vsrc, x[X_VC], k->inv_r, k->one_way) -
+                      x[X_VC] * k->g_chop - idc) *
+                         k->inv_c;
   dx[X_VA] = van;
   dx[X_VB] = vbn;
   dx[X_VN] = vn - 0.5 * vdc;
@@ -196,6 +200,8 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
   k.vsrc = p->dclink.v_source;
   k.inv_r = pl->aux.inv_r;
   k.inv_c = pl->aux.inv_c;
+  k.g_chop = pl->aux.g_chop;
+  k.one_way = pl->aux.one_way;
   for (int j = 0; j < 3; j++) {
     k.d[j] = duty[j];
     k.kd[j] = duty[j] > 0.0 && duty[j] < 1.0 ? pl->aux.kdt : 0.0;

@@ -124,7 +124,7 @@ static void fill_row(const sil_step_t *st, double *r) {
                     tm->duty[0],
                     tm->duty[1],
                     tm->duty[2],
-                    st->gates_on ? 1.0 : 0.0,
+                    st->gates_on ? 1.0 : (st->asc ? 2.0 : 0.0),
                     (double)tm->state,
                     (double)tm->faults,
                     p->theta_e,

@@ -453,8 +453,9 @@ static int parse_inverter(ctx_t *c, const cJSON *o, scenario_t *sc) {
 }
 
 static int parse_dclink(ctx_t *c, const cJSON *o, scenario_t *sc) {
-  static const char *const keys[] = {"kind", "voltage", "r", "c", NULL};
-  static const char *const kinds[] = {"ideal", "rc", NULL};
+  static const char *const keys[] = {"kind",      "voltage",    "r",           "c",
+                                     "chopper_r", "chopper_on", "chopper_off", NULL};
+  static const char *const kinds[] = {"ideal", "rc", "rectifier", NULL};
   if (check_keys(c, o, "dc_link", keys) != 0) {
     return -1;
   }
@@ -462,7 +463,10 @@ static int parse_dclink(ctx_t *c, const cJSON *o, scenario_t *sc) {
   if (get_enum(c, o, "dc_link", "kind", kinds, &kind) ||
       get_profile(c, o, "dc_link", "voltage", &sc->v_source) ||
       get_num(c, o, "dc_link", "r", 0.0, 1e6, &sc->plant.dclink.r) ||
-      get_num(c, o, "dc_link", "c", 0.0, 10.0, &sc->plant.dclink.c)) {
+      get_num(c, o, "dc_link", "c", 0.0, 10.0, &sc->plant.dclink.c) ||
+      get_num(c, o, "dc_link", "chopper_r", 0.0, 1e6, &sc->plant.dclink.r_chop) ||
+      get_num(c, o, "dc_link", "chopper_on", 0.0, 1e4, &sc->plant.dclink.v_chop_on) ||
+      get_num(c, o, "dc_link", "chopper_off", 0.0, 1e4, &sc->plant.dclink.v_chop_off)) {
     return -1;
   }
   sc->plant.dclink.kind = (plant_dc_kind_t)kind;
@@ -663,11 +667,24 @@ static int parse_references(ctx_t *c, const cJSON *o, scenario_t *sc) {
   return 0;
 }
 
+#define FAULT_NAME(E, n, d) #n,
 static int parse_inject(ctx_t *c, const cJSON *o, scenario_t *sc) {
-  static const char *const keys[] = {"encoder_error", "encoder_invalid", "main_stall", "isr_stall",
-                                     "cm_scale_d",    "cm_scale_q",      NULL};
+  static const char *const keys[] = {"encoder_error", "encoder_invalid", "main_stall",
+                                     "isr_stall",     "cm_scale_d",      "cm_scale_q",
+                                     "trip_at",       "trip_cause",      NULL};
+  static const char *const faults[] = {DRIVE_FAULT_LIST(FAULT_NAME) NULL};
   const char *P = "inject";
-  if (check_keys(c, o, P, keys) || get_profile(c, o, P, "encoder_error", &sc->encoder_error) ||
+  int cause = -1;
+  if (check_keys(c, o, P, keys) || get_num(c, o, P, "trip_at", 0.0, 1e6, &sc->trip_at) ||
+      get_enum(c, o, P, "trip_cause", faults, &cause)) {
+    return -1;
+  }
+  if ((cause >= 0) != (sc->trip_at > 0.0)) {
+    return fail(c, cause >= 0 ? "inject.trip_at" : "inject.trip_cause",
+                "trip_at (> 0) and trip_cause go together");
+  }
+  sc->trip_cause = cause >= 0 ? 1u << (unsigned)cause : 0u;
+  if (get_profile(c, o, P, "encoder_error", &sc->encoder_error) ||
       get_profile(c, o, P, "encoder_invalid", &sc->encoder_invalid) ||
       get_profile(c, o, P, "main_stall", &sc->main_stall) ||
       get_profile(c, o, P, "isr_stall", &sc->isr_stall) ||
@@ -755,6 +772,8 @@ static const char *scenario_key_of(const char *plant_field) {
                                        {"dclink.v_source", "dc_link.voltage"},
                                        {"dclink.r", "dc_link.r"},
                                        {"dclink.c", "dc_link.c"},
+                                       {"dclink.r_chop", "dc_link.chopper_r"},
+                                       {"dclink.v_chop_on", "dc_link.chopper_on"},
                                        {"mech.b", "mechanics.b"},
                                        {"mech.j", "mechanics.j"},
                                        {"mech.mode", "mechanics.mode"},

@@ -37,8 +37,12 @@ typedef struct {
   /* the controller's flux-map error (LIVE parameters cm_scale_d, cm_scale_q,
    * written by the main loop as over CAN when the profile changes) */
   profile_t cm_scale_d, cm_scale_q;
-  int log_decimation; /* log every n-th sample */
-  char map_file[512]; /* the flux map's file as resolved ("" for a linear machine) */
+  /* a fault the main loop posts once at trip_at (> 0; drive_request_fault):
+   * as if one of its own checks had found it */
+  double trip_at;
+  uint32_t trip_cause; /* fault bit mask, 0: none */
+  int log_decimation;  /* log every n-th sample */
+  char map_file[512];  /* the flux map's file as resolved ("" for a linear machine) */
 } scenario_t;
 
 /* Loads a scenario from JSON text; `origin` prefixes error messages (the

@@ -57,6 +57,11 @@ void sil_command_references(drive_t *drv, const scenario_t *sc, double t) {
   drive_cmd_speed(drv, (float)profile_eval(&sc->ref.speed, t));
   drive_cmd_current(drv, (float)profile_eval(&sc->ref.id, t), (float)profile_eval(&sc->ref.iq, t));
   drive_cmd_flux(drv, (float)profile_eval(&sc->ref.flux, t));
+  /* the injected trip, at the first main-loop period at or after trip_at */
+  if (sc->trip_cause != 0u && t >= sc->trip_at &&
+      t < sc->trip_at + (double)sc->drive.slow_div * sc->plant.ts) {
+    drive_request_fault(drv, sc->trip_cause);
+  }
   /* the controller's map error: a parameter write when the profile changes */
   if (sc->cm_scale_d.n > 0 || sc->cm_scale_q.n > 0) {
     drive_config_t cfg = *drive_requested_config(drv);
@@ -106,6 +111,7 @@ static int sil_start_firmware(sil_ctx_t *x, const scenario_t *sc, char *err, siz
  * outputs go idle), the firmware starts again from drive_init. */
 static int sil_reset_mcu(sil_ctx_t *x, const scenario_t *sc, char *err, size_t errlen) {
   x->hal.gates_on = false;
+  x->hal.asc = false;
   x->hal.reset_by_watchdog = true;
   x->hal.watchdog_last_us = x->hal.time_us;
   return sil_start_firmware(x, sc, err, errlen);
@@ -153,7 +159,12 @@ void sil_advance(sil_ctx_t *x, const scenario_t *sc, double t) {
    * with its star-point samples (gates on only) */
   const int n_star = x->hal.gates_on ? x->star_n : 0;
   plant_star_request(&x->plant, n_star, x->star_t);
-  plant_step_pattern(&x->plant, x->pwm_on, x->pwm_off, x->hal.gates_on);
+  if (x->hal.asc) { /* all low sides on for the whole period */
+    static const double low[3] = {0.0, 0.0, 0.0};
+    plant_step_pattern(&x->plant, low, low, true);
+  } else {
+    plant_step_pattern(&x->plant, x->pwm_on, x->pwm_off, x->hal.gates_on);
+  }
   double v[PLANT_STAR_MAX];
   x->star_got = plant_star_read(&x->plant, v);
   x->star_got_tv = x->star_tv;
@@ -171,13 +182,14 @@ void sil_advance(sil_ctx_t *x, const scenario_t *sc, double t) {
   }
   x->star_tv = x->hal.pwm.test_vector;
   /* hardware comparator: gates off in hardware, latched */
-  if (sc->hw_trip > 0.0 && x->hal.gates_on) {
+  if (sc->hw_trip > 0.0 && (x->hal.gates_on || x->hal.asc)) {
     plant_brief_t br;
     plant_get_brief(&x->plant, &br);
     if (fabs(br.i_abc[0]) > sc->hw_trip || fabs(br.i_abc[1]) > sc->hw_trip ||
         fabs(br.i_abc[2]) > sc->hw_trip) {
       x->hal.hw_tripped = true;
       x->hal.gates_on = false;
+      x->hal.asc = false;
     }
   }
 }
@@ -294,11 +306,17 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
       const float duty_active[3] = {(float)(x.pwm_off[0] - x.pwm_on[0]),
                                     (float)(x.pwm_off[1] - x.pwm_on[1]),
                                     (float)(x.pwm_off[2] - x.pwm_on[2])};
-      sil_step_t s = {k,           t,
-                      &st,         &x.hal.sample,
-                      &x.drv,      sc,
-                      duty_active, x.hal.gates_on,
-                      hw_in,       x.hal.timer_counts};
+      sil_step_t s = {k,
+                      t,
+                      &st,
+                      &x.hal.sample,
+                      &x.drv,
+                      sc,
+                      duty_active,
+                      x.hal.gates_on,
+                      x.hal.asc,
+                      hw_in,
+                      x.hal.timer_counts};
       obs(user, &s);
     }
     /* 4. plant over [t_k, t_k+1) */

@@ -46,6 +46,7 @@ typedef struct {
   const scenario_t *scenario;
   const float *duty_active; /* duties acting over [t_k, t_{k+1}) */
   bool gates_on;            /* gate state over [t_k, t_{k+1}) */
+  bool asc;                 /* active short circuit over [t_k, t_{k+1}) */
   bool hw_tripped;          /* the break input as ISR k found it */
   uint32_t timer_counts;    /* the SIL board's compare steps per period */
 } sil_step_t;

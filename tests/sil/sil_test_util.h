@@ -21,6 +21,7 @@ typedef struct {
   double *flux, *delta, *theta_err; /* true flux amplitude, load angle, used - true angle */
   double *duty_max;                 /* largest duty of the pattern the HAL applies */
   unsigned *faults, *state, *gates, *lc_cause;
+  unsigned *asc; /* active short circuit over [t_k, t_k+1) */
 } trace_t;
 
 static inline void trace_observer(void *user, const sil_step_t *st) {
@@ -58,6 +59,7 @@ static inline void trace_observer(void *user, const sil_step_t *st) {
   tr->faults[k] = st->drive->faults;
   tr->state[k] = st->drive->state;
   tr->gates[k] = st->gates_on;
+  tr->asc[k] = st->asc;
 }
 
 static inline void trace_alloc(trace_t *tr, size_t cap) {
@@ -71,7 +73,7 @@ static inline void trace_alloc(trace_t *tr, size_t cap) {
   for (size_t i = 0; i < sizeof d / sizeof d[0]; ++i) {
     *d[i] = calloc(cap, sizeof(double));
   }
-  unsigned **u[] = {&tr->faults, &tr->state, &tr->gates, &tr->lc_cause};
+  unsigned **u[] = {&tr->faults, &tr->state, &tr->gates, &tr->lc_cause, &tr->asc};
   for (size_t i = 0; i < sizeof u / sizeof u[0]; ++i) {
     *u[i] = calloc(cap, sizeof(unsigned));
   }
@@ -86,7 +88,7 @@ static inline void trace_free(trace_t *tr) {
   for (size_t i = 0; i < sizeof d / sizeof d[0]; ++i) {
     free(d[i]);
   }
-  unsigned *u[] = {tr->faults, tr->state, tr->gates, tr->lc_cause};
+  unsigned *u[] = {tr->faults, tr->state, tr->gates, tr->lc_cause, tr->asc};
   for (size_t i = 0; i < sizeof u / sizeof u[0]; ++i) {
     free(u[i]);
   }

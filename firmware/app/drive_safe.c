@@ -1,0 +1,166 @@
+/*
+ * drive_safe.c - the safe state while the gates do not modulate (idle and
+ * fault): all switches off, or the active short circuit (ASC, hal.h
+ * hal_pwm_short), issue 13 item 5, docs/faults.md "Safe state".
+ *
+ * With all switches off a PM machine turning faster than the rectifier
+ * speed, where the line-to-line back-EMF peak sqrt(3) psi_pm |w_e| exceeds
+ * v_dc, still drives current through the free-wheeling diodes: it brakes
+ * and charges the DC link, without limit if the link cannot return the
+ * energy (a diode rectifier, a cut supply). With all low sides on the
+ * back-EMF drives the short-circuit current in the windings only: at most
+ * psi_pm / L in steady state (about twice that in the transient), no
+ * energy into the link. So:
+ *  - when the gates leave modulation (a trip, a disable), the short is
+ *    chosen if sqrt(3) psi_pm |w_e| > asc_speed v_dc, if the link is over
+ *    SAFE_V_RATIO v_dc_max, or if the speed is not known (a position fault, a source
+ *    without a valid speed); otherwise all off;
+ *  - with all off, the short is engaged when the link goes over
+ *    SAFE_V_RATIO v_dc_max (ahead of the overvoltage trip),
+ *    or when a known speed (a source that runs with the gates off: the
+ *    encoder) stays above the entry speed for ENTRY_N periods;
+ *  - the short ends, after asc_hold, when the link is within that and
+ *    the speed stays below EXIT_RATIO times the entry speed for EXIT_N
+ *    periods. The speed is the source's if known, otherwise the rotation
+ *    of the short-circuit current vector, which turns at w_e whatever the
+ *    position sensor (after its offset decays with L/R: asc_hold);
+ *  - never on a machine whose short-circuit current at speed, the current
+ *    at zero flux i_sc (psi_pm / L_d on a linear machine), is not below
+ *    i_max: the short would hold more than the rated current for as long
+ *    as the load turns the rotor (and about twice it in the transient);
+ *    such a drive needs a braking chopper or a stiff link instead;
+ *  - never with the hardware break latched or after a fault that makes
+ *    the bridge itself suspect (hw_overcurrent: a switch may conduct
+ *    across the link, and the timer refuses MOE anyway), nor with
+ *    asc_speed = 0 (all off only, the former behaviour).
+ * An enable waits while the short is on (the offset calibration needs the
+ * gates off and no current). The functions live in flash (FD_COLD): they
+ * never run while the law does.
+ */
+#include "drive_safe.h"
+
+#include <math.h>
+
+#include "math/fast_trig.h"
+#include "math/fd_math.h"
+#include "math/frames.h"
+
+#define SAFE_SQRT3 1.7320508f
+/* the link level that engages the short, ahead of the overvoltage trip */
+#define SAFE_V_RATIO 0.95f
+#define ENTRY_N      16u    /* periods above the entry speed before the short */
+#define EXIT_N       16u    /* periods below the exit speed before all off */
+#define EXIT_RATIO   0.7f   /* exit speed / entry speed (hysteresis) */
+#define W_I_BW       300.0f /* bandwidth of the current-vector speed [rad/s] */
+#define I_FLOOR      0.02f  /* current vector too small to turn, times i_max */
+
+/* Faults after which the bridge is not trusted with a short. */
+#define SAFE_NO_ASC DRIVE_FAULT_HW_OVERCURRENT
+
+static bool asc_allowed(const drive_t *drv) {
+  return drv->cfg.asc_speed > 0.0f && drv->i_sc < drv->cfg.i_max &&
+         (drv->faults & SAFE_NO_ASC) == 0u && !hal_fault_hw_tripped();
+}
+
+/* The source's electrical speed when it is known with the gates off (or
+ * at the instant they went off), else -1. */
+static float known_speed(const drive_t *drv, bool at_trip) {
+  const bool gated = (drv->pos_src->caps & POS_CAP_GATED) != 0u;
+  if (!drv->pos.out.valid || (drv->faults & DRIVE_FAULT_POSITION) != 0u || (gated && !at_trip) ||
+      !fd_isfinite(drv->pos.out.omega)) {
+    return -1.0f;
+  }
+  return fabsf(drv->pos.out.omega);
+}
+
+static void start_short(drive_t *drv, const float i[3]) {
+  drive_safe_t *z = &drv->safe;
+  const ab_t a = frames_clarke((abc_t){i[0], i[1], i[2]});
+  z->asc = true;
+  z->n = 0u;
+  z->n_low = 0u;
+  z->w_i = 0.0f;
+  z->i_prev[0] = a.alpha;
+  z->i_prev[1] = a.beta;
+  hal_pwm_short();
+}
+
+static void end_short(drive_t *drv) {
+  drv->safe.asc = false;
+  drv->safe.n_high = 0u;
+  hal_pwm_disable();
+}
+
+/* The rotation rate of the current vector, low-pass filtered; 0 while
+ * the vector is too small to have a direction. */
+static void current_speed(drive_t *drv, const float i[3]) {
+  drive_safe_t *z = &drv->safe;
+  const ab_t a = frames_clarke((abc_t){i[0], i[1], i[2]});
+  const float floor2 = I_FLOOR * I_FLOOR * drv->cfg.i_max * drv->cfg.i_max;
+  const float m0 = z->i_prev[0] * z->i_prev[0] + z->i_prev[1] * z->i_prev[1];
+  const float m1 = a.alpha * a.alpha + a.beta * a.beta;
+  float w = 0.0f;
+  if (m0 > floor2 && m1 > floor2) {
+    const float cr = z->i_prev[0] * a.beta - z->i_prev[1] * a.alpha;
+    const float dt = z->i_prev[0] * a.alpha + z->i_prev[1] * a.beta;
+    w = fd_atan2f(cr, dt) / drv->cfg.ts;
+  }
+  if (fd_isfinite(w)) {
+    z->w_i += fd_minf(1.0f, W_I_BW * drv->cfg.ts) * (w - z->w_i);
+  }
+  z->i_prev[0] = a.alpha;
+  z->i_prev[1] = a.beta;
+}
+
+FD_COLD void drive_safe_leave_gates(drive_t *drv) {
+  drv->safe.decide = true;
+}
+
+FD_COLD void drive_safe_step(drive_t *drv, const float i[3], const hal_sample_t *s) {
+  drive_safe_t *z = &drv->safe;
+  const drive_config_t *c = &drv->cfg;
+  const bool finite_v = fd_isfinite(s->v_dc);
+  const bool over_v = finite_v && s->v_dc > SAFE_V_RATIO * c->v_dc_max;
+  /* back-EMF peak per rad/s against the link: the speed where the diodes rectify */
+  const float k_emf = SAFE_SQRT3 * drv->psi_pm;
+  const float v_entry = c->asc_speed * (finite_v ? fd_maxf(s->v_dc, 0.0f) : 0.0f);
+  if (!asc_allowed(drv)) {
+    z->decide = false;
+    if (z->asc || drv->state == DRIVE_STATE_FAULT) {
+      end_short(drv);
+    }
+    return;
+  }
+  if (z->decide) {
+    z->decide = false;
+    const float w = known_speed(drv, true);
+    if (over_v || w < 0.0f || k_emf * w > v_entry) {
+      start_short(drv, i);
+    }
+  }
+  if (!z->asc) {
+    if (drv->state == DRIVE_STATE_FAULT) {
+      hal_pwm_disable(); /* held off, whatever wrote the timer */
+    }
+    if (drv->state == DRIVE_STATE_OFFSET_CAL) {
+      return; /* entered with the short off; the gates stay off */
+    }
+    const float w = known_speed(drv, false);
+    z->n_high = (w >= 0.0f && k_emf * w > v_entry) ? z->n_high + 1u : 0u;
+    if (over_v || z->n_high >= ENTRY_N) {
+      start_short(drv, i);
+    }
+    return;
+  }
+  current_speed(drv, i);
+  z->n++;
+  const float wk = known_speed(drv, false);
+  const float w = wk >= 0.0f ? wk : fabsf(z->w_i);
+  const bool low = finite_v && !over_v && k_emf * w < EXIT_RATIO * v_entry;
+  z->n_low = low ? z->n_low + 1u : 0u;
+  if ((float)z->n * c->ts >= c->asc_hold && z->n_low >= EXIT_N) {
+    end_short(drv);
+    return;
+  }
+  hal_pwm_short(); /* held, as the gates-off state is (the break may have ended it) */
+}

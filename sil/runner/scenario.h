@@ -12,6 +12,7 @@
 #include "hal_sil.h"
 #include "plant.h"
 #include "profile.h"
+#include "sil_adc_faults.h"
 
 typedef struct {
   char name[96];
@@ -37,6 +38,9 @@ typedef struct {
   /* the controller's flux-map error (LIVE parameters cm_scale_d, cm_scale_q,
    * written by the main loop as over CAN when the profile changes) */
   profile_t cm_scale_d, cm_scale_q;
+  /* current-ADC channel faults (inject.current); the plant-parameter
+   * faults are in plant.faults (inject.rs_scale, ...) */
+  sil_adc_faults_t current_faults;
   int log_decimation; /* log every n-th sample */
   char map_file[512]; /* the flux map's file as resolved ("" for a linear machine) */
 } scenario_t;

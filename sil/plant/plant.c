@@ -17,15 +17,39 @@
 #include <math.h>
 #include <string.h>
 
+int plant_substeps_link(const plant_params_t *p) {
+  if (p->dclink.kind == PLANT_DC_IDEAL || !plant_finite_pos(p->dclink.r) ||
+      !plant_finite_pos(p->dclink.c)) {
+    return 1; /* no capacitor, or one plant_check refuses */
+  }
+  double lo = 1.0, hi = 1.0;
+  if (p->faults.c_scale.n > 0) {
+    profile_bounds(&p->faults.c_scale, &lo, &hi);
+  }
+  /* the chopper's resistance (when smaller) sets the faster pole */
+  const double r =
+      p->dclink.r_chop > 0.0 && p->dclink.r_chop < p->dclink.r ? p->dclink.r_chop : p->dclink.r;
+  const double n = ceil(p->ts / (PLANT_HC_MAX * r * p->dclink.c * lo));
+  if (!(n < 1e6)) { /* NaN, inf, a scale down to 0: beyond any limit */
+    return 1000000;
+  }
+  return n < 1.0 ? 1 : (int)n;
+}
+
 int plant_substeps_needed(const plant_params_t *p) {
   const double lmin = p->machine.map != NULL
                           ? plant_fluxmap_l_min(p->machine.map)
                           : (p->machine.ld < p->machine.lq ? p->machine.ld : p->machine.lq);
-  const double n = ceil(p->ts * p->machine.rs / (PLANT_HR_MAX * lmin));
+  double lo = 1.0, hi = 1.0;
+  if (p->faults.rs_scale.n > 0) {
+    profile_bounds(&p->faults.rs_scale, &lo, &hi);
+  }
+  const double n = ceil(p->ts * p->machine.rs * hi / (PLANT_HR_MAX * lmin));
   if (!(n < 1e6)) { /* NaN, inf: beyond any limit */
     return 1000000;
   }
-  return n < 1.0 ? 1 : (int)n;
+  const int nl = plant_substeps_link(p);
+  return n < 1.0 ? (nl > 1 ? nl : 1) : ((int)n > nl ? (int)n : nl);
 }
 
 int plant_check(const plant_params_t *p, const char **field) {
@@ -37,7 +61,8 @@ int plant_check(const plant_params_t *p, const char **field) {
   }
   if (plant_machine_check(&p->machine, f) != 0 ||
       plant_inverter_check(&p->inverter, p->ts, f) != 0 || plant_dclink_check(&p->dclink, f) != 0 ||
-      plant_mech_check(&p->mech, f) != 0 || plant_sensors_check(&p->sensors, f) != 0) {
+      plant_mech_check(&p->mech, f) != 0 || plant_sensors_check(&p->sensors, f) != 0 ||
+      plant_faults_check(p, f) != 0) {
     return -1;
   }
   if (p->inverter.substeps < plant_substeps_needed(p)) { /* unstable: NaN within periods */
@@ -89,6 +114,7 @@ int plant_init(plant_t *pl, const plant_params_t *p, const char **field) {
   pl->v_dc = p->dclink.v_source;
   a->cur.key[0] = NAN; /* no cached currents */
   plant_sensors_init(pl);
+  plant_faults_init(pl);
   return 0;
 }
 
@@ -119,6 +145,7 @@ void plant_step_pattern(plant_t *pl, const double on_in[3], const double off_in[
   }
   const double ts = pl->p.ts;
   plant_mech_input_refresh(pl);
+  plant_faults_period_start(pl);
   plant_dclink_chopper(pl);
   double x[X_N] = {pl->lambda_d, pl->lambda_q, pl->theta_m, pl->omega_m, pl->v_dc, 0, 0, 0, 0};
   const int avg = pl->p.inverter.model == PLANT_INV_AVERAGE;
@@ -133,6 +160,7 @@ void plant_step_pattern(plant_t *pl, const double on_in[3], const double off_in[
   } else {
     plant_inverter_sw_period(pl, on, off, gates_on, x);
   }
+  plant_faults_period_end(pl, x, cs_end);
   const double inv_ts = pl->aux.inv_ts;
   pl->v_abc_avg[0] = x[X_VA] * inv_ts;
   pl->v_abc_avg[1] = x[X_VB] * inv_ts;

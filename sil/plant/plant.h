@@ -109,13 +109,30 @@ typedef struct {
   uint32_t seed;          /* noise generator seed */
 } plant_sensors_t;
 
+/* Plant-parameter faults the controller is not told of (plant_faults.c).
+ * Profiles evaluated at each period start and held over the period (the
+ * RK4 stages see one set of parameters); a profile with no terms: none.
+ * Their bounds (profile_bounds) are checked: the scales stay positive (the
+ * PM's may reach 0), the friction terms non-negative. */
+typedef struct {
+  profile_t rs_scale;       /* R_s times this (winding temperature) */
+  profile_t lambda_m_scale; /* PM flux linkage times this (demagnetisation; linear machines) */
+  profile_t c_scale;        /* DC-link capacitance times this (capacitor loss; RC link) */
+  /* passive load (FREE mechanics): a friction that always opposes motion
+   * and never drives the rotor: Coulomb torque [N m] (at standstill it
+   * holds the rotor against a net torque up to its value) and viscous
+   * friction [N m s/rad] added to mech.b */
+  profile_t coulomb, viscous;
+} plant_faults_t;
+
 typedef struct {
   plant_machine_t machine;
   plant_inverter_t inverter;
   plant_dclink_t dclink;
   plant_mech_t mech;
   plant_sensors_t sensors;
-  double ts; /* PWM period [s] */
+  double ts;             /* PWM period [s] */
+  plant_faults_t faults; /* injected parameter faults */
 } plant_params_t;
 
 /* What the sensors deliver at the sampling instant (converted back to SI
@@ -198,7 +215,14 @@ typedef struct {
    * t in [m_t0, m_t1) */
   double m_val, m_t0, m_t1;
   plant_cur_cache_t cur;
-  int carry_n; /* periods since cur's cos/sin last came from libm */
+  int carry_n;
+  /* parameter faults (plant_faults.c): on at all, the nominal values they
+   * scale, the Coulomb torque of this period (added to the mechanical
+   * input), its direction of motion (+-1; 0: the rotor is held) */
+  int faults_on;
+  double rs0, lambda_m0, inv_c0, b0;
+  double fric, th_start;
+  int fric_dir; /* periods since cur's cos/sin last came from libm */
   /* sensor constants (plant_sensors.c) */
   double adc_levels, adc_ilsb, adc_vlsb, enc_step;
   /* ziggurat tables of the noise generator (plant_sensors.c) */
@@ -234,7 +258,17 @@ int plant_check(const plant_params_t *p, const char **field);
  * "inverter.substeps"). Needs a valid machine and ts. */
 #define PLANT_HR_MAX       0.5
 #define PLANT_SUBSTEPS_MAX 64
+/* The RC link's pole: h / (R C) <= PLANT_HC_MAX (RK4 is stable to 2.78;
+ * the default 0.1 Ohm, 470 uF link at 16 kHz is 1.33 with one step). With
+ * the faults, R_s and C at the extremes of their scale profiles' bounds. */
+#define PLANT_HC_MAX 2.0
+/* Largest scales of the parameter faults (plant_faults_t). */
+#define PLANT_RS_SCALE_MAX       4.0
+#define PLANT_LAMBDA_M_SCALE_MAX 2.0
+#define PLANT_C_SCALE_MAX        10.0
 int plant_substeps_needed(const plant_params_t *p);
+/* The RC link's share of it alone (1 for an ideal link). */
+int plant_substeps_link(const plant_params_t *p);
 /* Initialises (calls plant_check first). Returns 0 or the error. */
 int plant_init(plant_t *pl, const plant_params_t *p, const char **field);
 /* Advances one PWM period with the given duties (clamped to [0, 1]),

@@ -39,16 +39,17 @@ enum {
 };
 
 /* Mechanical input at time t: the imposed speed [rad/s] (IMPOSED) or the
- * load torque [N m] (FREE). Bit-identical to evaluating the profile; taken
+ * load torque [N m] (FREE), plus the passive load's Coulomb torque of the
+ * period (aux.fric, 0 unless injected; FREE only). Bit-identical to evaluating the profile; taken
  * from the span cache (plant_mech_input_refresh) while the profile is
  * constant. */
 static inline double plant_mech_input(const plant_t *pl, double t) {
   const plant_aux_t *a = &pl->aux;
   if (t >= a->m_t0 && t < a->m_t1) {
-    return a->m_val;
+    return a->m_val + a->fric;
   }
   const plant_mech_t *m = &pl->p.mech;
-  return profile_eval(m->mode == PLANT_MECH_IMPOSED ? &m->speed : &m->load_torque, t);
+  return profile_eval(m->mode == PLANT_MECH_IMPOSED ? &m->speed : &m->load_torque, t) + a->fric;
 }
 
 /* Refreshes the span cache of plant_mech_input when the period starting at
@@ -149,6 +150,15 @@ void plant_dclink_chopper(plant_t *pl);
 /* plant_mech.c */
 int plant_mech_check(const plant_mech_t *m, const char **field);
 void plant_mech_end_step(const plant_t *pl, double *x, double t_end);
+
+/* plant_faults.c: checks; the parameters of the period starting now (R_s,
+ * PM flux, 1/C, B, the Coulomb torque and its direction); the end of the
+ * period (a rotor the friction held or stopped: w = 0, never reversed;
+ * cs_end[0] = NAN when the angle was reset). */
+int plant_faults_check(const plant_params_t *p, const char **field);
+void plant_faults_init(plant_t *pl);
+void plant_faults_period_start(plant_t *pl);
+void plant_faults_period_end(plant_t *pl, double *x, double cs_end[2]);
 
 /* plant_sensors.c */
 int plant_sensors_check(const plant_sensors_t *s, const char **field);

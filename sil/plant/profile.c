@@ -70,6 +70,26 @@ double profile_eval_span(const profile_t *p, double t, double *t_end) {
   return profile_eval(p, t);
 }
 
+void profile_bounds(const profile_t *p, double *lo, double *hi) {
+  double l = 0.0, h = 0.0;
+  for (int i = 0; i < p->n; i++) {
+    const profile_term_t *k = &p->term[i];
+    const double v = k->kind == PROFILE_SINE ? fabs(k->value) : k->value;
+    if (k->kind == PROFILE_CONST) {
+      l += v;
+      h += v;
+    } else if (k->kind == PROFILE_SINE) {
+      l -= v;
+      h += v;
+    } else { /* step, ramp: between 0 and the value */
+      l += v < 0.0 ? v : 0.0;
+      h += v > 0.0 ? v : 0.0;
+    }
+  }
+  *lo = l;
+  *hi = h;
+}
+
 int profile_add(profile_t *p, profile_term_t term) {
   if (p->n < 0 || p->n >= PROFILE_MAX_TERMS) {
     return -1;

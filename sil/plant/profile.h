@@ -35,6 +35,11 @@ double profile_eval(const profile_t *p, double t);
  * before its start or after its end, a sine after its end). Lets callers
  * that evaluate a profile many times per period skip the evaluation. */
 double profile_eval_span(const profile_t *p, double t, double *t_end);
+/* Bounds every value of the profile can take, from its terms alone (a
+ * const term its value, a step or ramp between 0 and its value, a sine
+ * +-its amplitude, summed): lo <= profile_eval(p, t) <= hi for every t.
+ * No terms: 0, 0. */
+void profile_bounds(const profile_t *p, double *lo, double *hi);
 /* Appends a term; returns 0, or -1 when full. */
 int profile_add(profile_t *p, profile_term_t term);
 /* Validates term count, kinds and values (finite; ramp t1 > t0; sine

@@ -667,13 +667,97 @@ static int parse_references(ctx_t *c, const cJSON *o, scenario_t *sc) {
   return 0;
 }
 
+/* A profile whose every value (its terms' bounds, profile_bounds) lies in
+ * [lo, hi] ((lo, hi] with lo_open). */
+static int get_bounded_profile(ctx_t *c, const cJSON *o, const char *path, const char *key,
+                               double lo, int lo_open, double hi, profile_t *pr) {
+  if (get_profile(c, o, path, key, pr) != 0) {
+    return -1;
+  }
+  if (cJSON_GetObjectItemCaseSensitive(o, key) == NULL) {
+    return 0;
+  }
+  double l, h;
+  profile_bounds(pr, &l, &h);
+  if ((lo_open ? !(l > lo) : !(l >= lo)) || !(h <= hi)) {
+    char p[160];
+    join(p, sizeof p, path, key);
+    return fail(c, p, "must stay in %s%g, %g] at all times (its terms reach [%g, %g])",
+                lo_open ? "(" : "[", lo, hi, l, h);
+  }
+  return 0;
+}
+
+/* inject.current: an array of current-ADC channel faults. */
+static int parse_current_faults(ctx_t *c, const cJSON *arr, scenario_t *sc) {
+  static const char *const keys[] = {"channel", "kind", "active", "value", NULL};
+  static const char *const channels[] = {"a", "b", "c", NULL};
+  const char *kinds[SIL_ADC_KIND_COUNT + 1];
+  for (int k = 0; k <= (int)SIL_ADC_KIND_COUNT; ++k) {
+    kinds[k] = sil_adc_kind_name(k);
+  }
+  if (!cJSON_IsArray(arr)) {
+    return fail(c, "inject.current", "must be an array of channel faults");
+  }
+  sil_adc_faults_t *fs = &sc->current_faults;
+  const double fsc = sc->plant.sensors.i_full_scale;
+  int i = 0;
+  for (const cJSON *it = arr->child; it != NULL; it = it->next, ++i) {
+    char p[64];
+    snprintf(p, sizeof p, "inject.current[%d]", i);
+    if (i >= SIL_ADC_FAULTS_MAX) {
+      return fail(c, p, "too many channel faults (at most %d)", SIL_ADC_FAULTS_MAX);
+    }
+    sil_adc_fault_t *f = &fs->f[i];
+    *f = (sil_adc_fault_t){.channel = -1, .kind = SIL_ADC_KIND_COUNT};
+    int ch = -1, kind = -1;
+    if (check_keys(c, it, p, keys) || get_enum(c, it, p, "channel", channels, &ch) ||
+        get_enum(c, it, p, "kind", kinds, &kind) || get_profile(c, it, p, "active", &f->active)) {
+      return -1;
+    }
+    char q[80];
+    if (ch < 0) {
+      join(q, sizeof q, p, "channel");
+      return fail(c, q, "required (a, b or c)");
+    }
+    if (kind < 0) {
+      join(q, sizeof q, p, "kind");
+      return fail(c, q, "required (stuck, frozen, nan, invalid, offset or gain)");
+    }
+    f->channel = ch;
+    f->kind = (sil_adc_kind_t)kind;
+    const bool has = cJSON_GetObjectItemCaseSensitive(it, "value") != NULL;
+    join(q, sizeof q, p, "value");
+    if (sil_adc_kind_has_value(f->kind) != has) {
+      return fail(c, q, has ? "not taken by kind \"%s\"" : "required for kind \"%s\"",
+                  sil_adc_kind_name(kind));
+    }
+    if (has) {
+      const bool gain = f->kind == SIL_ADC_GAIN;
+      /* a stuck or drifting channel reads within its ADC's range; a gain
+       * from 0 (dead) to 10 times */
+      if (get_bounded_profile(c, it, p, "value", gain ? -1.0 : -fsc, 0, gain ? 9.0 : fsc,
+                              &f->value) != 0) {
+        return -1;
+      }
+    }
+    fs->n = i + 1;
+  }
+  return 0;
+}
+
 #define FAULT_NAME(E, n, d) #n,
 static int parse_inject(ctx_t *c, const cJSON *o, scenario_t *sc) {
-  static const char *const keys[] = {"encoder_error", "encoder_invalid", "main_stall",
-                                     "isr_stall",     "cm_scale_d",      "cm_scale_q",
-                                     "trip_at",       "trip_cause",      NULL};
+  static const char *const keys[] = {"encoder_error",  "encoder_invalid",
+                                     "main_stall",     "isr_stall",
+                                     "cm_scale_d",     "cm_scale_q",
+                                     "current",        "rs_scale",
+                                     "lambda_m_scale", "c_scale",
+                                     "passive_load",   "trip_at",
+                                     "trip_cause",     NULL};
   static const char *const faults[] = {DRIVE_FAULT_LIST(FAULT_NAME) NULL};
   const char *P = "inject";
+  plant_faults_t *pf = &sc->plant.faults;
   int cause = -1;
   if (check_keys(c, o, P, keys) || get_num(c, o, P, "trip_at", 0.0, 1e6, &sc->trip_at) ||
       get_enum(c, o, P, "trip_cause", faults, &cause)) {
@@ -689,8 +773,38 @@ static int parse_inject(ctx_t *c, const cJSON *o, scenario_t *sc) {
       get_profile(c, o, P, "main_stall", &sc->main_stall) ||
       get_profile(c, o, P, "isr_stall", &sc->isr_stall) ||
       get_profile(c, o, P, "cm_scale_d", &sc->cm_scale_d) ||
-      get_profile(c, o, P, "cm_scale_q", &sc->cm_scale_q)) {
+      get_profile(c, o, P, "cm_scale_q", &sc->cm_scale_q) ||
+      get_bounded_profile(c, o, P, "rs_scale", 0.0, 1, PLANT_RS_SCALE_MAX, &pf->rs_scale) ||
+      get_bounded_profile(c, o, P, "lambda_m_scale", 0.0, 0, PLANT_LAMBDA_M_SCALE_MAX,
+                          &pf->lambda_m_scale) ||
+      get_bounded_profile(c, o, P, "c_scale", 0.0, 1, PLANT_C_SCALE_MAX, &pf->c_scale)) {
     return -1;
+  }
+  const cJSON *cur = cJSON_GetObjectItemCaseSensitive(o, "current");
+  if (cur != NULL && parse_current_faults(c, cur, sc) != 0) {
+    return -1;
+  }
+  const cJSON *pl = cJSON_GetObjectItemCaseSensitive(o, "passive_load");
+  if (pl != NULL) {
+    static const char *const lkeys[] = {"coulomb", "viscous", NULL};
+    const char *L = "inject.passive_load";
+    if (check_keys(c, pl, L, lkeys) ||
+        get_bounded_profile(c, pl, L, "coulomb", 0.0, 0, 1e6, &pf->coulomb) ||
+        get_bounded_profile(c, pl, L, "viscous", 0.0, 0, 1e6, &pf->viscous)) {
+      return -1;
+    }
+    if (sc->plant.mech.mode != PLANT_MECH_FREE) {
+      return fail(c, L, "needs mechanics.mode \"free\" (a dynamometer imposes the speed)");
+    }
+  }
+  if (pf->lambda_m_scale.n > 0 && sc->plant.machine.map != NULL) {
+    return fail(c, "inject.lambda_m_scale",
+                "a flux-map machine's PM flux is inside its map (saturated with the currents): "
+                "give the demagnetised machine as its own map (machine.map)");
+  }
+  if (pf->c_scale.n > 0 && sc->plant.dclink.kind == PLANT_DC_IDEAL) {
+    return fail(c, "inject.c_scale",
+                "needs dc_link.kind \"rc\" or \"rectifier\" (an ideal link has no capacitor)");
   }
   return 0;
 }
@@ -778,7 +892,12 @@ static const char *scenario_key_of(const char *plant_field) {
                                        {"mech.j", "mechanics.j"},
                                        {"mech.mode", "mechanics.mode"},
                                        {"mech.omega0", "mechanics.speed0"},
-                                       {"mech.theta0", "mechanics.theta0"}};
+                                       {"mech.theta0", "mechanics.theta0"},
+                                       {"faults.rs_scale", "inject.rs_scale"},
+                                       {"faults.lambda_m_scale", "inject.lambda_m_scale"},
+                                       {"faults.c_scale", "inject.c_scale"},
+                                       {"faults.coulomb", "inject.passive_load.coulomb"},
+                                       {"faults.viscous", "inject.passive_load.viscous"}};
   for (size_t i = 0; i < sizeof map / sizeof map[0]; ++i) {
     if (strcmp(plant_field, map[i][0]) == 0) {
       return map[i][1];
@@ -798,6 +917,13 @@ static int resolve_substeps(ctx_t *c, scenario_t *sc) {
                           ? plant_fluxmap_l_min(p->machine.map)
                           : (p->machine.ld < p->machine.lq ? p->machine.ld : p->machine.lq);
   if (p->inverter.substeps == 0) {
+    if (need > PLANT_SUBSTEPS_MAX && plant_substeps_link(p) >= need) {
+      return fail(c, p->faults.c_scale.n > 0 ? "inject.c_scale" : "dc_link.c",
+                  "the plant cannot integrate this DC link at this PWM period: its time constant "
+                  "R C (at the smallest capacitance) needs %d integration steps per period, at "
+                  "most %d",
+                  need, PLANT_SUBSTEPS_MAX);
+    }
     if (need > PLANT_SUBSTEPS_MAX) {
       const char *key = p->machine.map != NULL           ? "machine.map"
                         : c->ls_given                    ? "machine.ls"

@@ -12,6 +12,7 @@
 #include "hal_sil.h"
 #include "plant.h"
 #include "profile.h"
+#include "sil_adc_faults.h"
 
 typedef struct {
   char name[96];
@@ -41,8 +42,11 @@ typedef struct {
    * as if one of its own checks had found it */
   double trip_at;
   uint32_t trip_cause; /* fault bit mask, 0: none */
-  int log_decimation;  /* log every n-th sample */
-  char map_file[512];  /* the flux map's file as resolved ("" for a linear machine) */
+  /* current-ADC channel faults (inject.current); the plant-parameter
+   * faults are in plant.faults (inject.rs_scale, ...) */
+  sil_adc_faults_t current_faults;
+  int log_decimation; /* log every n-th sample */
+  char map_file[512]; /* the flux map's file as resolved ("" for a linear machine) */
 } scenario_t;
 
 /* Loads a scenario from JSON text; `origin` prefixes error messages (the

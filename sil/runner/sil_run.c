@@ -138,6 +138,7 @@ int sil_setup(sil_ctx_t *x, const scenario_t *sc, char *err, size_t errlen) {
   x->enc_err_end = -INFINITY;
   x->v_src = 0.0;
   x->v_src_end = -INFINITY;
+  sil_adc_faults_reset(&x->adc_faults);
   return 0;
 }
 
@@ -148,6 +149,10 @@ void sil_sample(sil_ctx_t *x, const scenario_t *sc, double t) {
     x->enc_err = profile_eval_span(&sc->encoder_error, t, &x->enc_err_end);
   }
   to_hal_sample(&adc, x, x->enc_err, !injected(&sc->encoder_invalid, t), &x->hal.sample);
+  if (sc->current_faults.n > 0) {
+    sil_adc_faults_apply(&sc->current_faults, &x->adc_faults, t, sc->plant.sensors.i_full_scale,
+                         &x->hal.sample);
+  }
 }
 
 void sil_advance(sil_ctx_t *x, const scenario_t *sc, double t) {

@@ -14,7 +14,9 @@
  *   4. the plant advances over [t_k, t_{k+1}) with the pattern preloaded by
  *      ISR k-1 (the one-period command delay of the timing model).
  * Injected failures (scenario "inject"): main_stall skips step 0,
- * isr_stall skips step 2, encoder_invalid marks the encoder sample invalid.
+ * isr_stall skips step 2, encoder_invalid marks the encoder sample invalid,
+ * current (sil_adc_faults.h) alters the current channels of step 1; the
+ * plant-parameter faults act inside the plant (plant_faults_t).
  *
  * With CAN (sil_opts_t.can, fluxdrive-sil --can): at step 0 the transport
  * moves frames from the bus into the HAL queue, can_proto_poll() handles
@@ -106,6 +108,7 @@ typedef struct {
   uint8_t star_got_tv;
   double enc_err, enc_err_end; /* encoder error profile, constant until _end */
   double v_src, v_src_end;     /* DC source profile, constant until _end */
+  sil_adc_state_t adc_faults;  /* the current-ADC faults' memory */
 } sil_ctx_t;
 
 /* Plant, HAL and drive from the scenario; 0 or -1 with the message. */

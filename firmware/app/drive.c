@@ -9,6 +9,7 @@
  * side of the concurrency contract is drive_host.c.
  */
 #include "drive.h"
+#include "drive_pos_check.h"
 #include "drive_safe.h"
 #include "drive_sync.h"
 
@@ -35,7 +36,7 @@ static void drive_gates_off(const drive_t *drv) {
 
 /* A fault: gates off now (unless already shorted), the safe state chosen
  * in this ISR (drive_safe.c), the cause latched. */
-static void drive_trip(drive_t *drv, uint32_t bits) {
+static FD_NOINLINE void drive_trip(drive_t *drv, uint32_t bits) {
   if (!drv->safe.asc) {
     drive_gates_off(drv);
     drive_safe_leave_gates(drv);
@@ -186,8 +187,10 @@ FD_COLD static int drive_configure(drive_t *drv, const drive_config_t *cfg, driv
   drv->torque_scale = machine_torque(&drv->machine, i_rated);
   const dq_t l_pm = machine_flux(&drv->machine, (dq_t){0.0f, 0.0f});
   drv->psi_pm = sqrtf(l_pm.d * l_pm.d + l_pm.q * l_pm.q);
+  drv->psi0 = l_pm;
   const dq_t i_sc = machine_current(&drv->machine, (dq_t){0.0f, 0.0f});
   drv->i_sc = sqrtf(i_sc.d * i_sc.d + i_sc.q * i_sc.q);
+  drv->asc_psi_max = drive_safe_psi_max(drv);
   drv->flux_scale = sqrtf(l_rated.d * l_rated.d + l_rated.q * l_rated.q);
   return 0;
 }
@@ -499,9 +502,22 @@ static FD_NOINLINE void drive_current_sum_check(drive_t *drv) {
   }
 }
 
+/* The position plausibility check, half a slow period after the speed
+ * loop (the worst-case ISR does not carry both). */
+static FD_NOINLINE void drive_pos_check_step(drive_t *drv) {
+  const uint32_t pf = drive_pos_check(drv);
+  if (pf != 0u) {
+    drive_trip(drv, pf);
+  }
+}
+
 static void drive_speed_loop(drive_t *drv) {
   const drive_config_t *c = &drv->cfg;
-  if ((drv->isr_count - 1u) % c->slow_div != 0u) {
+  const uint32_t phase = (drv->isr_count - 1u) % c->slow_div;
+  if (phase == c->slow_div / 2u) {
+    drive_pos_check_step(drv);
+  }
+  if (phase != 0u) {
     return;
   }
   drive_current_sum_check(drv);

@@ -112,9 +112,6 @@ typedef struct {
 
 typedef struct {
   /* ===== owned by the ISR ===== */
-  drive_config_t cfg; /* in force */
-  machine_t machine;
-  flux_map_t map; /* cfg's flux map, parsed (machine.map points here) */
   const hal_caps_t *caps;
   drive_state_t state;
   uint32_t faults;
@@ -161,6 +158,14 @@ typedef struct {
   float win_m[3];         /* the window pattern in force: phase moments (dfc_window.h) */
   float win_k;            /* Ts / L of their current correction [s/H] */
 
+  /* the parameter set in force and its machine (after the per-period
+   * state: a parameter added to the table does not move that state's
+   * fields beyond the Cortex-M's short load offsets; the code reaches the
+   * set through a pointer of its own) */
+  drive_config_t cfg; /* in force */
+  machine_t machine;
+  flux_map_t map; /* cfg's flux map, parsed (machine.map points here) */
+
   /* telemetry, under a sequence lock */
   volatile uint32_t tm_seq;
   drive_telemetry_t tm;
@@ -190,7 +195,13 @@ typedef struct {
   int32_t i_sum_n;   /* the current-sensor check's leaky count (drive.c) */
   drive_safe_t safe; /* the safe state with the gates not modulating (drive_safe.c) */
   float psi_pm;      /* |flux linkage at zero current| of the model [Vs] */
+  dq_t psi0;         /* that flux linkage [Vs] */
+  float asc_psi_max; /* largest stator flux a short may trap (drive_safe_psi_max) [Vs] */
   float i_sc;        /* |current at zero flux|: the steady short-circuit current at speed [A] */
+  int32_t pos_chk_n; /* the position plausibility check's leaky count (drive_pos_check.c) */
+  float pos_emf_res; /* its residual / tolerance at the last check (logs) */
+  dq_t pos_psi;      /* the model flux at the last check [Vs] */
+  bool pos_psi_ok;   /* ... taken in this run */
 } drive_t;
 
 /* Validates cfg, initialises everything and latches DRIVE_FAULT_WATCHDOG

@@ -89,6 +89,8 @@
     "safe state: active short circuit above asc_speed times the rectifier speed v_dc/(sqrt(3) psi_pm), or on overvoltage; 0: gates off only (docs/faults.md)") \
   X(121, asc_hold,      F32,  "s",      0.05f,       1e-3f,   10.0f,    LIVE, "controller.asc_hold",       \
     "safe state: shortest active short circuit (its current transient decays before the speed is judged from the current vector)") \
+  X(122, pos_emf_tol,   F32,  "",       0.5f,        0.0f,    10.0f,    LIVE, "controller.pos_emf_tol",    \
+    "position plausibility (encoder): trips position when the applied voltage differs from the model's at the source's angle by more than pos_emf_tol (back-EMF + R i) + 5 % v_dc; 0: off") \
   X(26, lc_track_time,  F32,  "s",      0.02f,       1e-4f,   1.0f,     LIVE, "controller.lc_track_time",  \
     "loss of control: time a tracking condition may persist (a reversal at the voltage limit takes ms)")   \
   /* controller */                                                                                          \

@@ -29,6 +29,10 @@
  *    i_max: the short would hold more than the rated current for as long
  *    as the load turns the rotor (and about twice it in the transient);
  *    such a drive needs a braking chopper or a stiff link instead;
+ *  - never when the stator flux the short would trap, bounded from the
+ *    current's amplitude, drives a current beyond i_trip in some rotor
+ *    position (drive_safe_psi_max: a reluctance machine's flux along its
+ *    low inductance);
  *  - never with the hardware break latched or after a fault that makes
  *    the bridge itself suspect (hw_overcurrent: a switch may conduct
  *    across the link, and the timer refuses MOE anyway), nor with
@@ -73,9 +77,73 @@ static float known_speed(const drive_t *drv, bool at_trip) {
   return fabsf(drv->pos.out.omega);
 }
 
-static void start_short(drive_t *drv, const float i[3]) {
+/* Largest |f(r e^{j phi})| over RING_N directions: f = machine_current
+ * (flux to current) or machine_flux (current to flux). */
+#define RING_N 8
+static float ring_max(const machine_t *m, float r, bool current) {
+  static const float cs[RING_N][2] = {
+      {1.0f, 0.0f},  {0.70710678f, 0.70710678f},   {0.0f, 1.0f},  {-0.70710678f, 0.70710678f},
+      {-1.0f, 0.0f}, {-0.70710678f, -0.70710678f}, {0.0f, -1.0f}, {0.70710678f, -0.70710678f}};
+  float best = 0.0f;
+  for (unsigned k = 0; k < RING_N; ++k) {
+    const dq_t x = {r * cs[k][0], r * cs[k][1]};
+    const dq_t y = current ? machine_current(m, x) : machine_flux(m, x);
+    best = fd_maxf(best, sqrtf(y.d * y.d + y.q * y.q));
+  }
+  return best;
+}
+
+/* The short traps the stator flux psi_0 it begins with; in the rotor frame
+ * it turns backwards at w_e while it decays (to the flux of i_sc), so the
+ * current passes |i(psi)| for |psi| = |psi_0| in every direction. The
+ * largest |psi_0| whose ring stays within i_trip (bisection, at
+ * configuration): a reluctance machine's trapped flux along its low
+ * inductance would otherwise drive a current far beyond the trip. */
+FD_COLD float drive_safe_psi_max(const drive_t *drv) {
+  float lo = 0.0f, hi = 4.0f * (drv->psi_pm + drv->flux_scale);
+  if (ring_max(&drv->machine, hi, true) <= drv->cfg.i_trip) {
+    return hi;
+  }
+  for (unsigned k = 0; k < 12u; ++k) {
+    const float mid = 0.5f * (lo + hi);
+    if (ring_max(&drv->machine, mid, true) <= drv->cfg.i_trip) {
+      lo = mid;
+    } else {
+      hi = mid;
+    }
+  }
+  return lo;
+}
+
+/* The stator flux a short would trap now: the model's at the last run
+ * period's rotor-frame currents when the gates just left modulation with
+ * the angle known; else the law's observed flux when it has an observer
+ * (the DFVC laws: a voltage model, independent of the position at speed);
+ * else bounded from the current's amplitude in any direction. */
+static float trapped_flux(const drive_t *drv, float amp, bool from_run, bool angle_known) {
+  const bool ran = drv->tm.state == DRIVE_STATE_RUN;
+  if (from_run && ran && angle_known) {
+    const dq_t l = machine_flux(&drv->machine, (dq_t){drv->tm.i_dq[0], drv->tm.i_dq[1]});
+    return sqrtf(l.d * l.d + l.q * l.q);
+  }
+  const float obs = drv->tm.law_tm.flux;
+  if (from_run && ran && (drv->ctrl.impl->caps & CTRL_CAP_FLUX) != 0u && fd_isfinite(obs) &&
+      obs > 0.0f) {
+    return obs;
+  }
+  return ring_max(&drv->machine, amp, false);
+}
+
+/* Starts the short unless the flux it would trap exceeds asc_psi_max:
+ * then all off. */
+static void start_short(drive_t *drv, const float i[3], bool from_run, bool angle_known) {
   drive_safe_t *z = &drv->safe;
   const ab_t a = frames_clarke((abc_t){i[0], i[1], i[2]});
+  const float amp = sqrtf(a.alpha * a.alpha + a.beta * a.beta);
+  const float psi = trapped_flux(drv, amp, from_run, angle_known);
+  if (!fd_isfinite(amp) || !(psi <= drv->asc_psi_max)) {
+    return;
+  }
   z->asc = true;
   z->n = 0u;
   z->n_low = 0u;
@@ -135,7 +203,7 @@ FD_COLD void drive_safe_step(drive_t *drv, const float i[3], const hal_sample_t 
     z->decide = false;
     const float w = known_speed(drv, true);
     if (over_v || w < 0.0f || k_emf * w > v_entry) {
-      start_short(drv, i);
+      start_short(drv, i, true, w >= 0.0f);
     }
   }
   if (!z->asc) {
@@ -148,7 +216,7 @@ FD_COLD void drive_safe_step(drive_t *drv, const float i[3], const hal_sample_t 
     const float w = known_speed(drv, false);
     z->n_high = (w >= 0.0f && k_emf * w > v_entry) ? z->n_high + 1u : 0u;
     if (over_v || z->n_high >= ENTRY_N) {
-      start_short(drv, i);
+      start_short(drv, i, false, false);
     }
     return;
   }

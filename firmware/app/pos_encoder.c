@@ -71,5 +71,19 @@ static void enc_align(pos_state_t *s, const drive_config_t *cfg, const hal_sampl
   s->enc.started = false;
 }
 
+/* Counts enough to commutate: 8 per electrical revolution (45 degrees
+ * electrical per count; the PLL interpolates between them at speed). An
+ * encoder of 16 counts on Rubino's 21 pole pairs has less than one count
+ * per electrical revolution: the drive cannot even tell the sector. */
+#define ENC_MIN_COUNTS_PER_E_REV 8.0f
+FD_COLD static const char *enc_check(const drive_config_t *cfg, const char **field) {
+  if (cfg->enc_cpr > 0u && (float)cfg->enc_cpr < ENC_MIN_COUNTS_PER_E_REV * cfg->pole_pairs) {
+    *field = "enc_cpr";
+    return "too few encoder counts to commutate: at least 8 per electrical revolution "
+           "(enc_cpr >= 8 pole_pairs; 0: an unquantised angle)";
+  }
+  return NULL;
+}
+
 const pos_source_row_t pos_source_encoder = {POS_CAP_ALIGN, enc_init,  enc_reset,
-                                             enc_update,    enc_align, NULL};
+                                             enc_update,    enc_align, enc_check};

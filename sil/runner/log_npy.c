@@ -68,7 +68,8 @@ static const char *const signals[] = {"t",
                                       "load_torque_est",
                                       "rls_a",
                                       "rls_b",
-                                      "kf_r"};
+                                      "kf_r",
+                                      "pos_emf_res"};
 enum { NSIG = sizeof signals / sizeof signals[0], HEADER_LEN = 4096 };
 
 static void fill_row(const sil_step_t *st, double *r) {
@@ -157,7 +158,8 @@ static void fill_row(const sil_step_t *st, double *r) {
                     tm->load_est,
                     rls ? (double)st->drive->pos_st.dfc.dc.a : 0.0,
                     rls ? (double)st->drive->pos_st.dfc.dc.b : 0.0,
-                    dfc ? (double)st->drive->pos_st.dfc.r : 0.0};
+                    dfc ? (double)st->drive->pos_st.dfc.r : 0.0,
+                    st->drive->pos_emf_res};
   memcpy(r, v, sizeof v);
 }
 

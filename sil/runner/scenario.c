@@ -746,15 +746,33 @@ static int parse_current_faults(ctx_t *c, const cJSON *arr, scenario_t *sc) {
   return 0;
 }
 
+/* inject.encoder: the encoder's faults (sil_enc_faults.h). */
+static int parse_encoder_faults(ctx_t *c, const cJSON *o, scenario_t *sc) {
+  static const char *const keys[] = {"frozen", "reversed", "jitter", "missing", "seed", NULL};
+  const char *E = "inject.encoder";
+  sil_enc_faults_t *f = &sc->encoder_faults;
+  int seed = 1;
+  if (check_keys(c, o, E, keys) || get_profile(c, o, E, "frozen", &f->frozen) ||
+      get_profile(c, o, E, "reversed", &f->reversed) ||
+      get_num(c, o, E, "jitter", 0.0, 1e-3, &f->jitter) ||
+      get_num(c, o, E, "missing", 0.0, 0.5, &f->missing) ||
+      get_int(c, o, E, "seed", 0, 2147483647, &seed)) {
+    return -1;
+  }
+  f->seed = (uint32_t)seed;
+  if (f->missing > 0.0 && sc->plant.sensors.encoder_cpr <= 0) {
+    return fail(c, "inject.encoder.missing",
+                "needs counts to lose: sensors.encoder_cpr > 0 (0 is an ideal encoder)");
+  }
+  return 0;
+}
+
 #define FAULT_NAME(E, n, d) #n,
 static int parse_inject(ctx_t *c, const cJSON *o, scenario_t *sc) {
-  static const char *const keys[] = {"encoder_error",  "encoder_invalid",
-                                     "main_stall",     "isr_stall",
-                                     "cm_scale_d",     "cm_scale_q",
-                                     "current",        "rs_scale",
-                                     "lambda_m_scale", "c_scale",
-                                     "passive_load",   "trip_at",
-                                     "trip_cause",     NULL};
+  static const char *const keys[] = {
+      "encoder_error", "encoder_invalid", "main_stall", "isr_stall",      "cm_scale_d",
+      "cm_scale_q",    "current",         "rs_scale",   "lambda_m_scale", "c_scale",
+      "passive_load",  "trip_at",         "trip_cause", "encoder",        NULL};
   static const char *const faults[] = {DRIVE_FAULT_LIST(FAULT_NAME) NULL};
   const char *P = "inject";
   plant_faults_t *pf = &sc->plant.faults;
@@ -782,6 +800,10 @@ static int parse_inject(ctx_t *c, const cJSON *o, scenario_t *sc) {
   }
   const cJSON *cur = cJSON_GetObjectItemCaseSensitive(o, "current");
   if (cur != NULL && parse_current_faults(c, cur, sc) != 0) {
+    return -1;
+  }
+  const cJSON *enc = cJSON_GetObjectItemCaseSensitive(o, "encoder");
+  if (enc != NULL && parse_encoder_faults(c, enc, sc) != 0) {
     return -1;
   }
   const cJSON *pl = cJSON_GetObjectItemCaseSensitive(o, "passive_load");

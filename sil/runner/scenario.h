@@ -13,6 +13,7 @@
 #include "plant.h"
 #include "profile.h"
 #include "sil_adc_faults.h"
+#include "sil_enc_faults.h"
 
 typedef struct {
   char name[96];
@@ -45,8 +46,9 @@ typedef struct {
   /* current-ADC channel faults (inject.current); the plant-parameter
    * faults are in plant.faults (inject.rs_scale, ...) */
   sil_adc_faults_t current_faults;
-  int log_decimation; /* log every n-th sample */
-  char map_file[512]; /* the flux map's file as resolved ("" for a linear machine) */
+  sil_enc_faults_t encoder_faults; /* inject.encoder */
+  int log_decimation;              /* log every n-th sample */
+  char map_file[512];              /* the flux map's file as resolved ("" for a linear machine) */
 } scenario_t;
 
 /* Loads a scenario from JSON text; `origin` prefixes error messages (the

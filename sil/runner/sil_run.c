@@ -139,6 +139,7 @@ int sil_setup(sil_ctx_t *x, const scenario_t *sc, char *err, size_t errlen) {
   x->v_src = 0.0;
   x->v_src_end = -INFINITY;
   sil_adc_faults_reset(&x->adc_faults);
+  sil_enc_faults_reset(&x->enc_faults, &sc->encoder_faults);
   return 0;
 }
 
@@ -149,6 +150,13 @@ void sil_sample(sil_ctx_t *x, const scenario_t *sc, double t) {
     x->enc_err = profile_eval_span(&sc->encoder_error, t, &x->enc_err_end);
   }
   to_hal_sample(&adc, x, x->enc_err, !injected(&sc->encoder_invalid, t), &x->hal.sample);
+  const sil_enc_faults_t *ef = &sc->encoder_faults;
+  if (ef->frozen.n > 0 || ef->reversed.n > 0 || ef->jitter > 0.0 || ef->missing > 0.0) {
+    const int cpr = sc->plant.sensors.encoder_cpr;
+    x->hal.sample.enc_angle =
+        (float)sil_enc_faults_apply(ef, &x->enc_faults, t, adc.enc_angle + x->enc_err,
+                                    x->plant.omega_m, cpr > 0 ? 2.0 * SIL_PI / cpr : 0.0);
+  }
   if (sc->current_faults.n > 0) {
     sil_adc_faults_apply(&sc->current_faults, &x->adc_faults, t, sc->plant.sensors.i_full_scale,
                          &x->hal.sample);

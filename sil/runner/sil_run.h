@@ -109,6 +109,7 @@ typedef struct {
   double enc_err, enc_err_end; /* encoder error profile, constant until _end */
   double v_src, v_src_end;     /* DC source profile, constant until _end */
   sil_adc_state_t adc_faults;  /* the current-ADC faults' memory */
+  sil_enc_state_t enc_faults;  /* the encoder faults' memory */
 } sil_ctx_t;
 
 /* Plant, HAL and drive from the scenario; 0 or -1 with the message. */

@@ -273,6 +273,10 @@ static void live_limits_reclamp_the_references(void **state) {
   start_running();
   const drive_param_t *tmax = drive_params_by_name("torque_max");
   const drive_param_t *wmax = drive_params_by_name("speed_max");
+  /* no machine behind these samples: the position check (rightly) finds
+   * the applied voltage unexplained within 16 ms; off for this test */
+  assert_int_equal(drive_params_set(&drv, drive_params_by_name("pos_emf_tol")->id, 0.0f, NULL),
+                   DRIVE_PARAM_OK);
   drive_cmd_torque(&drv, 15.0f);
   run_isrs(2);
   assert_float_equal(drv.tm.torque_ref, 15.0f, 0.0f);

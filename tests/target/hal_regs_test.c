@@ -177,9 +177,10 @@ static void esc1_comparators_and_dac3(void **state) {
   const double i_code = esc1_current_of_code(s_dac3.DHR12R1);
   const double lsb_a = ESC1_VREF / 4095.0 * ESC1_PGA / (ESC1_SHUNT * ESC1_GAIN);
   printf("DAC3 DHR12R1 %u DHR12R2 %u (exact %.2f: %.4f V at the comparator); trips at %.2f A "
-         "(1 LSB = %.3f A); zero current at code %.1f\n",
+         "(1 LSB = %.3f A); zero current at %.4f V = code %.1f; ADC pin %.2f mV/A\n",
          (unsigned)s_dac3.DHR12R1, (unsigned)s_dac3.DHR12R2, code_exact, v_trip, i_code, lsb_a,
-         ESC1_MID / ESC1_PGA / ESC1_VREF * 4095.0);
+         ESC1_MID / ESC1_PGA, ESC1_MID / ESC1_PGA / ESC1_VREF * 4095.0,
+         1e3 * ESC1_SHUNT * ESC1_GAIN);
   assert_int_equal(s_dac3.DHR12R1, s_dac3.DHR12R2);
   assert_true(i_code > ESC1_TRIP_A - 0.5 * lsb_a && i_code < ESC1_TRIP_A + 0.5 * lsb_a);
   assert_true(i_code > ESC1_DRIVE_TRIP); /* the drive trips first */

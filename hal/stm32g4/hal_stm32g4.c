@@ -14,8 +14,10 @@
 
 #include "adc.h"
 #include "board.h"
+#include "break_comp.h"
 #include "cordic.h"
 #include "fdcan.h"
+#include "hal.h"
 #include "hal_time.h"
 #include "pwm_tim1.h"
 
@@ -30,12 +32,20 @@ uint32_t hal_stm32g4_init(void) {
   if (!hal_adc_init()) {
     err |= HAL_INIT_ERR_ADC;
   }
+  if (!hal_break_comp_init()) { /* after the op-amps and analog pins */
+    err |= HAL_INIT_ERR_BREAK;
+  }
   /* The protocol's identifiers are base + node with the node in the low
    * nibble (firmware/app/can/fluxdrive.dbc): accept every base for this
    * node; can_proto ignores the bases it does not handle. */
   if (!hal_fdcan_init(BOARD_CAN_BITRATE, BOARD_CAN_NODE_ID, 0x00Fu)) {
     err |= HAL_INIT_ERR_CAN;
   }
+  /* The break inputs have settled (the BKIN pin and its pull-up since
+   * hal_tim1_init, the comparators since hal_break_comp_init): a break
+   * flagged while they came up is cleared; one still active stays set and
+   * is the drive's hw_overcurrent from its first ISR. */
+  hal_fault_hw_clear();
   return err;
 }
 

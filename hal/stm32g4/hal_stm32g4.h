@@ -13,7 +13,8 @@ enum {
   HAL_INIT_ERR_CLOCK = 1u << 0, /* SYSCLK is not the PLL at 170 MHz */
   HAL_INIT_ERR_ADC = 1u << 1,   /* ADC regulator / calibration / ready time-out */
   HAL_INIT_ERR_CAN = 1u << 2,   /* FDCAN did not enter or leave INIT */
-  HAL_INIT_ERR_PWM = 1u << 3    /* TIM1 update could not be aligned to the valley */
+  HAL_INIT_ERR_PWM = 1u << 3,   /* TIM1 update could not be aligned to the valley */
+  HAL_INIT_ERR_BREAK = 1u << 4  /* DAC3 of the comparator trip did not become ready */
 };
 
 /* Configure every peripheral (gates off). Returns HAL_INIT_ERR_* bits. */

@@ -14,14 +14,21 @@
  * Preload: OCxPE = 1 and ARPE = 1, so duties written by the ISR after the
  * valley of period k are transferred at the valley k+1 and act over
  * [k+1, k+2).
- * Protection: BKIN (board's comparator) with BKE = 1: MOE is cleared in
- * hardware, outputs go to the idle level (OSSI = 1, OISx = off level), BIF
- * latches until software clears it. AOE = 0: no automatic restart. LOCK
- * level 1 freezes dead time, break and idle configuration until reset.
+ * Protection: the break (BKE = 1) from the BKIN pin (an external
+ * comparator, G474) or the MCU's comparators (TIM1_AF1.BKCMPxE, ESC1:
+ * break_comp.c): MOE is cleared in hardware, the outputs go inactive at
+ * once and to the idle level after the dead time (OSSI = 1, OISx = OISxN =
+ * off level), BIF latches until software clears it and MOE cannot be set
+ * while the input is active. AOE = 0: no automatic restart. BKBID = 0: the
+ * break is an input only. LOCK level 1 freezes the dead time, the break
+ * (BKE, BKP, BKF, AF1 sources and polarities) and the idle levels OISx
+ * until reset; OSSI/OSSR (level 2) and OCxM (level 3) stay writable, so
+ * hal_pwm_short() works.
  */
 #include "pwm_tim1.h"
 
 #include "board.h"
+#include "break_comp.h"
 #include "hal.h"
 #include "star_window.h"
 
@@ -93,6 +100,10 @@ void hal_tim1_init(void) {
 #if BOARD_BKIN_ACTIVE_HIGH
   bdtr |= TIM_BDTR_BKP;
 #endif
+#elif BOARD_HAS_BREAK_COMP
+  /* the comparators only (BKINE = 0), BKCMPxP = 0 with BKP = 1: active high */
+  TIM1->AF1 = hal_break_comp_af1();
+  bdtr |= TIM_BDTR_BKE | TIM_BDTR_BKP | (BOARD_BREAK_FILTER << TIM_BDTR_BKF_Pos);
 #else
   TIM1->AF1 = 0u; /* no break source: BKE stays 0 */
 #endif

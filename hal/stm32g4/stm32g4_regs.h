@@ -206,9 +206,14 @@ typedef struct {
 #define TIM_BDTR_AOE        (1u << 14)
 #define TIM_BDTR_MOE        (1u << 15)
 #define TIM_BDTR_BKF_Pos    16u
-#define TIM1_AF1_BKINE      (1u << 0) /* BKIN pin enable (reset value 1) */
-#define TIM1_AF1_BKCMP1E    (1u << 1) /* COMPx output to break: bit x */
+#define TIM_BDTR_BKF_Msk    (0xFu << 16)
+#define TIM_BDTR_BKDSRM     (1u << 26)
+#define TIM_BDTR_BKBID      (1u << 28)
+#define TIM1_AF1_BKINE      (1u << 0)             /* BKIN pin enable (reset value 1) */
+#define TIM1_AF1_BKCMP1E    (1u << 1)             /* COMPx output to break: bit x */
+#define TIM1_AF1_BKCMPE(x)  (1u << (uint32_t)(x)) /* x = 1..7 */
 #define TIM1_AF1_BKINP      (1u << 9)
+#define TIM1_AF1_BKCMPP(x)  (1u << (9u + (uint32_t)(x))) /* x = 1..4: polarity */
 
 /* ---- ADC: RM0440 section 21.7 (ADC1/ADC2 registers) and 21.8 (common
  * registers of ADC1/ADC2 at ADC12 base + 0x300) ---- */
@@ -324,6 +329,53 @@ typedef struct {
 #define OPAMP_CSR_OPAHSM       (1u << 7)
 #define OPAMP_CSR_OPAINTOEN    (1u << 8)
 #define OPAMP_CSR_PGA_GAIN_Pos 14u
+
+/* ---- COMP: RM0440 section 24.6 (COMPx_CSR, one word per comparator) ---- */
+typedef struct {
+  reg32_t CSR[7]; /* 0x00 COMP1 .. 0x18 COMP7 (COMP1..4 on the STM32G431) */
+} comp_regs_t;
+#define COMP                ((comp_regs_t *)0x40010200u)
+#define COMP_CSR_EN         (1u << 0)
+#define COMP_CSR_INMSEL_Pos 4u /* 100: DAC3_CH1 (COMP1, 3), DAC3_CH2 (COMP2, 4) */
+#define COMP_INMSEL_DAC3    4u
+#define COMP_CSR_INPSEL     (1u << 8) /* 0: INP IO1 (PA1, PA7, PA0, PB0 for COMP1..4) */
+#define COMP_CSR_POLARITY   (1u << 15)
+#define COMP_CSR_HYST_Pos   16u /* 000: none .. 111: 70 mV, 10 mV steps */
+#define COMP_CSR_BLANK_Pos  19u /* 000: no blanking */
+#define COMP_CSR_BRGEN      (1u << 22)
+#define COMP_CSR_SCALEN     (1u << 23)
+#define COMP_CSR_VALUE      (1u << 30)
+#define COMP_CSR_LOCK       (1u << 31)
+
+/* ---- DAC3 (internal channels only): RM0440 section 22.7 ---- */
+typedef struct {
+  reg32_t CR;      /* 0x00 */
+  reg32_t SWTRIGR; /* 0x04 */
+  reg32_t DHR12R1; /* 0x08 */
+  reg32_t DHR12L1; /* 0x0C */
+  reg32_t DHR8R1;  /* 0x10 */
+  reg32_t DHR12R2; /* 0x14 */
+  reg32_t DHR12L2; /* 0x18 */
+  reg32_t DHR8R2;  /* 0x1C */
+  reg32_t DHR12RD; /* 0x20 */
+  reg32_t DHR12LD; /* 0x24 */
+  reg32_t DHR8RD;  /* 0x28 */
+  reg32_t DOR1;    /* 0x2C */
+  reg32_t DOR2;    /* 0x30 */
+  reg32_t SR;      /* 0x34 */
+  reg32_t CCR;     /* 0x38 */
+  reg32_t MCR;     /* 0x3C */
+} dac_regs_t;
+#define DAC3               ((dac_regs_t *)0x50001000u)
+#define DAC_CR_EN1         (1u << 0)
+#define DAC_CR_EN2         (1u << 16)
+#define DAC_SR_DAC1RDY     (1u << 11)
+#define DAC_SR_DAC2RDY     (1u << 27)
+#define DAC_MCR_MODE2_Pos  16u /* MODE1 at bit 0 */
+#define DAC_MODE_INTERNAL  3u  /* 011: normal mode, on-chip peripherals only, no buffer */
+#define DAC_MCR_HFSEL_Pos  14u
+#define DAC_HFSEL_160MHZ   2u /* 10: AHB clock above 160 MHz */
+#define RCC_AHB2ENR_DAC3EN (1u << 18)
 
 /* ---- FDCAN1: RM0440 section 44.4 (registers), 44.3.3 (message RAM) ---- */
 typedef struct {
@@ -519,6 +571,10 @@ _Static_assert(offsetof(gpio_regs_t, BRR) == 0x28u, "GPIO_BRR");
 _Static_assert(offsetof(tim_regs_t, RCR) == 0x30u, "TIM_RCR");
 _Static_assert(offsetof(tim_regs_t, BDTR) == 0x44u, "TIM_BDTR");
 _Static_assert(offsetof(tim_regs_t, AF1) == 0x60u, "TIM_AF1");
+_Static_assert(offsetof(dac_regs_t, DHR12R2) == 0x14u, "DAC_DHR12R2");
+_Static_assert(offsetof(dac_regs_t, SR) == 0x34u, "DAC_SR");
+_Static_assert(offsetof(dac_regs_t, MCR) == 0x3Cu, "DAC_MCR");
+_Static_assert(offsetof(comp_regs_t, CSR[3]) == 0x0Cu, "COMP4_CSR");
 _Static_assert(offsetof(adc_regs_t, JSQR) == 0x4Cu, "ADC_JSQR");
 _Static_assert(offsetof(adc_regs_t, JDR) == 0x80u, "ADC_JDR1");
 _Static_assert(offsetof(adc_regs_t, DIFSEL) == 0xB0u, "ADC_DIFSEL");

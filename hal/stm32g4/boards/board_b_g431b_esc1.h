@@ -28,12 +28,32 @@
 #define BOARD_PWM_HIGH_ACTIVE_LOW 0
 #define BOARD_PWM_LOW_ACTIVE_LOW  0
 
-/* Hardware over-current: on this kit the protection is built from the
- * MCU's internal comparators (COMPx on the shunt signals, threshold from a
- * DAC) feeding the TIM1 break. That chain (COMP + DAC3 + TIM1_AF1.BKCMPxE) is
- * NOT configured yet: OPEN. Until then the break is disabled and the only
- * over-current protection is the drive's sampled i_trip. */
-#define BOARD_HAS_BKIN 0
+/* Hardware over-current: no BKIN pin; the MCU's comparators watch the
+ * shunt signals at the op-amps' non-inverting inputs (the kit's wiring, as
+ * ST's motor-control SDK configures it) against DAC3 and break TIM1
+ * (hal/stm32g4/break_comp.c, docs/flashing.md "Hardware over-current"):
+ *   U: COMP1 INP IO1 = PA1 (OPAMP1 VINP0), INM = DAC3_CH1
+ *   V: COMP2 INP IO1 = PA7 (OPAMP2 VINP0), INM = DAC3_CH2
+ *   W: COMP4 INP IO1 = PB0 (OPAMP3 VINP0), INM = DAC3_CH2
+ * Entries {COMP number 1..4, INPSEL}. The comparator sees the PGA input:
+ * the ADC pin voltage over BOARD_OPAMP_PGA_GAIN. */
+#define BOARD_HAS_BKIN       0
+#define BOARD_HAS_BREAK_COMP 1
+#define BOARD_BREAK_COMPS                                                                          \
+  {                                                                                                \
+    {1u, 0u}, {2u, 0u}, {                                                                          \
+      4u, 0u                                                                                       \
+    }                                                                                              \
+  }
+#define BOARD_BREAK_NCOMPS 3
+/* The phase current at which the stage trips, taken OUT of the machine
+ * through a low-side shunt (where its signal rises; a leg shoot-through
+ * flows that way too). Above BOARD_I_TRIP (the drive trips first), at the
+ * kit's 40 A peak rating. */
+#define BOARD_HW_TRIP_A 40.0f
+/* BKF = 0111: f_DTS / 4, N = 8: 8 x 4 / 170 MHz = 188 ns of the switching
+ * edges' ringing ignored */
+#define BOARD_BREAK_FILTER 0x7u
 
 /* FDCAN1: PA11 RX / PB9 TX (AF9), transceiver on the ESC board. */
 #define BOARD_CAN_RX_PIN                                                                           \
@@ -71,6 +91,7 @@
 
 #define BOARD_USE_OPAMP_PGA       1
 #define BOARD_OPAMP_PGA_GAIN_CODE 0x0Bu /* PGA_GAIN = 01011: x16, bias/input on VINM0 */
+#define BOARD_OPAMP_PGA_GAIN      16.0f /* the PGA output over its VINP input */
 
 /* Shunt 3 mOhm; total gain shunt -> ADC pin 9.14 V/V (external resistor
  * network + PGA x16); the signal FALLS with current into the machine. */

@@ -34,7 +34,8 @@
 #define BOARD_PWM_LOW_ACTIVE_LOW  0
 
 /* Hardware over-current: BKIN pin, active low, digital filter fCK/32 N=8. */
-#define BOARD_HAS_BKIN 1
+#define BOARD_HAS_BKIN       1
+#define BOARD_HAS_BREAK_COMP 0 /* no comparator trip: the external one on BKIN */
 #define BOARD_BKIN_PIN                                                                             \
   { PORT_A, 6, 6 }
 #define BOARD_BKIN_ACTIVE_HIGH 0

@@ -14,6 +14,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <string.h>
 
 #include <cmocka.h>
@@ -476,6 +477,53 @@ static void bad_config_is_named(void **state) {
   assert_string_equal(err.field, "v_dc_min");
 }
 
+/* Issue 13: the `control` fault. DB-DFVC running; the speed reference
+ * the law gets turns non-finite (a NaN through the speed loop's state,
+ * written here past the checks of the command path): the law refuses its
+ * input, asks for the gates off, and the drive trips `control` alone in
+ * that ISR. */
+static void non_finite_law_input_trips_control(void **state) {
+  (void)state;
+  drive_config_t cfg;
+  drive_config_default(&cfg);
+  cfg.law = DRIVE_LAW_DB_DFVC;
+  setup_with(&cfg);
+  sample(0.0f, 0.0f, 0.0f, 310.0f);
+  drive_cmd_enable(&drv, true);
+  run_isrs(drv.cfg.offset_samples + 2);
+  assert_int_equal(drv.state, DRIVE_STATE_RUN);
+  assert_null(drive_cmd_set_mode(&drv, DRIVE_MODE_SPEED));
+  run_isrs(20);
+  assert_int_equal(drv.state, DRIVE_STATE_RUN);
+  drv.speed_torque = NAN; /* what the law takes as its torque reference */
+  drv.isr_count = 1u;     /* the next ISR is not a speed-loop one (phase 1 of slow_div) */
+  drive_isr(&drv);
+  printf("control: faults 0x%x\n", (unsigned)drv.faults);
+  assert_int_equal(drv.state, DRIVE_STATE_FAULT);
+  assert_int_equal(drv.faults, DRIVE_FAULT_CONTROL);
+  assert_false(hal.gates_on);
+}
+
+/* Issue 13: the `config` fault. The main loop validates every set before
+ * it posts it, so the ISR refusing one means a corrupted request: written
+ * here past the validation (an invalid i_max in creq, a new sequence
+ * number). The ISR keeps the set in force and trips `config`. */
+static void refused_set_in_the_isr_trips_config(void **state) {
+  (void)state;
+  setup_drive();
+  sample(0.0f, 0.0f, 0.0f, 310.0f);
+  run_isrs(2);
+  const float i_max = drv.cfg.i_max;
+  drv.creq.cfg = drv.cfg;
+  drv.creq.cfg.i_max = -1.0f;
+  drv.creq.seq += 2u;
+  drive_isr(&drv);
+  assert_int_equal(drv.state, DRIVE_STATE_FAULT);
+  assert_int_equal(drv.faults, DRIVE_FAULT_CONFIG);
+  assert_float_equal(drv.cfg.i_max, i_max, 0.0f);
+  assert_false(hal.gates_on);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {cmocka_unit_test(calibrates_offsets_then_runs),
                                      cmocka_unit_test(offset_out_of_range_faults),
@@ -494,6 +542,8 @@ int main(void) {
                                      cmocka_unit_test(watchdog_needs_both_contexts),
                                      cmocka_unit_test(alignment_sets_the_encoder_offset),
                                      cmocka_unit_test(angle_extrapolated_from_timestamps),
-                                     cmocka_unit_test(bad_config_is_named)};
+                                     cmocka_unit_test(bad_config_is_named),
+                                     cmocka_unit_test(non_finite_law_input_trips_control),
+                                     cmocka_unit_test(refused_set_in_the_isr_trips_config)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

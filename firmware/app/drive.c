@@ -9,6 +9,7 @@
  * side of the concurrency contract is drive_host.c.
  */
 #include "drive.h"
+#include "drive_overrun.h"
 #include "drive_safe.h"
 #include "drive_sync.h"
 
@@ -252,6 +253,7 @@ FD_COLD int drive_init(drive_t *drv, const drive_config_t *cfg, drive_config_err
     drv->faults = DRIVE_FAULT_WATCHDOG;
     drv->state = DRIVE_STATE_FAULT;
   }
+  drive_overrun_init(drv);
   drive_gates_off(drv);
   drv->tm.state = drv->state;
   drv->tm.faults = drv->faults;
@@ -505,6 +507,9 @@ static void drive_speed_loop(drive_t *drv) {
     return;
   }
   drive_current_sum_check(drv);
+  if (drive_overrun_check(drv) && drv->state != DRIVE_STATE_FAULT) {
+    drive_trip(drv, DRIVE_FAULT_OVERRUN);
+  }
   const float w =
       drv->rate_n > 0u ? drv->rate_acc / ((float)drv->rate_n * c->pole_pairs) : drv->omega_m;
   drv->rate_acc = 0.0f;

@@ -89,6 +89,10 @@
     "safe state: active short circuit above asc_speed times the rectifier speed v_dc/(sqrt(3) psi_pm), or on overvoltage; 0: gates off only (docs/faults.md)") \
   X(121, asc_hold,      F32,  "s",      0.05f,       1e-3f,   10.0f,    LIVE, "controller.asc_hold",       \
     "safe state: shortest active short circuit (its current transient decays before the speed is judged from the current vector)") \
+  X(130, overrun_n,     U16,  "",       16.0f,       1.0f,    32.0f,    LIVE, "controller.overrun_n",      \
+    "ISR overrun check: window of slow periods (main-loop periods, slow_div ISRs each)")                  \
+  X(131, overrun_k,     U16,  "",       4.0f,        1.0f,    32.0f,    LIVE, "controller.overrun_k",      \
+    "ISR overrun check: overruns in overrun_k of the last overrun_n slow periods trip overrun")            \
   X(26, lc_track_time,  F32,  "s",      0.02f,       1e-4f,   1.0f,     LIVE, "controller.lc_track_time",  \
     "loss of control: time a tracking condition may persist (a reversal at the voltage limit takes ms)")   \
   /* controller */                                                                                          \

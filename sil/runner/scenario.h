@@ -13,6 +13,7 @@
 #include "plant.h"
 #include "profile.h"
 #include "sil_adc_faults.h"
+#include "sil_can_faults.h"
 
 typedef struct {
   char name[96];
@@ -45,6 +46,11 @@ typedef struct {
   /* current-ADC channel faults (inject.current); the plant-parameter
    * faults are in plant.faults (inject.rs_scale, ...) */
   sil_adc_faults_t current_faults;
+  /* CAN frame loss and delay in the socketcand transport (inject.can) */
+  sil_can_faults_t can_faults;
+  /* ISR overrun: while > 0.5 the PWM-period interrupt ends after the next
+   * valley (inject.isr_overrun, sil_run.c) */
+  profile_t isr_overrun;
   int log_decimation; /* log every n-th sample */
   char map_file[512]; /* the flux map's file as resolved ("" for a linear machine) */
 } scenario_t;

@@ -187,12 +187,13 @@ typedef struct {
    * single instructions from the drive's base) ===== */
   uint32_t clear_seen; /* req.clear_count taken */
   uint32_t fault_seen[DRIVE_FAULT_COUNT];
-  int32_t i_sum_n;       /* the current-sensor check's leaky count (drive.c) */
+  int32_t i_sum_n;   /* the current-sensor check's leaky count (drive.c) */
+  drive_safe_t safe; /* the safe state with the gates not modulating (drive_safe.c) */
+  float psi_pm;      /* |flux linkage at zero current| of the model [Vs] */
+  float i_sc;        /* |current at zero flux|: the steady short-circuit current at speed [A] */
+  /* the ISR overrun check (drive_overrun.c), at the slow rate */
   uint32_t overrun_seen; /* the board's overrun count at the last slow period */
-  uint32_t overrun_hist; /* bit j: overruns in the slow period j back (drive_overrun.c) */
-  drive_safe_t safe;     /* the safe state with the gates not modulating (drive_safe.c) */
-  float psi_pm;          /* |flux linkage at zero current| of the model [Vs] */
-  float i_sc;            /* |current at zero flux|: the steady short-circuit current at speed [A] */
+  uint32_t overrun_hist; /* bit j: overruns in the slow period j back */
 } drive_t;
 
 /* Validates cfg, initialises everything and latches DRIVE_FAULT_WATCHDOG

@@ -157,5 +157,8 @@ typedef struct {
   uint32_t overruns;                /* periods whose interrupt did not finish in time */
 } hal_isr_stats_t;
 void hal_isr_stats(hal_isr_stats_t *st);
+/* hal_isr_stats_t.overruns alone (one word, read in the ISR's slow path:
+ * the drive's overrun check, drive_overrun.h). */
+uint32_t hal_isr_overruns(void);
 
 #endif /* FLUXDRIVE_HAL_H */

@@ -125,3 +125,7 @@ bool hal_reset_by_watchdog(void) {
 void hal_isr_stats(hal_isr_stats_t *st) {
   st->cycles_last = st->cycles_max = st->cycles_mean = st->overruns = 0u;
 }
+
+uint32_t hal_isr_overruns(void) {
+  return 0u;
+}

@@ -10,6 +10,7 @@
  */
 #include "drive.h"
 #include "drive_pos_check.h"
+#include "drive_overrun.h"
 #include "drive_safe.h"
 #include "drive_sync.h"
 
@@ -255,6 +256,7 @@ FD_COLD int drive_init(drive_t *drv, const drive_config_t *cfg, drive_config_err
     drv->faults = DRIVE_FAULT_WATCHDOG;
     drv->state = DRIVE_STATE_FAULT;
   }
+  drive_overrun_init(drv);
   drive_gates_off(drv);
   drv->tm.state = drv->state;
   drv->tm.faults = drv->faults;
@@ -293,6 +295,21 @@ static void take_config(drive_t *drv) {
   }
 }
 
+/* The fault requests of the command block in force, per bit, against
+ * those seen (the clear marks them void): only when their total changed. */
+static FD_NOINLINE void take_fault_requests(drive_t *drv) {
+  uint32_t req = 0u;
+  for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {
+    if (drv->cmd.fault_count[b] != drv->fault_seen[b]) {
+      drv->fault_seen[b] = drv->cmd.fault_count[b];
+      req |= 1u << b;
+    }
+  }
+  if (req != 0u) {
+    drive_trip(drv, req);
+  }
+}
+
 /* The main loop's command block (req): references, enable, law and mode,
  * then fault requests and clears in the order the main loop made them. */
 static void take_commands(drive_t *drv) {
@@ -314,15 +331,9 @@ static void take_commands(drive_t *drv) {
       drv->armed = false; /* a fresh enable is needed */
     }
   }
-  uint32_t req = 0u;
-  for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {
-    if (drv->cmd.fault_count[b] != drv->fault_seen[b]) {
-      drv->fault_seen[b] = drv->cmd.fault_count[b];
-      req |= 1u << b;
-    }
-  }
-  if (req != 0u) {
-    drive_trip(drv, req);
+  if (drv->cmd.fault_total != drv->fault_total_seen) {
+    drv->fault_total_seen = drv->cmd.fault_total;
+    take_fault_requests(drv);
   }
 }
 
@@ -521,6 +532,9 @@ static void drive_speed_loop(drive_t *drv) {
     return;
   }
   drive_current_sum_check(drv);
+  if (drive_overrun_check(drv) && drv->state != DRIVE_STATE_FAULT) {
+    drive_trip(drv, DRIVE_FAULT_OVERRUN);
+  }
   const float w =
       drv->rate_n > 0u ? drv->rate_acc / ((float)drv->rate_n * c->pole_pairs) : drv->omega_m;
   drv->rate_acc = 0.0f;

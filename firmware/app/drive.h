@@ -96,6 +96,7 @@ typedef struct {
   uint32_t clear_count;                    /* drive_cmd_clear_fault() calls */
   uint32_t fault_count[DRIVE_FAULT_COUNT]; /* drive_request_fault() per bit */
   uint32_t clear_mark[DRIVE_FAULT_COUNT];  /* fault_count at the last clear */
+  uint32_t fault_total;                    /* drive_request_fault() calls, all bits */
 } drive_cmd_t;
 
 /* The safe state while the gates do not modulate (idle, fault): all
@@ -190,7 +191,8 @@ typedef struct {
   /* ===== ISR-owned, used at the slow rate or on a command (last: the
    * periodic path's fields stay within the load offsets of the Cortex-M's
    * single instructions from the drive's base) ===== */
-  uint32_t clear_seen; /* req.clear_count taken */
+  uint32_t clear_seen;       /* req.clear_count taken */
+  uint32_t fault_total_seen; /* req.fault_total taken */
   uint32_t fault_seen[DRIVE_FAULT_COUNT];
   int32_t i_sum_n;   /* the current-sensor check's leaky count (drive.c) */
   drive_safe_t safe; /* the safe state with the gates not modulating (drive_safe.c) */
@@ -202,6 +204,9 @@ typedef struct {
   float pos_emf_res; /* its residual / tolerance at the last check (logs) */
   dq_t pos_psi;      /* the model flux at the last check [Vs] */
   bool pos_psi_ok;   /* ... taken in this run */
+  /* the ISR overrun check (drive_overrun.c), at the slow rate */
+  uint32_t overrun_seen; /* the board's overrun count at the last slow period */
+  uint32_t overrun_hist; /* bit j: overruns in the slow period j back */
 } drive_t;
 
 /* Validates cfg, initialises everything and latches DRIVE_FAULT_WATCHDOG

@@ -198,6 +198,7 @@ int drive_config_check(const drive_config_t *cfg, drive_config_err_t *err) {
        "must be positive when align_time > 0");
   RULE(cfg->align_current <= cfg->i_max, "align_current", "must be at most i_max");
   RULE(cfg->dfc_t_meas < cfg->dfc_tw, "dfc_t_meas", "must be shorter than dfc_tw");
+  RULE(cfg->overrun_k <= cfg->overrun_n, "overrun_k", "must be at most overrun_n");
   RULE(cfg->dfc_t0 + cfg->dfc_tw <= 0.25f * c, "dfc_tw",
        "the DFC window dfc_t0 + dfc_tw must end within the first quarter of the period ts");
   flux_map_t map;

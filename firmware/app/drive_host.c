@@ -172,6 +172,7 @@ void drive_request_fault(drive_t *drv, uint32_t fault_bits) {
       c->fault_count[b]++;
     }
   }
+  c->fault_total++;
   cmd_end(drv);
 }
 

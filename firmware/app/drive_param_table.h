@@ -91,6 +91,10 @@
     "safe state: shortest active short circuit (its current transient decays before the speed is judged from the current vector)") \
   X(122, pos_emf_tol,   F32,  "",       0.5f,        0.0f,    10.0f,    LIVE, "controller.pos_emf_tol",    \
     "position plausibility (encoder): trips position when the applied voltage differs from the model's at the source's angle by more than pos_emf_tol (back-EMF + R i) + 5 % v_dc; 0: off") \
+  X(130, overrun_n,     U16,  "",       16.0f,       1.0f,    32.0f,    LIVE, "controller.overrun_n",      \
+    "ISR overrun check: window of slow periods (main-loop periods, slow_div ISRs each)")                  \
+  X(131, overrun_k,     U16,  "",       4.0f,        1.0f,    32.0f,    LIVE, "controller.overrun_k",      \
+    "ISR overrun check: overruns in overrun_k of the last overrun_n slow periods trip overrun")            \
   X(26, lc_track_time,  F32,  "s",      0.02f,       1e-4f,   1.0f,     LIVE, "controller.lc_track_time",  \
     "loss of control: time a tracking condition may persist (a reversal at the voltage limit takes ms)")   \
   /* controller */                                                                                          \

@@ -58,7 +58,13 @@ int can_socketcand_open(can_socketcand_t *s, uint16_t port, char *err, size_t er
     return -1;
   }
   s->port = ntohs(a.sin_port);
+  can_socketcand_seed(s, 1u);
   return 0;
+}
+
+void can_socketcand_seed(can_socketcand_t *s, uint64_t seed) {
+  can_link_init(&s->rx, seed);
+  can_link_init(&s->tx, seed + 1u);
 }
 
 uint16_t can_socketcand_port(const can_socketcand_t *s) {
@@ -216,6 +222,15 @@ static int queue_room(const hal_sil_can_queue_t *q) {
   return q->head - q->tail < HAL_SIL_CAN_QUEUE;
 }
 
+/* The frames the rx link releases by t, into the drive's queue while it has
+ * room (the rest wait in the link, then in the sockets). */
+static void drain_rx(can_socketcand_t *s, hal_sil_t *hal, double t) {
+  hal_can_frame_t f;
+  while (queue_room(&hal->can_rx) && can_link_take(&s->rx, t, &f, NULL)) {
+    hal_sil_can_push(&hal->can_rx, &f);
+  }
+}
+
 /* To every raw-mode client but number `except` (-1: none). */
 static void broadcast(can_socketcand_t *s, const hal_can_frame_t *f, double t, int except) {
   char line[96];
@@ -260,10 +275,11 @@ static int do_command(can_socketcand_t *s, can_scd_client_t *c, char *cmd, hal_s
       s->bad_commands++;
       return 0;
     }
-    if (!queue_room(&hal->can_rx)) {
+    drain_rx(s, hal, t);
+    if (!queue_room(&hal->can_rx) || !can_link_offer(&s->rx, &f, t)) {
       return 1;
     }
-    hal_sil_can_push(&hal->can_rx, &f);
+    drain_rx(s, hal, t);
     s->rx_frames++;
     broadcast(s, &f, t, (int)(c - s->cl));
   } else if (strcmp(tok[0], "echo") == 0 && ntok == 1) {
@@ -353,9 +369,13 @@ void can_socketcand_poll(can_socketcand_t *s, hal_sil_t *hal, double t) {
       read_client(s, &s->cl[i], hal, t);
     }
   }
+  drain_rx(s, hal, t); /* delayed frames now due */
   hal_can_frame_t f;
-  while (hal_sil_can_pop(&hal->can_tx, &f)) {
+  while (can_link_room(&s->tx) && hal_sil_can_pop(&hal->can_tx, &f)) {
     s->tx_frames++;
+    (void)can_link_offer(&s->tx, &f, t);
+  }
+  while (can_link_take(&s->tx, t, &f, NULL)) {
     broadcast(s, &f, t, -1);
   }
   for (int i = 0; i < CAN_SCD_CLIENTS; ++i) {

@@ -17,6 +17,10 @@
  *    lost); malformed commands and garbage are skipped and counted;
  *  - transmit: per client a bounded buffer; a client that does not read
  *    loses frames (counted), the others do not.
+ * Between the clients and the drive each direction passes a can_link_t
+ * (can_link.h): injected frame loss and delay (scenario inject.can,
+ * docs/scenarios.md), none by default. The clients see each other's frames
+ * as sent; the link is the drive's side of the bus.
  */
 #ifndef FLUXDRIVE_CAN_SOCKETCAND_H
 #define FLUXDRIVE_CAN_SOCKETCAND_H
@@ -24,6 +28,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "can_link.h"
 #include "hal_sil.h"
 
 #define CAN_SCD_CLIENTS 4
@@ -54,11 +59,16 @@ typedef struct {
   uint32_t dropped;            /* frames lost on a full client buffer */
   uint32_t handshake_timeouts; /* clients dropped before raw mode (CAN_SCD_HANDSHAKE_S) */
   can_scd_client_t cl[CAN_SCD_CLIENTS];
+  can_link_t rx; /* clients -> drive: injected loss and delay */
+  can_link_t tx; /* drive -> clients */
 } can_socketcand_t;
 
 /* Listens on 127.0.0.1:port (0 = any free port). 0 or -1 with err. */
 int can_socketcand_open(can_socketcand_t *s, uint16_t port, char *err, size_t errlen);
 uint16_t can_socketcand_port(const can_socketcand_t *s);
+/* Seeds the two links' loss generators (rx: seed, tx: seed + 1); their
+ * faults are s->rx.fault, s->tx.fault (none after open). */
+void can_socketcand_seed(can_socketcand_t *s, uint64_t seed);
 /* Clients in raw mode (exchanging frames). */
 int can_socketcand_clients(const can_socketcand_t *s);
 /* Accepts, reads client commands into hal->can_rx, sends hal->can_tx to

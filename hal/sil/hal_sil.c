@@ -137,4 +137,9 @@ bool hal_reset_by_watchdog(void) {
 
 void hal_isr_stats(hal_isr_stats_t *st) {
   memset(st, 0, sizeof *st); /* no cycle counter on the host */
+  st->overruns = bound->isr_overruns;
+}
+
+uint32_t hal_isr_overruns(void) {
+  return bound->isr_overruns;
 }

@@ -52,6 +52,8 @@ typedef struct {
   uint32_t watchdog_last_us;
   uint32_t watchdog_kicks;
   bool reset_by_watchdog;     /* what hal_reset_by_watchdog() reports */
+  uint32_t isr_overruns;      /* interrupts that ended after the next valley
+                               * (set by the runner: inject.isr_overrun) */
   hal_sil_can_queue_t can_rx; /* towards the firmware */
   hal_sil_can_queue_t can_tx; /* from the firmware */
 } hal_sil_t;

@@ -284,6 +284,12 @@ void hal_isr_stats(hal_isr_stats_t *st) {
   hal_irq_restore(pm);
 }
 
+/* One aligned word: read whole, also from the ISR (which adds to it only
+ * after the drive's code returned). */
+uint32_t hal_isr_overruns(void) {
+  return s_isr.overruns;
+}
+
 /* What the board can do (hal.h), fixed by its header and the ADC set-up. */
 const hal_caps_t *hal_caps(void) {
   static hal_caps_t caps;

@@ -61,8 +61,13 @@ static void on_signal(int sig) {
 static can_socketcand_t scd;
 static can_socketcan_t sck;
 
+/* user: the scenario, for its CAN link faults (inject.can) */
 static void io_socketcand(void *user, hal_sil_t *hal, double t) {
-  (void)user;
+  const sil_can_faults_t *cf = &((const scenario_t *)user)->can_faults;
+  if (cf->on) {
+    sil_can_dir_at(&cf->rx, t, &scd.rx.fault);
+    sil_can_dir_at(&cf->tx, t, &scd.tx.fault);
+  }
   can_socketcand_poll(&scd, hal, t);
 }
 
@@ -219,9 +224,18 @@ int main(int argc, char **argv) {
       fprintf(stderr, "fluxdrive-sil: socketcand on 127.0.0.1:%u, node %u: waiting for a client\n",
               (unsigned)can_socketcand_port(&scd), (unsigned)pcfg.node);
       fflush(stderr);
+      can_socketcand_seed(&scd, sc.can_faults.seed);
       opts.can_io = io_socketcand;
       opts.can_ready = ready_socketcand;
+      opts.can_user = &sc;
     } else if (strncmp(can, "socketcan:", 10) == 0 && can[10] != '\0') {
+      if (sc.can_faults.on) {
+        fprintf(stderr,
+                "fluxdrive-sil: %s: inject.can: only with --can socketcand:PORT (the SIL's "
+                "own CAN server)\n",
+                scenario);
+        return 2;
+      }
       if (can_socketcan_open(&sck, can + 10, err, sizeof err) != 0) {
         fprintf(stderr, "fluxdrive-sil: --can %s: %s\n", can, err);
         return 2;
@@ -261,6 +275,13 @@ int main(int argc, char **argv) {
             "%u timeouts\n",
             (unsigned)res.can.rx_frames, (unsigned)res.can.rx_ok, (unsigned)res.can.rx_errors,
             (unsigned)res.can.rx_ignored, (unsigned)res.can.tx_dropped, (unsigned)res.can.timeouts);
+    if (sc.can_faults.on) {
+      fprintf(stderr,
+              "fluxdrive-sil: CAN link (inject.can): rx %u of %u frames lost, %u delayed; "
+              "tx %u of %u lost, %u delayed\n",
+              (unsigned)scd.rx.lost, (unsigned)scd.rx.offered, (unsigned)scd.rx.delayed,
+              (unsigned)scd.tx.lost, (unsigned)scd.tx.offered, (unsigned)scd.tx.delayed);
+    }
     can_socketcand_close(&scd);
     can_socketcan_close(&sck);
   }

@@ -767,12 +767,70 @@ static int parse_encoder_faults(ctx_t *c, const cJSON *o, scenario_t *sc) {
   return 0;
 }
 
+/* inject.can: CAN frame loss and delay per direction (socketcand). */
+static int parse_can_dir(ctx_t *c, const cJSON *o, const char *path, sil_can_dir_t *d) {
+  static const char *const keys[] = {"loss", "every", "delay", "jitter", NULL};
+  int every = 0;
+  if (!cJSON_IsObject(o)) {
+    return fail(c, path, "must be an object (loss, every, delay, jitter)");
+  }
+  if (check_keys(c, o, path, keys) ||
+      get_bounded_profile(c, o, path, "loss", 0.0, 0, 1.0, &d->loss) ||
+      get_int(c, o, path, "every", 0, 1000000, &every) ||
+      get_bounded_profile(c, o, path, "delay", 0.0, 0, SIL_CAN_DELAY_MAX, &d->delay) ||
+      get_bounded_profile(c, o, path, "jitter", 0.0, 0, SIL_CAN_DELAY_MAX, &d->jitter)) {
+    return -1;
+  }
+  if (every == 1) {
+    char p[160];
+    join(p, sizeof p, path, "every");
+    return fail(c, p, "must be 0 (none) or at least 2 (1 would lose every frame: use loss 1)");
+  }
+  d->every = (uint32_t)every;
+  return 0;
+}
+
+static int parse_can_faults(ctx_t *c, const cJSON *o, scenario_t *sc) {
+  static const char *const keys[] = {"seed", "rx", "tx", NULL};
+  const char *P = "inject.can";
+  sil_can_faults_t *f = &sc->can_faults;
+  int seed = 1;
+  if (!cJSON_IsObject(o)) {
+    return fail(c, P, "must be an object (seed, rx, tx)");
+  }
+  if (check_keys(c, o, P, keys) || get_int(c, o, P, "seed", 0, 0x7fffffff, &seed)) {
+    return -1;
+  }
+  const cJSON *rx = cJSON_GetObjectItemCaseSensitive(o, "rx");
+  const cJSON *tx = cJSON_GetObjectItemCaseSensitive(o, "tx");
+  if ((rx != NULL && parse_can_dir(c, rx, "inject.can.rx", &f->rx) != 0) ||
+      (tx != NULL && parse_can_dir(c, tx, "inject.can.tx", &f->tx) != 0)) {
+    return -1;
+  }
+  f->seed = (uint32_t)seed;
+  f->on = true;
+  return 0;
+}
+
 #define FAULT_NAME(E, n, d) #n,
 static int parse_inject(ctx_t *c, const cJSON *o, scenario_t *sc) {
-  static const char *const keys[] = {
-      "encoder_error", "encoder_invalid", "main_stall", "isr_stall",      "cm_scale_d",
-      "cm_scale_q",    "current",         "rs_scale",   "lambda_m_scale", "c_scale",
-      "passive_load",  "trip_at",         "trip_cause", "encoder",        NULL};
+  static const char *const keys[] = {"encoder_error",
+                                     "encoder_invalid",
+                                     "main_stall",
+                                     "isr_stall",
+                                     "cm_scale_d",
+                                     "cm_scale_q",
+                                     "current",
+                                     "rs_scale",
+                                     "lambda_m_scale",
+                                     "c_scale",
+                                     "passive_load",
+                                     "trip_at",
+                                     "trip_cause",
+                                     "encoder",
+                                     "can",
+                                     "isr_overrun",
+                                     NULL};
   static const char *const faults[] = {DRIVE_FAULT_LIST(FAULT_NAME) NULL};
   const char *P = "inject";
   plant_faults_t *pf = &sc->plant.faults;
@@ -790,6 +848,7 @@ static int parse_inject(ctx_t *c, const cJSON *o, scenario_t *sc) {
       get_profile(c, o, P, "encoder_invalid", &sc->encoder_invalid) ||
       get_profile(c, o, P, "main_stall", &sc->main_stall) ||
       get_profile(c, o, P, "isr_stall", &sc->isr_stall) ||
+      get_profile(c, o, P, "isr_overrun", &sc->isr_overrun) ||
       get_profile(c, o, P, "cm_scale_d", &sc->cm_scale_d) ||
       get_profile(c, o, P, "cm_scale_q", &sc->cm_scale_q) ||
       get_bounded_profile(c, o, P, "rs_scale", 0.0, 1, PLANT_RS_SCALE_MAX, &pf->rs_scale) ||
@@ -804,6 +863,10 @@ static int parse_inject(ctx_t *c, const cJSON *o, scenario_t *sc) {
   }
   const cJSON *enc = cJSON_GetObjectItemCaseSensitive(o, "encoder");
   if (enc != NULL && parse_encoder_faults(c, enc, sc) != 0) {
+    return -1;
+  }
+  const cJSON *cf = cJSON_GetObjectItemCaseSensitive(o, "can");
+  if (cf != NULL && parse_can_faults(c, cf, sc) != 0) {
     return -1;
   }
   const cJSON *pl = cJSON_GetObjectItemCaseSensitive(o, "passive_load");

@@ -14,6 +14,7 @@
 #include "profile.h"
 #include "sil_adc_faults.h"
 #include "sil_enc_faults.h"
+#include "sil_can_faults.h"
 
 typedef struct {
   char name[96];
@@ -47,8 +48,13 @@ typedef struct {
    * faults are in plant.faults (inject.rs_scale, ...) */
   sil_adc_faults_t current_faults;
   sil_enc_faults_t encoder_faults; /* inject.encoder */
-  int log_decimation;              /* log every n-th sample */
-  char map_file[512];              /* the flux map's file as resolved ("" for a linear machine) */
+  /* CAN frame loss and delay in the socketcand transport (inject.can) */
+  sil_can_faults_t can_faults;
+  /* ISR overrun: while > 0.5 the PWM-period interrupt ends after the next
+   * valley (inject.isr_overrun, sil_run.c) */
+  profile_t isr_overrun;
+  int log_decimation; /* log every n-th sample */
+  char map_file[512]; /* the flux map's file as resolved ("" for a linear machine) */
 } scenario_t;
 
 /* Loads a scenario from JSON text; `origin` prefixes error messages (the

@@ -113,6 +113,7 @@ static int sil_reset_mcu(sil_ctx_t *x, const scenario_t *sc, char *err, size_t e
   x->hal.gates_on = false;
   x->hal.asc = false;
   x->hal.reset_by_watchdog = true;
+  x->hal.isr_overruns = 0u; /* the board's counter restarts with the MCU */
   x->hal.watchdog_last_us = x->hal.time_us;
   return sil_start_firmware(x, sc, err, errlen);
 }
@@ -138,6 +139,7 @@ int sil_setup(sil_ctx_t *x, const scenario_t *sc, char *err, size_t errlen) {
   x->enc_err_end = -INFINITY;
   x->v_src = 0.0;
   x->v_src_end = -INFINITY;
+  x->isr_late = false;
   sil_adc_faults_reset(&x->adc_faults);
   sil_enc_faults_reset(&x->enc_faults, &sc->encoder_faults);
   return 0;
@@ -185,15 +187,19 @@ void sil_advance(sil_ctx_t *x, const scenario_t *sc, double t) {
     x->star_v[k] = v[k];
     x->star_tt[k] = x->plant.aux.star_t[k] - sc->plant.ts;
   }
+  /* the pattern loaded at t_{k+1}: the ISR's, or, if it overran, the one
+   * written before it */
+  const hal_pwm_t *next = x->isr_late ? &x->pwm_before : &x->hal.pwm;
+  x->isr_late = false;
   for (int j = 0; j < 3; ++j) {
-    x->pwm_on[j] = x->hal.pwm.on[j];
-    x->pwm_off[j] = x->hal.pwm.off[j];
+    x->pwm_on[j] = next->on[j];
+    x->pwm_off[j] = next->off[j];
   }
-  x->star_n = x->hal.pwm.n_star;
+  x->star_n = next->n_star;
   for (int k = 0; k < HAL_STAR_MAX; ++k) {
-    x->star_t[k] = x->hal.pwm.t_star_req[k];
+    x->star_t[k] = next->t_star_req[k];
   }
-  x->star_tv = x->hal.pwm.test_vector;
+  x->star_tv = next->test_vector;
   /* hardware comparator: gates off in hardware, latched */
   if (sc->hw_trip > 0.0 && (x->hal.gates_on || x->hal.asc)) {
     plant_brief_t br;
@@ -282,7 +288,14 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
     /* 2. ISR (unless the interrupt is stuck) */
     const bool hw_in = x.hal.hw_tripped;
     if (!injected(&sc->isr_stall, t)) {
+      x.isr_late = injected(&sc->isr_overrun, t); /* it ends after the next valley */
+      if (x.isr_late) {
+        x.pwm_before = x.hal.pwm;
+      }
       drive_isr(&x.drv);
+      if (x.isr_late) { /* counted at its exit: the update already pending */
+        x.hal.isr_overruns++;
+      }
     }
     if (hal_sil_watchdog_expired(&x.hal, x.hal.time_us)) {
       res->watchdog_resets++;

@@ -14,9 +14,22 @@
  *   4. the plant advances over [t_k, t_{k+1}) with the pattern preloaded by
  *      ISR k-1 (the one-period command delay of the timing model).
  * Injected failures (scenario "inject"): main_stall skips step 0,
- * isr_stall skips step 2, encoder_invalid marks the encoder sample invalid,
+ * isr_stall skips step 2, isr_overrun makes ISR k end after the valley
+ * t_{k+1} (below), encoder_invalid marks the encoder sample invalid,
  * current (sil_adc_faults.h) alters the current channels of step 1; the
  * plant-parameter faults act inside the plant (plant_faults_t).
+ *
+ *
+ * ISR overrun (inject.isr_overrun > 0.5 at t_k), as on the STM32G4: ISR k
+ * still runs on the samples of t_k but ends after the next valley, so its
+ * compare values miss the update at t_{k+1} (TIM1 preload) and the pattern
+ * written before it acts once more over [t_{k+1}, t_{k+2}); ISR k's pattern
+ * acts from t_{k+2} unless ISR k+1 (pending meanwhile, tail-chained, on the
+ * samples of t_{k+1}) overwrites it before that update. The HAL counts the
+ * overrun (hal_isr_stats().overruns, the board's "update pending at exit").
+ * A sustained overrun thus delays every pattern by one more period. Not
+ * modelled: the main loop starved by the busy CPU, a third interrupt
+ * coalesced (an ISR longer than two periods).
  *
  * With CAN (sil_opts_t.can, fluxdrive-sil --can): at step 0 the transport
  * moves frames from the bus into the HAL queue, can_proto_poll() handles
@@ -110,6 +123,8 @@ typedef struct {
   double v_src, v_src_end;     /* DC source profile, constant until _end */
   sil_adc_state_t adc_faults;  /* the current-ADC faults' memory */
   sil_enc_state_t enc_faults;  /* the encoder faults' memory */
+  bool isr_late;               /* ISR k overran: its pattern misses t_{k+1} */
+  hal_pwm_t pwm_before;        /* then: the pattern written before it */
 } sil_ctx_t;
 
 /* Plant, HAL and drive from the scenario; 0 or -1 with the message. */

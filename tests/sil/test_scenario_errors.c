@@ -111,6 +111,31 @@ static const bad_case_t cases[] = {
     {"{\"duration\": 1, \"machine\": {\"ls\": 1e-4}, \"inverter\": {\"substeps\": 1}}",
      "inverter.substeps: 1 steps per period are unstable for this machine (h R_s / L_min = 4.44 > "
      "0.5): at least 9"},
+    /* issue 13, item 4: CAN link faults and ISR overrun */
+    {"{\"duration\": 1, \"inject\": {\"can\": {\"rx\": {\"loss\": 1.5}}}}",
+     "inject.can.rx.loss: must stay in [0, 1] at all times (its terms reach [1.5, 1.5])"},
+    {"{\"duration\": 1, \"inject\": {\"can\": {\"tx\": {\"delay\": [{\"type\": \"step\", "
+     "\"t\": 1, \"value\": -0.1}]}}}}",
+     "inject.can.tx.delay: must stay in [0, 1] at all times"},
+    {"{\"duration\": 1, \"inject\": {\"can\": {\"tx\": {\"jitter\": 2}}}}",
+     "inject.can.tx.jitter: must stay in [0, 1]"},
+    {"{\"duration\": 1, \"inject\": {\"can\": {\"rx\": {\"every\": 1}}}}",
+     "inject.can.rx.every: must be 0 (none) or at least 2"},
+    {"{\"duration\": 1, \"inject\": {\"can\": {\"rx\": {\"every\": 2.5}}}}",
+     "inject.can.rx.every: must be an integer"},
+    {"{\"duration\": 1, \"inject\": {\"can\": {\"rx\": {\"lost\": 0.1}}}}",
+     "inject.can.rx.lost: unknown field"},
+    {"{\"duration\": 1, \"inject\": {\"can\": {\"bus\": {}}}}", "inject.can.bus: unknown field"},
+    {"{\"duration\": 1, \"inject\": {\"can\": {\"seed\": -1}}}", "inject.can.seed: must be in"},
+    {"{\"duration\": 1, \"inject\": {\"can\": 0.5}}", "inject.can: must be an object"},
+    {"{\"duration\": 1, \"inject\": {\"can\": {\"rx\": 3}}}", "inject.can.rx: must be an object"},
+    {"{\"duration\": 1, \"inject\": {\"can\": {\"rx\": {\"loss\": 0.1, \"loss\": 0.2}}}}",
+     "inject.can.rx.loss: given twice"},
+    {"{\"duration\": 1, \"inject\": {\"isr_overrun\": \"often\"}}", "inject.isr_overrun: must be"},
+    {"{\"duration\": 1, \"controller\": {\"overrun_n\": 4, \"overrun_k\": 5}}",
+     "controller.overrun_k: must be at most overrun_n"},
+    {"{\"duration\": 1, \"controller\": {\"overrun_n\": 33}}",
+     "controller.overrun_n: must be in [1, 32]"},
 };
 
 static void bad_scenarios_name_the_field(void **state) {

@@ -64,11 +64,12 @@ class Drive:
 
     def __init__(self, channel: str = "vcan0", interface: str = "socketcand", node: int = 1, *,
                  host: str = "127.0.0.1", port: int = 29536, bus: can.BusABC | None = None,
-                 reply_timeout: float = 1.0) -> None:
+                 reply_timeout: float = 1.0, retries: int = 0) -> None:
         self.proto = Protocol(node)
         self.bus = bus if bus is not None else open_bus(channel, interface, host, port)
         self._own_bus = bus is None
         self.reply_timeout = reply_timeout
+        self.retries = retries  # resends after a reply_timeout without an answer
         self._replies: queue.Queue[Reply] = queue.Queue()
         self._cond = threading.Condition()
         self._values: dict[str, float] = {}
@@ -97,23 +98,33 @@ class Drive:
             self._cond.notify_all()
 
     def request(self, message: str, check: bool = True, **signals: Any) -> Reply:
-        """Sends a CMD_* or PARAM_REQ frame and returns the drive's REPLY."""
+        """Sends a CMD_* or PARAM_REQ frame and returns the drive's REPLY.
+
+        With `retries` > 0 the frame is sent again when no reply came within
+        `reply_timeout` (a lost request or a lost reply: every request of the
+        protocol sets a value, so a repeat is harmless)."""
         frame = self.proto.encode(message, **signals)
         param = signals.get("param_id")
         with self._req_lock:
             while not self._replies.empty():  # stale answers
                 self._replies.get_nowait()
-            self.bus.send(frame)
-            deadline = time.monotonic() + self.reply_timeout
-            while True:
-                left = deadline - time.monotonic()
-                try:
-                    r = self._replies.get(timeout=max(left, 0.0))
-                except queue.Empty:
-                    raise DriveError(f"no reply to {message} from node {self.proto.node} "
-                                     f"within {self.reply_timeout} s") from None
-                if r.req == message and (param is None or r.param in (param, self.proto.param_names.get(param))):
+            r = None
+            for _ in range(self.retries + 1):
+                self.bus.send(frame)
+                deadline = time.monotonic() + self.reply_timeout
+                while r is None:
+                    left = deadline - time.monotonic()
+                    try:
+                        got = self._replies.get(timeout=max(left, 0.0))
+                    except queue.Empty:
+                        break
+                    if got.req == message and (param is None or got.param in (param, self.proto.param_names.get(param))):
+                        r = got
+                if r is not None:
                     break
+            if r is None:
+                raise DriveError(f"no reply to {message} from node {self.proto.node} "
+                                 f"within {self.reply_timeout} s ({self.retries + 1} tries)")
         if check and not r.ok:
             what = f" ({r.signal})" if r.signal != "none" else ""
             raise DriveError(f"{message} rejected: {r.result}{what}", r)

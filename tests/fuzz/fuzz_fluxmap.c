@@ -14,7 +14,9 @@
  *     inductance, the current from a flux (Newton), torque, MTPA current,
  *     flux and torque, MTPV torque; the plant's flux, current and
  *     Jacobian);
- *   - the core's flux equals the blob's value at every grid point.
+ *   - the core's flux equals the blob's value at every grid point (that
+ *     floats can address: a step far below the origin's resolution has
+ *     none).
  */
 #include <math.h>
 #include <stdbool.h>
@@ -52,13 +54,22 @@ static float word_f32(const uint32_t *w, size_t i) {
 
 static void check_map(const map_load_t *e) {
   const flux_map_t *m = &e->map;
-  /* grid values back at the grid points */
+  /* grid values back at the grid points (to the rounding of the weights,
+   * on the scale of the largest value) */
+  float big = 0.0f;
+  for (uint32_t o = 0; o < m->nd * m->nq; ++o) {
+    big = fmaxf(big, fmaxf(fabsf(word_f32(m->psi_d, o)), fabsf(word_f32(m->psi_q, o))));
+  }
   for (uint32_t k = 0; k < m->nq; ++k) {
     for (uint32_t j = 0; j < m->nd; ++j) {
       const dq_t i = {m->id0 + (float)j * m->did, m->iq0 + (float)k * m->diq};
+      if (!(fabsf((i.d - m->id0) * m->inv_did - (float)j) <= 1e-5f * (float)(j + 1u) &&
+            fabsf((i.q - m->iq0) * m->inv_diq - (float)k) <= 1e-5f * (float)(k + 1u))) {
+        continue; /* a step below the float resolution of the origin: no grid point */
+      }
       const dq_t l = flux_map_flux(m, i);
       const float ld = word_f32(m->psi_d, k * m->nd + j), lq = word_f32(m->psi_q, k * m->nd + j);
-      const float tol = 1e-4f * (fabsf(ld) + fabsf(lq)) + 1e-6f;
+      const float tol = 1e-4f * big + 1e-6f;
       if (!(fabsf(l.d - ld) <= tol && fabsf(l.q - lq) <= tol)) {
         violated("flux at a grid point differs from the blob", (double)j, (double)k);
       }

@@ -204,7 +204,7 @@ int map_load_bytes(const void *bytes, size_t n, const char *shown, map_load_t *e
 
 void map_load_release(map_load_t *e) {
   plant_fluxmap_free(e->plant);
-  free((void *)(uintptr_t)e->words);
+  free((void *)e->words); /* map_load_bytes allocated it */
   memset(e, 0, sizeof *e);
 }
 

@@ -67,6 +67,9 @@ CAN = {
     "seed-params": param(0, 11, 0.0) + param(1, 11, 2.0) + param(1, 12, 100.0)
     + state(1, mode=1) + speed(600.0) + wait_ms(30) + param(1, 12, 20.0)
     + param(1, 65, 30.0) + wait_ms(20) + bytes([7, 10, 3, 7, 11, 1]),
+    # torque_max lowered to a tenth (20 -> 2 N m) under a 5 N m reference
+    "seed-torque-lowered": state(1, mode=0) + wait_ms(20) + torque(5.0) + wait_ms(10)
+    + bytes([7, 11, 7]) + wait_ms(10),
     "seed-blocked": bytes([5]) + b"".join(torque(0.1 * k) for k in range(20))
     + wait_ms(60) + bytes([5]) + wait_ms(5),
     "seed-errors": frame(TORQUE, i32(1e9)) + frame(SPEED, [0], dlc=3)

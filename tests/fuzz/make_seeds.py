@@ -70,6 +70,9 @@ CAN = {
     # torque_max lowered to a tenth (20 -> 2 N m) under a 5 N m reference
     "seed-torque-lowered": state(1, mode=0) + wait_ms(20) + torque(5.0) + wait_ms(10)
     + bytes([7, 11, 7]) + wait_ms(10),
+    # shown by fuzz_can's current-limit invariant: i_max halved (idle) under a 3 A current reference
+    "regress-imax-lowered": state(0, mode=2) + current(0.0, 3.0) + bytes([7, 10, 1])
+    + state(1) + wait_ms(30),
     "seed-blocked": bytes([5]) + b"".join(torque(0.1 * k) for k in range(20))
     + wait_ms(60) + bytes([5]) + wait_ms(5),
     "seed-errors": frame(TORQUE, i32(1e9)) + frame(SPEED, [0], dlc=3)

@@ -16,8 +16,10 @@
  *     when its DLC is wrong; no REPLY without a request; all replies out by
  *     the end;
  *   - the references the drive runs on are finite and within the limits in
- *     force: torque reference within torque_max, speed reference within
- *     speed_max, in current mode |(i_d, i_q)| within i_max;
+ *     force: torque reference within torque_max, in current mode
+ *     |(i_d, i_q)| within i_max, the ramped speed reference within
+ *     speed_max or approaching it (it starts from the measured speed and
+ *     follows a lowered speed_max at accel_max);
  *   - the gates are off in idle, offset calibration and fault;
  *   - the watchdog never expires (both loops run);
  *   - after the last frame, while the drive is enabled, the command
@@ -74,14 +76,21 @@ static struct {
   uint32_t rx_tail_seen; /* the HAL's RX queue tail at the last poll */
   uint32_t last_rx_us;   /* last poll that took a frame */
   uint32_t states;       /* drive states seen (bit per state) */
+  float speed_ref_prev;  /* the ramped speed reference of the last ISR */
+  bool speed_loop_prev;  /* and whether the speed loop ran then */
   bool last_rx_any;      /* a frame was taken since the start */
 } st;
 
 static void violated(const char *what) {
+  const drive_telemetry_t *tm = &x.drv.tm;
   fprintf(stderr,
-          "fuzz_can: invariant violated: %s (t = %.6f s, state %d, faults 0x%x, gates %d)\n", what,
-          (double)st.k * sc.plant.ts, (int)x.drv.state, (unsigned)x.drv.faults,
-          (int)x.hal.gates_on);
+          "fuzz_can: invariant violated: %s (t = %.6f s, state %d, faults 0x%x, gates %d; "
+          "torque ref %g / max %g N m, speed ref %g (before %g) / max %g / measured %g rad/s, "
+          "i_ref (%g, %g) / max %g A)\n",
+          what, (double)st.k * sc.plant.ts, (int)x.drv.state, (unsigned)x.drv.faults,
+          (int)x.hal.gates_on, (double)tm->torque_ref, (double)x.drv.cfg.torque_max,
+          (double)tm->speed_ref, (double)st.speed_ref_prev, (double)x.drv.cfg.speed_max,
+          (double)tm->omega_m, (double)x.drv.cmd.id, (double)x.drv.cmd.iq, (double)x.drv.cfg.i_max);
   __builtin_trap();
 }
 
@@ -176,15 +185,32 @@ static void check_isr(void) {
   if (off_state && x.hal.gates_on) {
     violated("gates on in idle, offset calibration or fault");
   }
+  /* the ramped speed reference starts from the measured speed (bumpless)
+   * and follows a lowered speed_max at accel_max (docs/can.md): beyond
+   * speed_max it may only approach it */
+  const float w = fabsf(d->tm.speed_ref);
+  if (!isfinite(w)) {
+    violated("speed reference not finite");
+  }
+  if (d->state != DRIVE_STATE_RUN) {
+    st.speed_loop_prev = false;
+  } else if ((d->isr_count - 1u) % c->slow_div == 0u) { /* the speed loop's period */
+    const float w_prev = fabsf(st.speed_ref_prev);
+    /* the ramp's step, where float resolves it at this speed */
+    const float step = c->accel_max * c->ts * (float)c->slow_div;
+    const float must = step > 1e-6f * w ? w_prev - 0.5f * step : w_prev;
+    if (st.speed_loop_prev && d->speed_active && w > c->speed_max * (1.0f + REL_TOL) && w > must) {
+      violated("speed reference beyond speed_max and not approaching it at accel_max");
+    }
+    st.speed_ref_prev = d->tm.speed_ref;
+    st.speed_loop_prev = d->speed_active;
+  }
   if (d->state != DRIVE_STATE_RUN) {
     return;
   }
   const drive_telemetry_t *tm = &d->tm;
   if (!(fabsf(tm->torque_ref) <= c->torque_max * (1.0f + REL_TOL))) {
     violated("torque reference beyond torque_max (or not finite)");
-  }
-  if (!(fabsf(tm->speed_ref) <= c->speed_max * (1.0f + REL_TOL))) {
-    violated("speed reference beyond speed_max (or not finite)");
   }
   const bool current_mode =
       cmd->mode == DRIVE_MODE_CURRENT && (d->ctrl.impl->caps & CTRL_CAP_CURRENT) != 0u;

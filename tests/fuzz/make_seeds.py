@@ -73,6 +73,11 @@ CAN = {
     # shown by fuzz_can's current-limit invariant: i_max halved (idle) under a 3 A current reference
     "regress-imax-lowered": state(0, mode=2) + current(0.0, 3.0) + bytes([7, 10, 1])
     + state(1) + wait_ms(30),
+    # speed_max lowered to a tenth under a ramping speed reference (it must
+    # come down at accel_max), heartbeats keeping the timeout off
+    "seed-speed-lowered": state(1, mode=1) + speed(1000.0)
+    + (wait_ms(40) + frame(HB, [0])) * 5 + bytes([7, 12, 7])
+    + (wait_ms(20) + frame(HB, [1])) * 2,
     "seed-blocked": bytes([5]) + b"".join(torque(0.1 * k) for k in range(20))
     + wait_ms(60) + bytes([5]) + wait_ms(5),
     "seed-errors": frame(TORQUE, i32(1e9)) + frame(SPEED, [0], dlc=3)

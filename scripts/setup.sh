@@ -7,7 +7,8 @@ cd "$(dirname "$0")/.."
 
 APT_PACKAGES=(cmake ninja-build gcc g++ libcmocka-dev libcjson-dev
   gcc-arm-none-eabi libnewlib-arm-none-eabi libeigen3-dev
-  python3 python3-venv clang-format clang-tidy cppcheck qemu-system-arm)
+  python3 python3-venv clang-format clang-tidy cppcheck qemu-system-arm
+  clang-14 libclang-rt-14-dev)
 
 missing=()
 for p in "${APT_PACKAGES[@]}"; do

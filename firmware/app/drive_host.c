@@ -144,15 +144,20 @@ void drive_cmd_speed(drive_t *drv, float speed_m) {
   cmd_end(drv);
 }
 
-void drive_cmd_current(drive_t *drv, float id, float iq) {
-  const float lim = drv->creq.cfg.i_max;
-  id = command_clamp(id, -lim, lim);
-  iq = command_clamp(iq, -lim, lim);
-  const float mag = sqrtf(id * id + iq * iq);
+/* The current references within the circle of radius lim (each axis
+ * first, so that the magnitude is finite). */
+static void current_clamp(float *id, float *iq, float lim) {
+  *id = command_clamp(*id, -lim, lim);
+  *iq = command_clamp(*iq, -lim, lim);
+  const float mag = sqrtf(*id * *id + *iq * *iq);
   if (mag > lim) {
-    id *= lim / mag;
-    iq *= lim / mag;
+    *id *= lim / mag;
+    *iq *= lim / mag;
   }
+}
+
+void drive_cmd_current(drive_t *drv, float id, float iq) {
+  current_clamp(&id, &iq, drv->creq.cfg.i_max);
   drive_cmd_t *c = cmd_begin(drv);
   c->id = id;
   c->iq = iq;
@@ -189,12 +194,14 @@ int drive_request_config(drive_t *drv, const drive_config_t *cfg, drive_config_e
   }
   drive_machine_copy(&drv->host.machine, &drv->host.map, &m, &map);
   /* first the command block within the new limits (a LIVE speed_max or
-   * torque_max lowered while running): the ISR takes it before or with the
-   * set, never an old reference beyond the limits in force; the ISR's
-   * command block stays the published one */
+   * torque_max lowered while running, an i_max lowered with the gates off
+   * under a current reference: fuzz_can's current-limit invariant): the ISR takes
+   * it before or with the set, never an old reference beyond the limits in
+   * force; the ISR's command block stays the published one */
   drive_cmd_t *c = cmd_begin(drv);
   c->torque = command_clamp(c->torque, -cfg->torque_max, cfg->torque_max);
   c->speed = command_clamp(c->speed, -cfg->speed_max, cfg->speed_max);
+  current_clamp(&c->id, &c->iq, cfg->i_max);
   cmd_end(drv);
   drv->creq.seq++;
   DRIVE_BARRIER();

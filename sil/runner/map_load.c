@@ -93,28 +93,35 @@ static int convert(const char *src, char *tmp, size_t tmpn, char *err, size_t er
   return 0;
 }
 
-static uint32_t *read_blob(const char *path, const char *shown, uint32_t *size, char *err,
+enum { MAX_BYTES = 4 * (12 + 2 * 64 * 64 + 2 + 4 * 128 + 1) };
+
+/* The file's bytes in a buffer of MAX_BYTES + 4 (zeroed); NULL on failure. */
+static uint32_t *read_file(const char *path, const char *shown, size_t *n, char *err,
                            size_t errlen) {
-  enum { MAX_BYTES = 4 * (12 + 2 * 64 * 64 + 2 + 4 * 128 + 1) };
   FILE *f = fopen(path, "rb");
   if (f == NULL) {
     snprintf(err, errlen, "%s: cannot open", shown);
     return NULL;
   }
   uint32_t *w = calloc(MAX_BYTES / 4 + 1, 4);
-  const size_t n = w != NULL ? fread(w, 1, MAX_BYTES + 1, f) : 0;
+  *n = w != NULL ? fread(w, 1, MAX_BYTES + 1, f) : 0;
   fclose(f);
-  if (w == NULL || n > MAX_BYTES || n < 16u || (n & 3u) != 0u || w[2] != n) {
+  if (w == NULL) {
+    snprintf(err, errlen, "%s: out of memory", shown);
+  }
+  return w;
+}
+
+/* The blob's size checks (n bytes in w, a buffer of MAX_BYTES + 4). */
+static int check_blob(const uint32_t *w, size_t n, const char *shown, char *err, size_t errlen) {
+  if (n > MAX_BYTES || n < 16u || (n & 3u) != 0u || w[2] != n) {
     snprintf(err, errlen, "%s: %s", shown,
-             w == NULL            ? "out of memory"
-             : n > MAX_BYTES      ? "larger than the largest map blob"
+             n > MAX_BYTES        ? "larger than the largest map blob"
              : (n & 3u) || n < 16 ? "not a whole number of 32-bit words"
                                   : "size does not match the header");
-    free(w);
-    return NULL;
+    return -1;
   }
-  *size = (uint32_t)n;
-  return w;
+  return 0;
 }
 
 /* The plant's map from the blob's grid (float values, as the core sees). */
@@ -145,6 +152,62 @@ static plant_fluxmap_t *plant_map(const flux_map_t *m, const char *shown, char *
   return pm;
 }
 
+/* The blob in w (n bytes, a buffer of MAX_BYTES + 4 the entry takes on
+ * success) checked, parsed and inverted for the plant into *e. */
+static int load_words(uint32_t *w, size_t n, const char *shown, map_load_t *e, char *err,
+                      size_t errlen) {
+  if (check_blob(w, n, shown, err, errlen) != 0) {
+    return -1;
+  }
+  flux_map_status_t st;
+  if (flux_map_parse(&e->map, w, (uint32_t)n, &st) != 0) {
+    if (st.k >= 0) {
+      snprintf(err, errlen, "%s: %s at grid cell (%d, %d)", shown, flux_map_err_str(st.code), st.j,
+               st.k);
+    } else if (st.j >= 0) {
+      snprintf(err, errlen, "%s: %s (at %d)", shown, flux_map_err_str(st.code), st.j);
+    } else {
+      snprintf(err, errlen, "%s: %s", shown, flux_map_err_str(st.code));
+    }
+    return -1;
+  }
+  e->plant = plant_map(&e->map, shown, err, errlen);
+  if (e->plant == NULL) {
+    return -1;
+  }
+  e->words = w;
+  e->size = (uint32_t)n;
+  return 0;
+}
+
+int map_load_bytes(const void *bytes, size_t n, const char *shown, map_load_t *e, char *err,
+                   size_t errlen) {
+  memset(e, 0, sizeof *e);
+  if (n > MAX_BYTES) {
+    snprintf(err, errlen, "%s: larger than the largest map blob", shown);
+    return -1;
+  }
+  uint32_t *w = calloc(MAX_BYTES / 4 + 1, 4);
+  if (w == NULL) {
+    snprintf(err, errlen, "%s: out of memory", shown);
+    return -1;
+  }
+  if (n > 0u) {
+    memcpy(w, bytes, n);
+  }
+  if (load_words(w, n, shown, e, err, errlen) != 0) {
+    free(w);
+    return -1;
+  }
+  return 0;
+}
+
+void map_load_release(map_load_t *e) {
+  plant_fluxmap_free(e->plant);
+  free((void *)e->words); /* map_load_bytes allocated it */
+  memset(e, 0, sizeof *e);
+}
+
 const map_load_t *map_load(const char *file, const char *origin, char *err, size_t errlen) {
   char path[512];
   if (resolve(file, origin, path, sizeof path) != 0) {
@@ -173,33 +236,19 @@ const map_load_t *map_load(const char *file, const char *origin, char *err, size
     return NULL;
   }
   map_load_t *e = &loaded[n_loaded];
-  uint32_t *w = read_blob(tool ? tmp : path, file, &e->size, err, errlen);
+  size_t n = 0;
+  uint32_t *w = read_file(tool ? tmp : path, file, &n, err, errlen);
   if (tool) {
     remove(tmp);
   }
   if (w == NULL) {
     return NULL;
   }
-  flux_map_status_t st;
-  if (flux_map_parse(&e->map, w, e->size, &st) != 0) {
-    if (st.k >= 0) {
-      snprintf(err, errlen, "%s: %s at grid cell (%d, %d)", file, flux_map_err_str(st.code), st.j,
-               st.k);
-    } else if (st.j >= 0) {
-      snprintf(err, errlen, "%s: %s (at %d)", file, flux_map_err_str(st.code), st.j);
-    } else {
-      snprintf(err, errlen, "%s: %s", file, flux_map_err_str(st.code));
-    }
-    free(w);
-    return NULL;
-  }
-  e->plant = plant_map(&e->map, file, err, errlen);
-  if (e->plant == NULL) {
+  if (load_words(w, n, file, e, err, errlen) != 0) {
     free(w);
     return NULL;
   }
   snprintf(e->path, sizeof e->path, "%s", path);
-  e->words = w;
   n_loaded++;
   return e;
 }

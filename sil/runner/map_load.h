@@ -39,4 +39,11 @@ typedef struct {
  * the file, the check and the grid cell) on failure. */
 const map_load_t *map_load(const char *file, const char *origin, char *err, size_t errlen);
 
+/* The same checks, parse and plant map for a file's contents in memory (n
+ * bytes), into *e without the cache (e->path empty); 0, or -1 with a
+ * message naming `shown`. map_load_release() frees what it holds. */
+int map_load_bytes(const void *bytes, size_t n, const char *shown, map_load_t *e, char *err,
+                   size_t errlen);
+void map_load_release(map_load_t *e);
+
 #endif

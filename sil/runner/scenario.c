@@ -30,6 +30,10 @@ typedef struct {
   int ls_given; /* machine.ls set both inductances (for the error's key) */
 } ctx_t;
 
+static void utf8_clean(char *s);
+
+/* The first error, as "<origin>: <path>: <reason>", made valid UTF-8 (a key
+ * or a string from the file may carry any bytes; the summary is JSON). */
 static int fail(ctx_t *c, const char *path, const char *fmt, ...) {
   if (c->failed) {
     return -1;
@@ -42,6 +46,7 @@ static int fail(ctx_t *c, const char *path, const char *fmt, ...) {
   vsnprintf(reason, sizeof reason, fmt, ap); // NOLINT(clang-analyzer-valist.Uninitialized)
   va_end(ap);
   snprintf(c->err, c->errlen, "%s: %s: %s", c->origin, path, reason);
+  utf8_clean(c->err);
   return -1;
 }
 
@@ -1044,6 +1049,7 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
     }
     snprintf(err, errlen, "%s: line %d: not valid JSON (or text after the top-level object)",
              origin, line);
+    utf8_clean(err);
     return -1;
   }
   static const char *const keys[] = {

@@ -300,6 +300,29 @@ static void live_limits_reclamp_the_references(void **state) {
   assert_float_equal(drv.tm.speed_ref, 50.0f, 1e-3f);
 }
 
+/* Shown by tests/fuzz fuzz_can (its current-limit invariant, on the input
+ * corpus/fuzz_can/regress-imax-lowered): an i_max lowered with the gates off
+ * re-clamps the current references in force as torque_max and speed_max
+ * do; before, a current-mode reference of 3 A stayed in force (and was
+ * taken into the run) under an i_max of 1.77 A. */
+static void lowered_i_max_reclamps_the_currents(void **state) {
+  (void)state;
+  setup_drive();
+  sample(0.0f, 0.0f, 0.0f, 310.0f);
+  const drive_param_t *imax = drive_params_by_name("i_max");
+  const float lim = 0.5f * drv.cfg.i_max;
+  drive_cmd_current(&drv, -1.0f, 3.0f);
+  drive_isr(&drv);
+  assert_float_equal(drv.cmd.iq, 3.0f, 0.0f);
+  assert_int_equal(drive_params_set(&drv, imax->id, lim, NULL), DRIVE_PARAM_OK);
+  drive_isr(&drv);
+  assert_float_equal(drv.cfg.i_max, lim, 0.0f);
+  /* as drive_cmd_current clamps: each axis to the limit (i_q 3 -> lim),
+   * then onto the circle of radius lim */
+  assert_float_equal(hypotf(drv.cmd.id, drv.cmd.iq), lim, 1e-5f * lim);
+  assert_float_equal(drv.cmd.iq / drv.cmd.id, -lim, 1e-4f);
+}
+
 /* Issue 13, item 1: a trip the board's ADC cannot see is refused, at
  * start-up and as a parameter write (a current beyond the ADC's range reads
  * as the full scale and would never reach i_trip). */
@@ -535,6 +558,7 @@ int main(void) {
                                      cmocka_unit_test(invalid_position_faults),
                                      cmocka_unit_test(commands_are_clamped_and_posted),
                                      cmocka_unit_test(live_limits_reclamp_the_references),
+                                     cmocka_unit_test(lowered_i_max_reclamps_the_currents),
                                      cmocka_unit_test(protections_must_fit_the_adc_ranges),
                                      cmocka_unit_test(law_change_waits_for_gates_off),
                                      cmocka_unit_test(syr_machine_runs_foc_only),

@@ -85,7 +85,24 @@ static void refused_maps(void **state) {
   fx_put_f(blob, 12 + 5 * FX_N + 9, NAN);
   fx_reseal(blob);
   write_file("map_nan.fdmap", blob, n);
-  expect_refused("map_nan.fdmap", "flux value not finite at grid cell (9, 5)");
+  expect_refused("map_nan.fdmap", "flux value not finite or beyond 1000 Vs at grid cell (9, 5)");
+  /* finite but beyond any machine: they overflowed the lookups (found by
+   * tests/fuzz fuzz_fluxmap: a torque of inf from 1.6e32 pole pairs) */
+  n = fx_build(&FX_PM, blob);
+  fx_put_f(blob, 12 + 5 * FX_N + 9, 1e4);
+  fx_reseal(blob);
+  write_file("map_huge.fdmap", blob, n);
+  expect_refused("map_huge.fdmap", "beyond 1000 Vs at grid cell (9, 5)");
+  n = fx_build(&FX_PM, blob);
+  fx_put_f(blob, 7, 1.6e32); /* pole pairs */
+  fx_reseal(blob);
+  write_file("map_poles.fdmap", blob, n);
+  expect_refused("map_poles.fdmap", "or beyond 1e5 A or 100 pole pairs");
+  n = fx_build(&FX_PM, blob);
+  fx_put_f(blob, 9, 1e6); /* the i_d step: the grid ends far beyond 1e5 A */
+  fx_reseal(blob);
+  write_file("map_grid.fdmap", blob, n);
+  expect_refused("map_grid.fdmap", "or beyond 1e5 A or 100 pole pairs");
   n = fx_build(&FX_PM, blob);
   fx_break_pd(blob);
   write_file("map_pd.fdmap", blob, n);

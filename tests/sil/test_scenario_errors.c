@@ -224,6 +224,27 @@ static void scenario_name_stays_utf8(void **state) {
   assert_string_equal(sc.name, "a?b??c");
 }
 
+/* Found by fuzz_scenario (tests/fuzz): an unknown key with bytes that are
+ * not UTF-8 made an error message that was not UTF-8 (the key is quoted in
+ * it); the message is cleaned as the name is, also where it is cut. */
+static void error_message_stays_utf8(void **state) {
+  (void)state;
+  static scenario_t sc;
+  char err[512];
+  assert_int_equal(scenario_parse("{\"duration\": 1, \"boa\xff\xfe\xc0\xafrd\": 1}", "e.json", &sc,
+                                  err, sizeof err),
+                   -1);
+  assert_true(utf8_valid(err));
+  assert_string_equal(err, "e.json: boa????rd: unknown field");
+  for (size_t cut = 20; cut < 28; ++cut) { /* a 3-byte character across the end */
+    assert_int_equal(
+        scenario_parse("{\"duration\": 1, \"\xe2\x82\xac\xe2\x82\xac\xe2\x82\xac\": 1}", "e.json",
+                       &sc, err, cut),
+        -1);
+    assert_true(utf8_valid(err));
+  }
+}
+
 /* Issue 13, defect 7: a small inductance that one RK4 step per period
  * would take to NaN is integrated in as many steps as it needs (9 for
  * 0.1 mH and 7.1 Ohm at 16 kHz: h R / L <= 0.5), and stays finite. */
@@ -269,9 +290,11 @@ static void good_scenario_sets_fields(void **state) {
 }
 
 int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(bad_scenarios_name_the_field),
-      cmocka_unit_test(truncated_inputs_never_crash), cmocka_unit_test(good_scenario_sets_fields),
-      cmocka_unit_test(scenario_name_stays_utf8), cmocka_unit_test(small_inductance_is_substepped)};
+  const struct CMUnitTest tests[] = {cmocka_unit_test(bad_scenarios_name_the_field),
+                                     cmocka_unit_test(truncated_inputs_never_crash),
+                                     cmocka_unit_test(good_scenario_sets_fields),
+                                     cmocka_unit_test(scenario_name_stays_utf8),
+                                     cmocka_unit_test(error_message_stays_utf8),
+                                     cmocka_unit_test(small_inductance_is_substepped)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -146,14 +146,22 @@ static dq_t solve(const flux_map_ldq_t *l, dq_t r) {
 }
 
 dq_t flux_map_current(const flux_map_t *m, dq_t lambda) {
+  /* from the zero-current linearisation (the first step from i = 0), then
+   * FLUX_MAP_NEWTON steps. A step that leaves the floats ends the iteration
+   * at the last finite iterate: the parser checks each cell's mean
+   * inductance matrix, not the interpolant's at every point, and a
+   * Jacobian near singular inside a cell or far outside the grid gave
+   * inf, then NaN (found by tests/fuzz fuzz_fluxmap) */
   flux_map_ldq_t l;
-  const dq_t l0 = flux_jac(m, (dq_t){0.0f, 0.0f}, &l);
-  dq_t i = solve(&l, (dq_t){lambda.d - l0.d, lambda.q - l0.q});
-  for (int n = 0; n < FLUX_MAP_NEWTON; ++n) {
+  dq_t i = {0.0f, 0.0f};
+  for (int n = 0; n <= FLUX_MAP_NEWTON; ++n) {
     const dq_t f = flux_jac(m, i, &l);
     const dq_t s = solve(&l, (dq_t){lambda.d - f.d, lambda.q - f.q});
-    i.d += s.d;
-    i.q += s.q;
+    const dq_t next = {i.d + s.d, i.q + s.q};
+    if (!fd_isfinite(next.d + next.q)) {
+      break;
+    }
+    i = next;
   }
   return i;
 }

@@ -28,6 +28,13 @@
 #define FLUX_MAP_GRID_MAX 64u
 #define FLUX_MAP_LUT_MAX  128u
 #define FLUX_MAP_FLAG_PM  1u
+/* Bounds of a blob the parser accepts (found by tests/fuzz fuzz_fluxmap:
+ * finite but huge pole pairs, currents or flux values overflow the
+ * lookups): the pole_pairs parameter's range, grid currents within ten
+ * times the largest i_max, flux values [Vs]. */
+#define FLUX_MAP_POLES_MAX 100.0f
+#define FLUX_MAP_I_MAX     1e5f
+#define FLUX_MAP_PSI_MAX   1e3f
 /* Newton steps of flux_map_current (bounded loop). */
 #define FLUX_MAP_NEWTON 6
 

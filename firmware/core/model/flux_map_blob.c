@@ -4,6 +4,7 @@
  * wrote the blob (tools/src/fluxdrive/fluxmap/) where a wrong blob would
  * make a wrong machine: a blob may come from elsewhere than the tool.
  */
+#include <math.h>
 #include <stddef.h>
 #include <string.h>
 
@@ -61,9 +62,9 @@ const char *flux_map_err_str(flux_map_err_t e) {
       "table points outside 2..128",
       "unknown flags",
       "CRC mismatch",
-      "grid axes or pole pairs not finite and positive",
+      "grid axes or pole pairs not finite and positive, or beyond 1e5 A or 100 pole pairs",
       "grid does not cover both signs of i_q",
-      "flux value not finite",
+      "flux value not finite or beyond 1000 Vs",
       "incremental self-inductance not positive",
       "incremental inductance matrix not positive definite",
       "MTPA/MTPV tables not finite, negative or not increasing",
@@ -84,7 +85,8 @@ static int fail(flux_map_status_t *st, flux_map_err_t code, int j, int k) {
 static int check_cells(const flux_map_t *m, flux_map_status_t *st) {
   const uint32_t n = m->nd * m->nq;
   for (uint32_t o = 0u; o < n; ++o) {
-    if (!fd_isfinite(word_f32(m->psi_d, o)) || !fd_isfinite(word_f32(m->psi_q, o))) {
+    if (!(fabsf(word_f32(m->psi_d, o)) <= FLUX_MAP_PSI_MAX &&
+          fabsf(word_f32(m->psi_q, o)) <= FLUX_MAP_PSI_MAX)) {
       return fail(st, FLUX_MAP_E_FINITE, (int)(o % m->nd), (int)(o / m->nd));
     }
   }
@@ -172,10 +174,13 @@ int flux_map_parse(flux_map_t *m, const uint32_t *w, uint32_t size, flux_map_sta
   const float iq0 = word_f32(w, W_IQ0), diq = word_f32(w, W_DIQ);
   const float z = fd_zero_if_finite(pp) + fd_zero_if_finite(id0) + fd_zero_if_finite(did) +
                   fd_zero_if_finite(iq0) + fd_zero_if_finite(diq);
-  if (!(fd_isfinite(z) && pp >= 1.0f && did > 0.0f && diq > 0.0f)) {
+  const float id1 = id0 + (float)(nd - 1u) * did, iq1 = iq0 + (float)(nq - 1u) * diq;
+  if (!(fd_isfinite(z) && pp >= 1.0f && pp <= FLUX_MAP_POLES_MAX && did > 0.0f && diq > 0.0f &&
+        fabsf(id0) <= FLUX_MAP_I_MAX && fabsf(id1) <= FLUX_MAP_I_MAX &&
+        fabsf(iq0) <= FLUX_MAP_I_MAX && fabsf(iq1) <= FLUX_MAP_I_MAX)) {
     return fail(st, FLUX_MAP_E_AXES, -1, -1);
   }
-  if (!(iq0 < 0.0f && iq0 + (float)(nq - 1u) * diq > 0.0f)) {
+  if (!(iq0 < 0.0f && iq1 > 0.0f)) {
     return fail(st, FLUX_MAP_E_IQ_SIGNS, -1, -1);
   }
   const uint32_t *p = w + W_HEADER;
@@ -208,6 +213,9 @@ int flux_map_parse(flux_map_t *m, const uint32_t *w, uint32_t size, flux_map_sta
   }
   t.mtpa_inv = (float)(nl - 1u) / t.mtpa_t_max;
   t.mtpv_inv = (float)(nl - 1u) / t.mtpv_flux_max;
+  if (!fd_isfinite(t.mtpa_inv + t.mtpv_inv)) { /* a range too small to invert */
+    return fail(st, FLUX_MAP_E_TABLES, -1, -1);
+  }
   if (check_cells(&t, st) != 0 || check_tables(&t, st) != 0) {
     return -1;
   }

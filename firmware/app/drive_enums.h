@@ -47,7 +47,8 @@
   X(LOST_CONTROL, lost_control, "loss of control: current, load angle, tracking or observer")  \
   X(WATCHDOG, watchdog, "the MCU was reset by the watchdog (latched at start-up)")             \
   X(CONFIG, config, "the parameter set in force was refused (law unavailable)")                  \
-  X(CURRENT_SENSOR, current_sensor, "the three measured phase currents do not sum to zero (a gain, an offset, a lost channel)")
+  X(CURRENT_SENSOR, current_sensor, "the three measured phase currents do not sum to zero (a gain, an offset, a lost channel)") \
+  X(GATE_DRIVER, gate_driver, "the gate driver's fault output (nFAULT: desaturation / shoot-through, supply undervoltage) on the break-2 input: gates off in hardware")
 
 /* Position sources: X(ENUM, ident, "name", doc); ident names the source's
  * row (pos_source_<ident>), "name" is what scenarios, logs and CAN use.

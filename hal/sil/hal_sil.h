@@ -44,7 +44,8 @@ typedef struct {
   uint32_t pwm_clamped; /* writes with a leg outside the duty range (caps): the
                          * drive asked for what the board cannot do */
   bool gates_on;
-  bool hw_tripped; /* break input latch (set by the runner) */
+  bool hw_tripped;    /* break input latch (set by the runner) */
+  uint32_t hw_source; /* which break input latched (HAL_BREAK_*; 0: the comparator) */
   uint32_t time_us;
   /* watchdog: the runner calls hal_sil_watchdog_expired() every period */
   uint32_t watchdog_timeout_us;

@@ -14,10 +14,11 @@
  * Preload: OCxPE = 1 and ARPE = 1, so duties written by the ISR after the
  * valley of period k are transferred at the valley k+1 and act over
  * [k+1, k+2).
- * Protection: BKIN (board's comparator) with BKE = 1: MOE is cleared in
- * hardware, outputs go to the idle level (OSSI = 1, OISx = off level), BIF
- * latches until software clears it. AOE = 0: no automatic restart. LOCK
- * level 1 freezes dead time, break and idle configuration until reset.
+ * Protection: BKIN (board's comparator) with BKE = 1 and BKIN2 (the gate
+ * driver's nFAULT) with BK2E = 1: MOE is cleared in hardware, outputs go to
+ * the idle level (OSSI = 1, OISx = off level), BIF / B2IF latch until
+ * software clears them (hal_fault_hw_source() tells them apart). AOE = 0: no automatic restart.
+ * LOCK level 1 freezes dead time, break and idle configuration until reset.
  */
 #include "pwm_tim1.h"
 
@@ -96,6 +97,15 @@ void hal_tim1_init(void) {
 #else
   TIM1->AF1 = 0u; /* no break source: BKE stays 0 */
 #endif
+#if BOARD_HAS_BKIN2
+  TIM1->AF2 = TIM1_AF2_BK2INE; /* BKIN2 pin only, BK2INP = 0 */
+  bdtr |= TIM_BDTR_BK2E | (BOARD_BKIN2_FILTER << TIM_BDTR_BK2F_Pos);
+#if BOARD_BKIN2_ACTIVE_HIGH
+  bdtr |= TIM_BDTR_BK2P;
+#endif
+#else
+  TIM1->AF2 = 0u; /* no gate-driver fault input: BK2E stays 0 */
+#endif
   TIM1->BDTR = bdtr;
 
   TIM1->CR1 = (1u << TIM_CR1_CMS_Pos) | TIM_CR1_ARPE;
@@ -109,6 +119,10 @@ void hal_tim1_init(void) {
 #if BOARD_HAS_BKIN
   const hal_pin_t bkin = BOARD_BKIN_PIN;
   hal_gpio_af(bkin, BOARD_BKIN_ACTIVE_HIGH ? 2u : 1u); /* pull to the inactive level */
+#endif
+#if BOARD_HAS_BKIN2
+  const hal_pin_t bkin2 = BOARD_BKIN2_PIN;
+  hal_gpio_af(bkin2, BOARD_BKIN2_ACTIVE_HIGH ? 2u : 1u); /* nFAULT is open drain */
 #endif
 }
 
@@ -226,9 +240,16 @@ bool hal_pwm_is_enabled(void) {
 }
 
 bool hal_fault_hw_tripped(void) {
-  return (TIM1->SR & (TIM_SR_BIF | TIM_SR_SBIF)) != 0u;
+  return (TIM1->SR & (TIM_SR_BIF | TIM_SR_B2IF | TIM_SR_SBIF)) != 0u;
+}
+
+uint32_t hal_fault_hw_source(void) {
+  const uint32_t sr = TIM1->SR;
+  return ((sr & (TIM_SR_BIF | TIM_SR_SBIF)) != 0u ? (uint32_t)HAL_BREAK_OVERCURRENT : 0u) |
+         ((sr & TIM_SR_B2IF) != 0u ? (uint32_t)HAL_BREAK_GATE_DRIVER : 0u);
 }
 
 void hal_fault_hw_clear(void) {
-  TIM1->SR = ~(TIM_SR_BIF | TIM_SR_SBIF); /* stays set while the input is active */
+  /* stays set while the input is active */
+  TIM1->SR = ~(TIM_SR_BIF | TIM_SR_B2IF | TIM_SR_SBIF);
 }

@@ -663,17 +663,72 @@ static int parse_references(ctx_t *c, const cJSON *o, scenario_t *sc) {
   return 0;
 }
 
+/* A power-stage fault: {"switch" | "phase": name, "active": profile}; it
+ * acts on the switch-level circuit (the switching inverter model). */
+static int parse_power_fault(ctx_t *c, const cJSON *o, const char *key, int is_switch, int *target,
+                             profile_t *active) {
+  static const char *const switches[] = {"a_low", "a_high", "b_low", "b_high",
+                                         "c_low", "c_high", NULL};
+  static const char *const phases[] = {"a", "b", "c", NULL};
+  const cJSON *f = cJSON_GetObjectItemCaseSensitive(o, key);
+  if (f == NULL) {
+    return 0;
+  }
+  char p[160];
+  join(p, sizeof p, "inject", key);
+  const char *sel = is_switch ? "switch" : "phase";
+  const char *const keys[] = {sel, "active", NULL};
+  if (check_keys(c, f, p, keys) != 0) {
+    return -1;
+  }
+  if (cJSON_GetObjectItemCaseSensitive(f, sel) == NULL) {
+    char q[160];
+    join(q, sizeof q, p, sel);
+    return fail(c, q, "required (%s)",
+                is_switch ? "a_low, a_high, b_low, b_high, c_low or c_high" : "a, b or c");
+  }
+  if (cJSON_GetObjectItemCaseSensitive(f, "active") == NULL) {
+    char q[160];
+    join(q, sizeof q, p, "active");
+    return fail(c, q, "required (a profile: the fault acts while it is > 0.5)");
+  }
+  if (get_enum(c, f, p, sel, is_switch ? switches : phases, target) ||
+      get_profile(c, f, p, "active", active)) {
+    return -1;
+  }
+  return 0;
+}
+
 static int parse_inject(ctx_t *c, const cJSON *o, scenario_t *sc) {
-  static const char *const keys[] = {"encoder_error", "encoder_invalid", "main_stall", "isr_stall",
-                                     "cm_scale_d",    "cm_scale_q",      NULL};
+  static const char *const keys[] = {
+      "encoder_error", "encoder_invalid", "main_stall",    "isr_stall",  "cm_scale_d", "cm_scale_q",
+      "gate_driver",   "switch_open",     "switch_closed", "phase_lost", "phase_open", NULL};
   const char *P = "inject";
   if (check_keys(c, o, P, keys) || get_profile(c, o, P, "encoder_error", &sc->encoder_error) ||
       get_profile(c, o, P, "encoder_invalid", &sc->encoder_invalid) ||
       get_profile(c, o, P, "main_stall", &sc->main_stall) ||
       get_profile(c, o, P, "isr_stall", &sc->isr_stall) ||
       get_profile(c, o, P, "cm_scale_d", &sc->cm_scale_d) ||
-      get_profile(c, o, P, "cm_scale_q", &sc->cm_scale_q)) {
+      get_profile(c, o, P, "cm_scale_q", &sc->cm_scale_q) ||
+      get_profile(c, o, P, "gate_driver", &sc->gate_driver) ||
+      parse_power_fault(c, o, "switch_open", 1, &sc->switch_open.target, &sc->switch_open.active) ||
+      parse_power_fault(c, o, "switch_closed", 1, &sc->switch_closed.target,
+                        &sc->switch_closed.active) ||
+      parse_power_fault(c, o, "phase_lost", 0, &sc->phase_lost.target, &sc->phase_lost.active) ||
+      parse_power_fault(c, o, "phase_open", 0, &sc->phase_open.target, &sc->phase_open.active)) {
     return -1;
+  }
+  static const char *const power[] = {"switch_open", "switch_closed", "phase_lost", "phase_open"};
+  for (size_t k = 0; k < sizeof power / sizeof power[0]; ++k) {
+    if (cJSON_GetObjectItemCaseSensitive(o, power[k]) == NULL) {
+      continue;
+    }
+    sc->power_faults = 1;
+    if (sc->plant.inverter.model != PLANT_INV_SWITCHING) {
+      char p[160];
+      join(p, sizeof p, P, power[k]);
+      return fail(c, p, "needs inverter.model: switching (a fault of the switch-level circuit)");
+    }
   }
   return 0;
 }

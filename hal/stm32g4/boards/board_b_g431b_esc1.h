@@ -34,6 +34,8 @@
  * NOT configured yet: OPEN. Until then the break is disabled and the only
  * over-current protection is the drive's sampled i_trip. */
 #define BOARD_HAS_BKIN 0
+/* The kit's L6387E gate drivers have no fault output: no break 2. */
+#define BOARD_HAS_BKIN2 0
 
 /* FDCAN1: PA11 RX / PB9 TX (AF9), transceiver on the ESC board. */
 #define BOARD_CAN_RX_PIN                                                                           \

@@ -50,11 +50,15 @@
 
 /* Loss-of-control conditions (drive_telemetry_t.lc_cause). */
 enum {
-  DRIVE_LC_CURRENT = 1u << 0, /* |i| above lc_current * i_max */
-  DRIVE_LC_DELTA = 1u << 1,   /* |load angle| beyond delta_max + lc_delta */
-  DRIVE_LC_TORQUE = 1u << 2,  /* torque off its (deliverable) reference */
-  DRIVE_LC_FLUX = 1u << 3,    /* flux off its reference */
-  DRIVE_LC_OBSERVER = 1u << 4 /* observer flux off the current model */
+  DRIVE_LC_CURRENT = 1u << 0,  /* |i| above lc_current * i_max */
+  DRIVE_LC_DELTA = 1u << 1,    /* |load angle| beyond delta_max + lc_delta */
+  DRIVE_LC_TORQUE = 1u << 2,   /* torque off its (deliverable) reference */
+  DRIVE_LC_FLUX = 1u << 3,     /* flux off its reference */
+  DRIVE_LC_OBSERVER = 1u << 4, /* observer flux off the current model */
+  /* not a persistence condition (outside DRIVE_LC_COUNT): the slow-rate
+   * phase-balance check (drive.c: an open or lost phase, a switch stuck
+   * open) */
+  DRIVE_LC_PHASE = 1u << 5
 };
 #define DRIVE_LC_COUNT 5
 
@@ -175,7 +179,14 @@ typedef struct {
    * single instructions from the drive's base) ===== */
   uint32_t clear_seen; /* req.clear_count taken */
   uint32_t fault_seen[DRIVE_FAULT_COUNT];
-  int32_t i_sum_n; /* the current-sensor check's leaky count (drive.c) */
+  int32_t i_sum_n;        /* the current-sensor check's leaky count (drive.c) */
+  struct {                /* the phase-balance check's window (drive.c) */
+    float abs[3], sum[3]; /* sums of |i_x| and i_x [A] */
+    float angle;          /* electrical angle swept [rad] */
+    float t_min, t_max;   /* torque reference's range [N m] */
+    int32_t n;            /* samples */
+    int32_t bad;          /* unbalanced revolutions in a row */
+  } ph;
 } drive_t;
 
 /* Validates cfg, initialises everything and latches DRIVE_FAULT_WATCHDOG

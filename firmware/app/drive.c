@@ -509,8 +509,9 @@ static FD_NOINLINE void drive_current_sum_check(drive_t *drv) {
  * rate (the last period's currents); a revolution is judged when it spans
  * at least DRIVE_PH_MIN_N samples (f_e <= f_slow / 4: no aliasing of the
  * means) and at most DRIVE_PH_MAX_N (slower: nearly DC currents are
- * legitimately unequal), the torque reference stayed within DRIVE_PH_STEADY
- * of its largest magnitude and the largest mean |i_x| exceeds DRIVE_PH_FLOOR
+ * legitimately unequal), the torque reference (current mode: |i_d| + |i_q|
+ * of the current references) stayed within DRIVE_PH_STEADY of its largest
+ * magnitude and the largest mean |i_x| exceeds DRIVE_PH_FLOOR
  * i_max. A phase whose mean |i_x| is below DRIVE_PH_OPEN of the largest, or
  * whose |mean i_x| exceeds DRIVE_PH_ONEWAY of its mean |i_x|, in
  * DRIVE_PH_TRIP revolutions in a row (one not judged starts the count
@@ -555,7 +556,11 @@ static FD_NOINLINE void drive_phase_check(drive_t *drv, float w_m) {
     return;
   }
   const float *i = drv->tm.i_abc;
-  const float t = drv->tm.torque_ref;
+  /* the reference the law follows: the torque, or in current mode the
+   * currents' (|i_d| + |i_q|) */
+  const bool cur =
+      drv->cmd.mode == DRIVE_MODE_CURRENT && (drv->ctrl.impl->caps & CTRL_CAP_CURRENT) != 0u;
+  const float t = cur ? fabsf(drv->cmd.id) + fabsf(drv->cmd.iq) : drv->tm.torque_ref;
   if (drv->ph.n == 0) {
     drv->ph.t_min = t;
     drv->ph.t_max = t;

@@ -119,6 +119,7 @@ FD_COLD static void drive_derive(drive_t *drv) {
   drv->lc_n_fast = c->lc_time / c->ts;
   drv->lc_n_track = c->lc_track_time / c->ts;
   drv->inv_pole_pairs = 1.0f / c->pole_pairs;
+  drv->ph_dt = (float)c->slow_div * c->ts;
 }
 
 FD_COLD int drive_config_fits_board(const drive_config_t *cfg, const hal_caps_t *caps,
@@ -501,29 +502,27 @@ static FD_NOINLINE void drive_current_sum_check(drive_t *drv) {
   }
 }
 
-/* Phase balance: over one electrical revolution at a steady operating
- * point every phase carries the same mean |i_x| and no mean i_x. An open
- * phase (motor lead) or a lost one (both switches of a leg off) carries
- * none, a leg with a switch stuck open conducts one way only; the sum check
- * above sees neither (the currents still sum to zero). Sampled at the slow
- * rate (the last period's currents); a revolution is judged when it spans
- * at least DRIVE_PH_MIN_N samples (f_e <= f_slow / 4: no aliasing of the
- * means) and at most DRIVE_PH_MAX_N (slower: nearly DC currents are
- * legitimately unequal), the torque reference (current mode: |i_d| + |i_q|
- * of the current references) stayed within DRIVE_PH_STEADY of its largest
- * magnitude and the largest mean |i_x| exceeds DRIVE_PH_FLOOR
- * i_max. A phase whose mean |i_x| is below DRIVE_PH_OPEN of the largest, or
- * whose |mean i_x| exceeds DRIVE_PH_ONEWAY of its mean |i_x|, in
- * DRIVE_PH_TRIP revolutions in a row (one not judged starts the count
- * again) trips lost_control (lc_cause
- * DRIVE_LC_PHASE). */
+/* Phase balance: over one electrical revolution every phase carries the
+ * same mean |i_x| and no mean i_x. An open phase (motor lead) or a lost one
+ * (both switches of a leg off) carries none, a leg with a switch stuck open
+ * conducts one way only; the sum check above sees neither (the currents
+ * still sum to zero). Sampled at the slow rate, half a slow period after
+ * the speed loop (its ISR, the longest, stays as it was): the last period's
+ * currents, the angle swept from the position source's electrical speed. A
+ * revolution is judged when it spans at least DRIVE_PH_MIN_N samples (f_e <=
+ * f_slow / 4: no aliasing of the means) and at most DRIVE_PH_MAX_N (slower:
+ * nearly DC currents are legitimately unequal) and its largest mean |i_x|
+ * exceeds DRIVE_PH_FLOOR i_max. A phase whose mean |i_x| is below
+ * DRIVE_PH_OPEN of the largest, or whose |mean i_x| exceeds DRIVE_PH_ONEWAY
+ * of its mean |i_x|, in DRIVE_PH_TRIP revolutions in a row (one not judged
+ * starts the count again; a transient, e.g. a torque step, unbalances one)
+ * trips lost_control (lc_cause DRIVE_LC_PHASE). */
 #define DRIVE_PH_MIN_N  4
 #define DRIVE_PH_MAX_N  64
 #define DRIVE_PH_TRIP   2
 #define DRIVE_PH_OPEN   0.2f
 #define DRIVE_PH_ONEWAY 0.6f
 #define DRIVE_PH_FLOOR  0.05f
-#define DRIVE_PH_STEADY 0.2f
 
 static void phase_window_clear(drive_t *drv) {
   const int32_t bad = drv->ph.bad;
@@ -534,10 +533,8 @@ static void phase_window_clear(drive_t *drv) {
 /* The verdict on a full window: 1 unbalanced, 0 balanced, -1 not judged. */
 static int phase_window_verdict(const drive_t *drv) {
   const drive_config_t *c = &drv->cfg;
-  const float t_big = fd_maxf(fabsf(drv->ph.t_min), fabsf(drv->ph.t_max));
   const float big = fd_maxf(drv->ph.abs[0], fd_maxf(drv->ph.abs[1], drv->ph.abs[2]));
-  if (drv->ph.n < DRIVE_PH_MIN_N || drv->ph.t_max - drv->ph.t_min > DRIVE_PH_STEADY * t_big ||
-      big <= DRIVE_PH_FLOOR * c->i_max * (float)drv->ph.n) {
+  if (drv->ph.n < DRIVE_PH_MIN_N || big <= DRIVE_PH_FLOOR * c->i_max * (float)drv->ph.n) {
     return -1;
   }
   for (int x = 0; x < 3; ++x) {
@@ -549,30 +546,18 @@ static int phase_window_verdict(const drive_t *drv) {
   return 0;
 }
 
-static FD_NOINLINE void drive_phase_check(drive_t *drv, float w_m) {
-  const drive_config_t *c = &drv->cfg;
+static FD_NOINLINE void drive_phase_check(drive_t *drv) {
   if (drv->state != DRIVE_STATE_RUN) {
     memset(&drv->ph, 0, sizeof drv->ph);
     return;
   }
   const float *i = drv->tm.i_abc;
-  /* the reference the law follows: the torque, or in current mode the
-   * currents' (|i_d| + |i_q|) */
-  const bool cur =
-      drv->cmd.mode == DRIVE_MODE_CURRENT && (drv->ctrl.impl->caps & CTRL_CAP_CURRENT) != 0u;
-  const float t = cur ? fabsf(drv->cmd.id) + fabsf(drv->cmd.iq) : drv->tm.torque_ref;
-  if (drv->ph.n == 0) {
-    drv->ph.t_min = t;
-    drv->ph.t_max = t;
-  }
   for (int x = 0; x < 3; ++x) {
     drv->ph.abs[x] += fabsf(i[x]);
     drv->ph.sum[x] += i[x];
   }
-  drv->ph.t_min = fd_minf(drv->ph.t_min, t);
-  drv->ph.t_max = fd_maxf(drv->ph.t_max, t);
   drv->ph.n++;
-  drv->ph.angle += fabsf(w_m) * c->pole_pairs * (float)c->slow_div * c->ts;
+  drv->ph.angle += fabsf(drv->pos.out.omega) * drv->ph_dt;
   if (drv->ph.angle < FRAMES_2PI) {
     if (drv->ph.n >= DRIVE_PH_MAX_N) { /* too slow: no verdict */
       memset(&drv->ph, 0, sizeof drv->ph);
@@ -590,15 +575,23 @@ static FD_NOINLINE void drive_phase_check(drive_t *drv, float w_m) {
 
 static void drive_speed_loop(drive_t *drv) {
   const drive_config_t *c = &drv->cfg;
-  if ((drv->isr_count - 1u) % c->slow_div != 0u) {
+  const uint32_t slot = (drv->isr_count - 1u) % c->slow_div;
+  if (slot != 0u) {
+    /* the phase-balance check half a slow period later: the speed loop's
+     * ISR, the longest, stays as it was */
+    if (slot == c->slow_div / 2u) {
+      drive_phase_check(drv);
+    }
     return;
+  }
+  if (c->slow_div < 2u) {
+    drive_phase_check(drv);
   }
   drive_current_sum_check(drv);
   const float w =
       drv->rate_n > 0u ? drv->rate_acc / ((float)drv->rate_n * c->pole_pairs) : drv->omega_m;
   drv->rate_acc = 0.0f;
   drv->rate_n = 0u;
-  drive_phase_check(drv, w);
   if (drv->state == DRIVE_STATE_RUN && drv->cmd.mode == DRIVE_MODE_SPEED) {
     if (!drv->speed_active) {
       speed_ctrl_reset(&drv->speed, w, drv->tm.torque_ref);

@@ -183,10 +183,10 @@ typedef struct {
   struct {                /* the phase-balance check's window (drive.c) */
     float abs[3], sum[3]; /* sums of |i_x| and i_x [A] */
     float angle;          /* electrical angle swept [rad] */
-    float t_min, t_max;   /* torque reference's range [N m] */
     int32_t n;            /* samples */
     int32_t bad;          /* unbalanced revolutions in a row */
   } ph;
+  float ph_dt; /* its sample period, slow_div ts [s] */
 } drive_t;
 
 /* Validates cfg, initialises everything and latches DRIVE_FAULT_WATCHDOG

@@ -119,7 +119,6 @@ FD_COLD static void drive_derive(drive_t *drv) {
   drv->lc_n_fast = c->lc_time / c->ts;
   drv->lc_n_track = c->lc_track_time / c->ts;
   drv->inv_pole_pairs = 1.0f / c->pole_pairs;
-  drv->ph_dt = (float)c->slow_div * c->ts;
 }
 
 FD_COLD int drive_config_fits_board(const drive_config_t *cfg, const hal_caps_t *caps,
@@ -502,90 +501,10 @@ static FD_NOINLINE void drive_current_sum_check(drive_t *drv) {
   }
 }
 
-/* Phase balance: over one electrical revolution every phase carries the
- * same mean |i_x| and no mean i_x. An open phase (motor lead) or a lost one
- * (both switches of a leg off) carries none, a leg with a switch stuck open
- * conducts one way only; the sum check above sees neither (the currents
- * still sum to zero). Sampled at the slow rate, half a slow period after
- * the speed loop (its ISR, the longest, stays as it was): the last period's
- * currents, the angle swept from the position source's electrical speed. A
- * revolution is judged when it spans at least DRIVE_PH_MIN_N samples (f_e <=
- * f_slow / 4: no aliasing of the means) and at most DRIVE_PH_MAX_N (slower:
- * nearly DC currents are legitimately unequal) and its largest mean |i_x|
- * exceeds DRIVE_PH_FLOOR i_max. A phase whose mean |i_x| is below
- * DRIVE_PH_OPEN of the largest, or whose |mean i_x| exceeds DRIVE_PH_ONEWAY
- * of its mean |i_x|, in DRIVE_PH_TRIP revolutions in a row (one not judged
- * starts the count again; a transient, e.g. a torque step, unbalances one)
- * trips lost_control (lc_cause DRIVE_LC_PHASE). */
-#define DRIVE_PH_MIN_N  4
-#define DRIVE_PH_MAX_N  64
-#define DRIVE_PH_TRIP   2
-#define DRIVE_PH_OPEN   0.2f
-#define DRIVE_PH_ONEWAY 0.6f
-#define DRIVE_PH_FLOOR  0.05f
-
-static void phase_window_clear(drive_t *drv) {
-  const int32_t bad = drv->ph.bad;
-  memset(&drv->ph, 0, sizeof drv->ph);
-  drv->ph.bad = bad;
-}
-
-/* The verdict on a full window: 1 unbalanced, 0 balanced, -1 not judged. */
-static int phase_window_verdict(const drive_t *drv) {
-  const drive_config_t *c = &drv->cfg;
-  const float big = fd_maxf(drv->ph.abs[0], fd_maxf(drv->ph.abs[1], drv->ph.abs[2]));
-  if (drv->ph.n < DRIVE_PH_MIN_N || big <= DRIVE_PH_FLOOR * c->i_max * (float)drv->ph.n) {
-    return -1;
-  }
-  for (int x = 0; x < 3; ++x) {
-    if (drv->ph.abs[x] < DRIVE_PH_OPEN * big ||
-        fabsf(drv->ph.sum[x]) > DRIVE_PH_ONEWAY * drv->ph.abs[x]) {
-      return 1;
-    }
-  }
-  return 0;
-}
-
-static FD_NOINLINE void drive_phase_check(drive_t *drv) {
-  if (drv->state != DRIVE_STATE_RUN) {
-    memset(&drv->ph, 0, sizeof drv->ph);
-    return;
-  }
-  const float *i = drv->tm.i_abc;
-  for (int x = 0; x < 3; ++x) {
-    drv->ph.abs[x] += fabsf(i[x]);
-    drv->ph.sum[x] += i[x];
-  }
-  drv->ph.n++;
-  drv->ph.angle += fabsf(drv->pos.out.omega) * drv->ph_dt;
-  if (drv->ph.angle < FRAMES_2PI) {
-    if (drv->ph.n >= DRIVE_PH_MAX_N) { /* too slow: no verdict */
-      memset(&drv->ph, 0, sizeof drv->ph);
-    }
-    return;
-  }
-  const int v = phase_window_verdict(drv);
-  drv->ph.bad = v > 0 ? drv->ph.bad + 1 : 0;
-  phase_window_clear(drv);
-  if (drv->ph.bad >= DRIVE_PH_TRIP) {
-    drv->tm.lc_cause = DRIVE_LC_PHASE;
-    drive_trip(drv, DRIVE_FAULT_LOST_CONTROL);
-  }
-}
-
 static void drive_speed_loop(drive_t *drv) {
   const drive_config_t *c = &drv->cfg;
-  const uint32_t slot = (drv->isr_count - 1u) % c->slow_div;
-  if (slot != 0u) {
-    /* the phase-balance check half a slow period later: the speed loop's
-     * ISR, the longest, stays as it was */
-    if (slot == c->slow_div / 2u) {
-      drive_phase_check(drv);
-    }
+  if ((drv->isr_count - 1u) % c->slow_div != 0u) {
     return;
-  }
-  if (c->slow_div < 2u) {
-    drive_phase_check(drv);
   }
   drive_current_sum_check(drv);
   const float w =

@@ -44,21 +44,18 @@
 #include "control/speed_ctrl.h"
 #include "ctrl.h"
 #include "drive_config.h"
+#include "drive_phase_check.h"
 #include "hal.h"
 #include "model/machine.h"
 #include "pos_source.h"
 
 /* Loss-of-control conditions (drive_telemetry_t.lc_cause). */
 enum {
-  DRIVE_LC_CURRENT = 1u << 0,  /* |i| above lc_current * i_max */
-  DRIVE_LC_DELTA = 1u << 1,    /* |load angle| beyond delta_max + lc_delta */
-  DRIVE_LC_TORQUE = 1u << 2,   /* torque off its (deliverable) reference */
-  DRIVE_LC_FLUX = 1u << 3,     /* flux off its reference */
-  DRIVE_LC_OBSERVER = 1u << 4, /* observer flux off the current model */
-  /* not a persistence condition (outside DRIVE_LC_COUNT): the slow-rate
-   * phase-balance check (drive.c: an open or lost phase, a switch stuck
-   * open) */
-  DRIVE_LC_PHASE = 1u << 5
+  DRIVE_LC_CURRENT = 1u << 0, /* |i| above lc_current * i_max */
+  DRIVE_LC_DELTA = 1u << 1,   /* |load angle| beyond delta_max + lc_delta */
+  DRIVE_LC_TORQUE = 1u << 2,  /* torque off its (deliverable) reference */
+  DRIVE_LC_FLUX = 1u << 3,    /* flux off its reference */
+  DRIVE_LC_OBSERVER = 1u << 4 /* observer flux off the current model */
 };
 #define DRIVE_LC_COUNT 5
 
@@ -102,7 +99,7 @@ typedef struct {
   uint32_t clear_mark[DRIVE_FAULT_COUNT];  /* fault_count at the last clear */
 } drive_cmd_t;
 
-typedef struct {
+typedef struct drive_s {
   /* ===== owned by the ISR ===== */
   drive_config_t cfg; /* in force */
   machine_t machine;
@@ -167,11 +164,12 @@ typedef struct {
     drive_config_t cfg;
   } creq;
   struct {
-    machine_t machine;    /* of the requested parameter set (law checks) */
-    flux_map_t map;       /* its flux map (machine.map points here) */
-    uint32_t isr_seen;    /* ISR count at the last watchdog refresh */
-    drive_telemetry_t tm; /* last consistent telemetry copy */
-    uint32_t tm_retries;  /* copies that had to be retried (preemption) */
+    machine_t machine;      /* of the requested parameter set (law checks) */
+    flux_map_t map;         /* its flux map (machine.map points here) */
+    uint32_t isr_seen;      /* ISR count at the last watchdog refresh */
+    drive_telemetry_t tm;   /* last consistent telemetry copy */
+    uint32_t tm_retries;    /* copies that had to be retried (preemption) */
+    drive_phase_check_t ph; /* the phase-balance check (drive_phase_check.h) */
   } host;
 
   /* ===== ISR-owned, used at the slow rate or on a command (last: the
@@ -179,14 +177,7 @@ typedef struct {
    * single instructions from the drive's base) ===== */
   uint32_t clear_seen; /* req.clear_count taken */
   uint32_t fault_seen[DRIVE_FAULT_COUNT];
-  int32_t i_sum_n;        /* the current-sensor check's leaky count (drive.c) */
-  struct {                /* the phase-balance check's window (drive.c) */
-    float abs[3], sum[3]; /* sums of |i_x| and i_x [A] */
-    float angle;          /* electrical angle swept [rad] */
-    int32_t n;            /* samples */
-    int32_t bad;          /* unbalanced revolutions in a row */
-  } ph;
-  float ph_dt; /* its sample period, slow_div ts [s] */
+  int32_t i_sum_n; /* the current-sensor check's leaky count (drive.c) */
 } drive_t;
 
 /* Validates cfg, initialises everything and latches DRIVE_FAULT_WATCHDOG

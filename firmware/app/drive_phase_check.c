@@ -13,7 +13,6 @@
 
 static void window_clear(drive_phase_check_t *p) {
   memset(p->abs, 0, sizeof p->abs);
-  memset(p->sum, 0, sizeof p->sum);
   p->angle = 0.0f;
   p->n = 0;
 }
@@ -25,7 +24,7 @@ static int verdict(const drive_phase_check_t *p, float i_max) {
     return -1;
   }
   for (int x = 0; x < 3; ++x) {
-    if (p->abs[x] < DRIVE_PH_OPEN * big || fabsf(p->sum[x]) > DRIVE_PH_ONEWAY * p->abs[x]) {
+    if (p->abs[x] < DRIVE_PH_OPEN * big) {
       return 1;
     }
   }
@@ -49,7 +48,6 @@ void drive_phase_check(drive_t *drv) {
   }
   for (int x = 0; x < 3; ++x) {
     p->abs[x] += fabsf(tm->i_abc[x]);
-    p->sum[x] += tm->i_abc[x];
   }
   p->n++;
   p->angle += fabsf(tm->omega_m) * c->pole_pairs * (float)isrs * c->ts;

@@ -210,16 +210,20 @@ static void healthy_does_not_trip(void **state) {
 }
 
 /* The high side of leg a stuck open: phase a carries positive current only
- * through its low diode (leg at 0 V), so mostly one way: the phase-balance
- * check trips. */
+ * through its low diode (leg at 0 V): less torque than asked, nothing the
+ * drive checks is exceeded: ridden through undetected (docs/faults.md). */
 static void switch_stuck_open(void **state) {
   (void)state;
   trace_t tr;
   scenario_t sc;
   run_fault("\"switch_open\": {\"switch\": \"a_high\", " ACTIVE_FROM_INJ "}", &tr, &sc);
-  check_phase_trip(&tr, "a_high stuck open");
+  const double torque = mean_over(tr.torque, &tr, 0.2, 0.3);
   const double i_pk = max_over(tr.imax_abs, &tr, T_INJ, 0.3);
-  printf("a_high stuck open: peak current %.3f A\n", i_pk);
+  printf("a_high stuck open: faults 0x%x, mean torque 0.2-0.3 s %.3f N m (ref %.1f), peak "
+         "current %.3f A\n",
+         tr.faults[tr.n - 1], torque, T_REF, i_pk);
+  assert_true(first_fault(&tr) >= tr.n);
+  assert_true(torque > 0.0 && torque < T_REF);
   assert_true(i_pk < sc.drive.i_trip);
   trace_free(&tr);
 }

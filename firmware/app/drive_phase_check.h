@@ -28,7 +28,10 @@
 #define DRIVE_PH_MIN_N 4
 #define DRIVE_PH_MAX_N 64
 #define DRIVE_PH_TRIP  2
-#define DRIVE_PH_OPEN  0.2f
+/* below 0.08 of the largest: an open or lost phase gives 0.02 at most (the
+ * lost leg's diodes), healthy runs 0.14 at least (the decoupled DFVC's
+ * stationary current at light load, tests/python/test_fabbri2022_kf.py) */
+#define DRIVE_PH_OPEN  0.08f
 #define DRIVE_PH_FLOOR 0.05f
 
 typedef struct {

@@ -137,9 +137,16 @@ bool hal_can_receive(hal_can_frame_t *f);
 /* Free-running microsecond time (wraps after 2^32 us). */
 uint32_t hal_time_us(void);
 
-/* Hardware protection: the break input (comparator overcurrent) turns the
- * gates off in hardware and latches; the drive reads and clears it. */
+/* Hardware protection: a break input turns the gates off in hardware and
+ * latches; the drive reads and clears it. Two sources: the board's
+ * overcurrent comparator (break 1) and the gate driver's fault output
+ * nFAULT (break 2: desaturation / shoot-through, driver supply
+ * undervoltage, overtemperature). hal_fault_hw_tripped() is either (the one
+ * call the ISR makes every period); hal_fault_hw_source() says which
+ * (HAL_BREAK_* bits), read only once one has tripped. */
+enum { HAL_BREAK_OVERCURRENT = 1u << 0, HAL_BREAK_GATE_DRIVER = 1u << 1 };
 bool hal_fault_hw_tripped(void);
+uint32_t hal_fault_hw_source(void);
 void hal_fault_hw_clear(void);
 
 /* Watchdog refresh. Called only by drive_background() (main loop), and

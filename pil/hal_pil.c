@@ -12,7 +12,8 @@ static hal_sample_t sample;
 static hal_pwm_t pwm;
 static bool gates_on;
 static bool hw_tripped;
-static bool shorted; /* hal_pwm_short: not in the stream (no PIL scenario trips) */
+static bool shorted;      /* hal_pwm_short: not in the stream (no PIL scenario trips) */
+static uint32_t in_flags; /* the record's flags (the break's source, read on a trip) */
 static uint32_t time_us;
 
 void hal_pil_set_caps(const hal_caps_t *c, uint32_t timer_counts) {
@@ -38,6 +39,7 @@ void hal_pil_set_input(const isr_stream_in_t *in) {
   sample.enc_valid = (in->flags & ISR_IN_ENC_VALID) != 0u;
   sample.valid = (in->flags & ISR_IN_VALID) != 0u;
   hw_tripped = (in->flags & ISR_IN_HW_TRIPPED) != 0u;
+  in_flags = in->flags;
   if (hw_tripped) {
     gates_on = false; /* the break input turns the gates off in hardware */
     shorted = false;
@@ -112,8 +114,13 @@ bool hal_fault_hw_tripped(void) {
   return hw_tripped;
 }
 
+uint32_t hal_fault_hw_source(void) {
+  return (in_flags & ISR_IN_GATE_DRIVER) != 0u ? (uint32_t)HAL_BREAK_GATE_DRIVER : 0u;
+}
+
 void hal_fault_hw_clear(void) {
   hw_tripped = false;
+  in_flags &= ~ISR_IN_GATE_DRIVER;
 }
 
 void hal_watchdog_kick(void) {}

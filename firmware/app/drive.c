@@ -339,6 +339,18 @@ static void take_commands(drive_t *drv) {
 
 /* ---------------------------------------------------------- protections */
 
+/* The causes of a latched break: the comparator's (also when the board
+ * cannot tell) and / or the gate driver's. Off the periodic path: called
+ * only once a break has tripped. */
+static FD_NOINLINE uint32_t drive_break_causes(void) {
+  const uint32_t src = hal_fault_hw_source();
+  uint32_t f = (src & HAL_BREAK_GATE_DRIVER) != 0u ? DRIVE_FAULT_GATE_DRIVER : 0u;
+  if ((src & HAL_BREAK_OVERCURRENT) != 0u || f == 0u) {
+    f |= DRIVE_FAULT_HW_OVERCURRENT;
+  }
+  return f;
+}
+
 static uint32_t drive_protect(const drive_t *drv, const hal_sample_t *s, const float i[3]) {
   const drive_config_t *c = &drv->cfg;
   if (!s->valid ||
@@ -359,7 +371,7 @@ static uint32_t drive_protect(const drive_t *drv, const hal_sample_t *s, const f
     f |= DRIVE_FAULT_OVERSPEED;
   }
   if (hal_fault_hw_tripped()) {
-    f |= DRIVE_FAULT_HW_OVERCURRENT;
+    f |= drive_break_causes();
   }
   /* the position must be usable before the gates go on, and plausible
    * while they are */

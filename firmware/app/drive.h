@@ -44,6 +44,7 @@
 #include "control/speed_ctrl.h"
 #include "ctrl.h"
 #include "drive_config.h"
+#include "drive_phase_check.h"
 #include "hal.h"
 #include "model/machine.h"
 #include "pos_source.h"
@@ -111,7 +112,7 @@ typedef struct {
   uint32_t n_high; /* consecutive periods above the entry speed (gates off) */
 } drive_safe_t;
 
-typedef struct {
+typedef struct drive_s {
   /* ===== owned by the ISR ===== */
   const hal_caps_t *caps;
   drive_state_t state;
@@ -181,11 +182,12 @@ typedef struct {
     drive_config_t cfg;
   } creq;
   struct {
-    machine_t machine;    /* of the requested parameter set (law checks) */
-    flux_map_t map;       /* its flux map (machine.map points here) */
-    uint32_t isr_seen;    /* ISR count at the last watchdog refresh */
-    drive_telemetry_t tm; /* last consistent telemetry copy */
-    uint32_t tm_retries;  /* copies that had to be retried (preemption) */
+    machine_t machine;      /* of the requested parameter set (law checks) */
+    flux_map_t map;         /* its flux map (machine.map points here) */
+    uint32_t isr_seen;      /* ISR count at the last watchdog refresh */
+    drive_telemetry_t tm;   /* last consistent telemetry copy */
+    uint32_t tm_retries;    /* copies that had to be retried (preemption) */
+    drive_phase_check_t ph; /* the phase-balance check (drive_phase_check.h) */
   } host;
 
   /* ===== ISR-owned, used at the slow rate or on a command (last: the

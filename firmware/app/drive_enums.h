@@ -48,7 +48,8 @@
   X(WATCHDOG, watchdog, "the MCU was reset by the watchdog (latched at start-up)")             \
   X(CONFIG, config, "the parameter set in force was refused (law unavailable)")                  \
   X(CURRENT_SENSOR, current_sensor, "the three measured phase currents do not sum to zero (a gain, an offset, a lost channel)") \
-  X(OVERRUN, overrun, "the PWM-period interrupt overran its period repeatedly (overrun_k of the last overrun_n slow periods)")
+  X(OVERRUN, overrun, "the PWM-period interrupt overran its period repeatedly (overrun_k of the last overrun_n slow periods)") \
+  X(GATE_DRIVER, gate_driver, "the gate driver's fault output (nFAULT: desaturation / shoot-through, supply undervoltage) on the break-2 input: gates off in hardware")
 
 /* Position sources: X(ENUM, ident, "name", doc); ident names the source's
  * row (pos_source_<ident>), "name" is what scenarios, logs and CAN use.

@@ -36,6 +36,7 @@ void drive_background(drive_t *drv) {
   drive_telemetry_t tm;
   if (drive_telemetry_read(drv, &tm)) {
     drv->host.tm = tm;
+    drive_phase_check(drv);
   }
   const uint32_t n = drv->isr_count; /* one aligned word: read atomically */
   if (n != drv->host.isr_seen) {

@@ -59,7 +59,7 @@
 #define I_FLOOR      0.02f  /* current vector too small to turn, times i_max */
 
 /* Faults after which the bridge is not trusted with a short. */
-#define SAFE_NO_ASC DRIVE_FAULT_HW_OVERCURRENT
+#define SAFE_NO_ASC (DRIVE_FAULT_HW_OVERCURRENT | DRIVE_FAULT_GATE_DRIVER)
 
 static bool asc_allowed(const drive_t *drv) {
   return drv->cfg.asc_speed > 0.0f && drv->i_sc < drv->cfg.i_max &&

@@ -118,8 +118,13 @@ bool hal_fault_hw_tripped(void) {
   return bound->hw_tripped;
 }
 
+uint32_t hal_fault_hw_source(void) {
+  return bound->hw_source;
+}
+
 void hal_fault_hw_clear(void) {
   bound->hw_tripped = false;
+  bound->hw_source = 0u;
 }
 
 void hal_watchdog_kick(void) {

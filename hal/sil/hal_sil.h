@@ -46,6 +46,7 @@ typedef struct {
   bool gates_on;        /* modulating (the preloaded pattern) */
   bool asc;             /* active short circuit: all low sides on (hal_pwm_short) */
   bool hw_tripped;      /* break input latch (set by the runner) */
+  uint32_t hw_source;   /* which break input latched (HAL_BREAK_*; 0: the comparator) */
   uint32_t time_us;
   /* watchdog: the runner calls hal_sil_watchdog_expired() every period */
   uint32_t watchdog_timeout_us;

@@ -3,7 +3,7 @@
  * lives:
  *   hal_adc_read                      adc.c (JDR of ADC1/ADC2 -> SI)
  *   hal_pwm_set_duty/enable/disable/is_enabled,
- *   hal_fault_hw_tripped/clear        pwm_tim1.c (CCRx, BDTR.MOE, SR.BIF)
+ *   hal_fault_hw_tripped/source/clear pwm_tim1.c (CCRx, BDTR.MOE, SR.BIF, B2IF)
  *   hal_can_send/receive              fdcan.c (Tx FIFO, Rx FIFO 0)
  *   hal_time_us                       time.c (TIM2 at 1 MHz)
  *   hal_watchdog_kick                 iwdg.c

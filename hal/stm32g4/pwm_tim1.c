@@ -24,6 +24,9 @@
  * (BKE, BKP, BKF, AF1 sources and polarities) and the idle levels OISx
  * until reset; OSSI/OSSR (level 2) and OCxM (level 3) stay writable, so
  * hal_pwm_short() works.
+ * BKIN2 (the gate driver's nFAULT, boards with BOARD_HAS_BKIN2) with BK2E = 1
+ * acts the same way; BIF / B2IF latch separately (hal_fault_hw_source()
+ * tells them apart).
  */
 #include "pwm_tim1.h"
 
@@ -107,6 +110,15 @@ void hal_tim1_init(void) {
 #else
   TIM1->AF1 = 0u; /* no break source: BKE stays 0 */
 #endif
+#if BOARD_HAS_BKIN2
+  TIM1->AF2 = TIM1_AF2_BK2INE; /* BKIN2 pin only, BK2INP = 0 */
+  bdtr |= TIM_BDTR_BK2E | (BOARD_BKIN2_FILTER << TIM_BDTR_BK2F_Pos);
+#if BOARD_BKIN2_ACTIVE_HIGH
+  bdtr |= TIM_BDTR_BK2P;
+#endif
+#else
+  TIM1->AF2 = 0u; /* no gate-driver fault input: BK2E stays 0 */
+#endif
   TIM1->BDTR = bdtr;
 
   TIM1->CR1 = (1u << TIM_CR1_CMS_Pos) | TIM_CR1_ARPE;
@@ -120,6 +132,10 @@ void hal_tim1_init(void) {
 #if BOARD_HAS_BKIN
   const hal_pin_t bkin = BOARD_BKIN_PIN;
   hal_gpio_af(bkin, BOARD_BKIN_ACTIVE_HIGH ? 2u : 1u); /* pull to the inactive level */
+#endif
+#if BOARD_HAS_BKIN2
+  const hal_pin_t bkin2 = BOARD_BKIN2_PIN;
+  hal_gpio_af(bkin2, BOARD_BKIN2_ACTIVE_HIGH ? 2u : 1u); /* nFAULT is open drain */
 #endif
 }
 
@@ -262,9 +278,16 @@ bool hal_pwm_is_shorted(void) {
 }
 
 bool hal_fault_hw_tripped(void) {
-  return (TIM1->SR & (TIM_SR_BIF | TIM_SR_SBIF)) != 0u;
+  return (TIM1->SR & (TIM_SR_BIF | TIM_SR_B2IF | TIM_SR_SBIF)) != 0u;
+}
+
+uint32_t hal_fault_hw_source(void) {
+  const uint32_t sr = TIM1->SR;
+  return ((sr & (TIM_SR_BIF | TIM_SR_SBIF)) != 0u ? (uint32_t)HAL_BREAK_OVERCURRENT : 0u) |
+         ((sr & TIM_SR_B2IF) != 0u ? (uint32_t)HAL_BREAK_GATE_DRIVER : 0u);
 }
 
 void hal_fault_hw_clear(void) {
-  TIM1->SR = ~(TIM_SR_BIF | TIM_SR_SBIF); /* stays set while the input is active */
+  /* stays set while the input is active */
+  TIM1->SR = ~(TIM_SR_BIF | TIM_SR_B2IF | TIM_SR_SBIF);
 }

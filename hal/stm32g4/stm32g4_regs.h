@@ -212,6 +212,12 @@ typedef struct {
 #define TIM1_AF1_BKINE      (1u << 0)             /* BKIN pin enable (reset value 1) */
 #define TIM1_AF1_BKCMP1E    (1u << 1)             /* COMPx output to break: bit x */
 #define TIM1_AF1_BKCMPE(x)  (1u << (uint32_t)(x)) /* x = 1..7 */
+#define TIM_BDTR_BK2F_Pos   20u
+#define TIM_BDTR_BK2E       (1u << 24)
+#define TIM_BDTR_BK2P       (1u << 25)
+#define TIM1_AF2_BK2INE     (1u << 0) /* BKIN2 pin enable (reset value 1) */
+#define TIM1_AF1_BKINE      (1u << 0) /* BKIN pin enable (reset value 1) */
+#define TIM1_AF1_BKCMP1E    (1u << 1) /* COMPx output to break: bit x */
 #define TIM1_AF1_BKINP      (1u << 9)
 #define TIM1_AF1_BKCMPP(x)  (1u << (9u + (uint32_t)(x))) /* x = 1..4: polarity */
 

@@ -150,7 +150,7 @@ void plant_step_pattern(plant_t *pl, const double on_in[3], const double off_in[
   double x[X_N] = {pl->lambda_d, pl->lambda_q, pl->theta_m, pl->omega_m, pl->v_dc, 0, 0, 0, 0};
   const int avg = pl->p.inverter.model == PLANT_INV_AVERAGE;
   double cs_end[2] = {NAN, NAN}; /* cos, sin of the end angle (average model) */
-  if (gates_on && avg) {
+  if (gates_on && avg && !pl->aux.pf_any) {
     plant_inverter_avg_period(pl, d, x, cs_end);
     for (int j = 0; j < 3; j++) {
       pl->aux.cond[j] = -1; /* all legs driven: no diode state */
@@ -240,4 +240,24 @@ void plant_get_state(const plant_t *pl, plant_state_t *out) {
   out->torque_avg = pl->torque_avg;
   out->i_dq_avg[0] = pl->i_dq_avg[0];
   out->i_dq_avg[1] = pl->i_dq_avg[1];
+}
+
+int plant_set_power_faults(plant_t *pl, const plant_power_fault_t *f) {
+  for (int j = 0; j < 3; j++) {
+    const unsigned both = PLANT_SW_LOW(j) | PLANT_SW_HIGH(j);
+    if ((f->closed & both) == both) {
+      return -1;
+    }
+  }
+  pl->aux.pf.open = f->open & 0x3Fu;
+  pl->aux.pf.closed = f->closed & 0x3Fu;
+  pl->aux.pf.phase_open = f->phase_open & 0x7u;
+  pl->aux.pf_any = (pl->aux.pf.open | pl->aux.pf.closed | pl->aux.pf.phase_open) != 0u;
+  return 0;
+}
+
+bool plant_take_desat(plant_t *pl) {
+  const bool d = pl->aux.desat != 0;
+  pl->aux.desat = 0;
+  return d;
 }

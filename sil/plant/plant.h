@@ -181,6 +181,18 @@ typedef struct {
   double v_dc;     /* [V] */
 } plant_brief_t;
 
+/* Power-stage faults (switching inverter model, plant_inverter_sw.c).
+ * Switch bit of leg x (0..2): PLANT_SW_LOW(x), PLANT_SW_HIGH(x). */
+#define PLANT_SW_LOW(x)  (1u << (2 * (x)))
+#define PLANT_SW_HIGH(x) (1u << (2 * (x) + 1))
+typedef struct {
+  unsigned open;       /* switches that never conduct (their diodes still do); both
+                          of a leg: the leg's gate signals lost, it floats */
+  unsigned closed;     /* switches that conduct whatever the gates (at most one per leg) */
+  unsigned phase_open; /* bit x: phase x's lead disconnected (its current is zero,
+                          its terminal floats) */
+} plant_power_fault_t;
+
 /* Internal working data of plant_t (constants precomputed by plant_init,
  * caches and the memory of the switching-level inverter). Not part of the
  * API: read the state through plant_get_state(). */
@@ -201,7 +213,13 @@ typedef struct {
   double edge_t[3];
   int edge_cmd[3];
   int cond[3];
-  int all_zero;   /* all phase currents blocked by the diodes */
+  int all_zero; /* all phase currents blocked by the diodes */
+  /* power-stage faults in force (plant_set_power_faults), any of them set;
+   * a shoot-through ended by the gate driver since the last
+   * plant_take_desat() (healthy switches held off while set) */
+  plant_power_fault_t pf;
+  int pf_any;
+  int desat;
   int gates_prev; /* gates were on during the last period */
   double v_star;  /* star-point voltage at the last valley (see plant_sample) */
   /* star-point samples (plant_star.c): requested instants of the next
@@ -299,6 +317,19 @@ void plant_star_gain(const plant_t *pl, double theta_e, double i_q, double g[3])
 /* Sensor readings at the present plant time (the carrier valley). */
 void plant_sample(plant_t *pl, plant_adc_t *out);
 void plant_get_state(const plant_t *pl, plant_state_t *out);
+/* Power-stage faults from the next plant_step on (between steps; all zero:
+ * healthy). They act on the switch-level circuit: with gates on they need
+ * the switching model (the average model's periods are routed to it while
+ * any is set). Returns -1 (nothing changed) for two stuck-closed switches
+ * in one leg. */
+int plant_set_power_faults(plant_t *pl, const plant_power_fault_t *f);
+/* A shoot-through since the last call: a stuck-closed switch's partner was
+ * commanded on. The gate driver's desaturation detection turns that switch
+ * off again within its blanking time (taken as zero: the shoot-through
+ * current, which bypasses the machine, is not integrated) and holds every
+ * healthy switch off; the caller latches its fault output (nFAULT).
+ * Returns and clears the flag. */
+bool plant_take_desat(plant_t *pl);
 /* The same values as plant_get_state() for the members of plant_brief_t,
  * cheaply: the currents are computed once per state and shared with
  * plant_sample() (hence not const). */

@@ -24,13 +24,22 @@
  * most Ts/substeps; diode events inside an interval (current zero crossing,
  * blocked-leg voltage leaving [0, v_dc], all-zero gap opening) are located
  * with the Illinois method to 1e-8 Ts and the step is split there.
+ * Power-stage faults (plant_set_power_faults): a switch stuck open drops
+ * out of the commanded leg state (both of a leg: the leg floats on its
+ * diodes), a switch stuck closed conducts whatever the gates; a leg with
+ * both switches on is a shoot-through, ended at once by the gate driver's
+ * desaturation detection (aux.desat: every healthy switch off from then
+ * on). An open phase is a leg of its own kind (LEG_OPEN): always blocked,
+ * its terminal at whatever potential keeps its current zero, without the
+ * [0, v_dc] bound of a diode leg (no EV_U events, unbounded in the
+ * all-zero state).
  */
 #include "plant_internal.h"
 
 #include <math.h>
 #include <string.h>
 
-enum { LEG_LO, LEG_HI, LEG_FLOAT };
+enum { LEG_LO, LEG_HI, LEG_FLOAT, LEG_OPEN };
 enum { COND_NONE = -1, COND_LO = 0, COND_HI = 1, COND_BLOCK = 2 };
 enum { EV_CUR0 = 0, EV_U_LO = 3, EV_U_HI = 4, EV_GAP = 5, EV_N = 6 };
 
@@ -70,6 +79,11 @@ static void phase_currents(const plant_t *pl, const double *x, double i[3], doub
 
 /* Allowed leg potential range for the all-zero state. */
 static void leg_range(int type, double vdc, double *lo, double *hi) {
+  if (type == LEG_OPEN) {
+    *lo = -1e300;
+    *hi = 1e300;
+    return;
+  }
   *lo = type == LEG_HI ? vdc : 0.0;
   *hi = type == LEG_LO ? 0.0 : vdc;
 }
@@ -182,7 +196,7 @@ static void enter_all_zero(const plant_t *pl, sw_cfg_t *cf, double *x) {
   cf->all_zero = 1;
   cf->blocked = -1;
   for (int j = 0; j < 3; j++) {
-    cf->cond[j] = cf->type[j] == LEG_FLOAT ? COND_BLOCK : COND_NONE;
+    cf->cond[j] = cf->type[j] == LEG_FLOAT || cf->type[j] == LEG_OPEN ? COND_BLOCK : COND_NONE;
   }
 }
 
@@ -238,7 +252,7 @@ static void sw_events(const plant_t *pl, const sw_cfg_t *cf, double t, const dou
       z[EV_CUR0 + j] = i[j];
     }
   }
-  if (cf->blocked >= 0) {
+  if (cf->blocked >= 0 && cf->type[cf->blocked] != LEG_OPEN) {
     double dx[X_N];
     sw_out_t o;
     sw_deriv(pl, cf, x, plant_mech_input(pl, t), dx, &o);
@@ -282,8 +296,9 @@ static void exit_all_zero(const plant_t *pl, sw_cfg_t *cf, double t, const doubl
   cf->all_zero = 0;
   cf->cond[jx] = cf->type[jx] == LEG_FLOAT ? COND_LO : COND_NONE;
   cf->cond[jy] = cf->type[jy] == LEG_FLOAT ? COND_HI : COND_NONE;
-  cf->cond[jz] = cf->type[jz] == LEG_FLOAT ? COND_BLOCK : COND_NONE;
-  cf->blocked = cf->type[jz] == LEG_FLOAT ? jz : -1;
+  const int jz_free = cf->type[jz] == LEG_FLOAT || cf->type[jz] == LEG_OPEN;
+  cf->cond[jz] = jz_free ? COND_BLOCK : COND_NONE;
+  cf->blocked = jz_free ? jz : -1;
 }
 
 static void sw_transition(const plant_t *pl, sw_cfg_t *cf, double t, double *x, int ev) {
@@ -415,6 +430,8 @@ static void sw_setup(const plant_t *pl, sw_cfg_t *cf, double *x, const int type[
       if (cf->type[j] != LEG_FLOAT || cf->cond[j] == COND_NONE) {
         cf->cond[j] = fabs(i[j]) <= SW_I_EPS ? COND_BLOCK : (i[j] > 0.0 ? COND_LO : COND_HI);
       }
+    } else if (type[j] == LEG_OPEN) {
+      cf->cond[j] = COND_BLOCK;
     } else {
       cf->cond[j] = COND_NONE;
     }
@@ -426,7 +443,7 @@ static void sw_setup(const plant_t *pl, sw_cfg_t *cf, double *x, const int type[
   }
   int nb = 0, jb = -1;
   for (int j = 0; j < 3; j++) {
-    if (cf->type[j] == LEG_FLOAT && cf->cond[j] == COND_BLOCK) {
+    if ((cf->type[j] == LEG_FLOAT || cf->type[j] == LEG_OPEN) && cf->cond[j] == COND_BLOCK) {
       nb++;
       jb = j;
     }
@@ -456,6 +473,34 @@ static int leg_type_at(const edges_t *e, double tau, double td) {
     return LEG_FLOAT;
   }
   return e->cmd[k] ? LEG_HI : LEG_LO;
+}
+
+/* The leg states the power-stage faults leave of the commanded ones
+ * (header comment). */
+static void sw_fault_legs(plant_aux_t *a, int type[3]) {
+  int on[3][2] = {{0, 0}, {0, 0}, {0, 0}};
+  for (int pass = 0; pass < 2; pass++) {
+    int shoot = 0;
+    for (int j = 0; j < 3; j++) {
+      const int cmd_lo = !a->desat && type[j] == LEG_LO, cmd_hi = !a->desat && type[j] == LEG_HI;
+      on[j][0] = (cmd_lo && (a->pf.open & PLANT_SW_LOW(j)) == 0u) ||
+                 (a->pf.closed & PLANT_SW_LOW(j)) != 0u;
+      on[j][1] = (cmd_hi && (a->pf.open & PLANT_SW_HIGH(j)) == 0u) ||
+                 (a->pf.closed & PLANT_SW_HIGH(j)) != 0u;
+      shoot |= on[j][0] && on[j][1];
+    }
+    if (!shoot) {
+      break;
+    }
+    a->desat = 1; /* the second pass: healthy switches off */
+  }
+  for (int j = 0; j < 3; j++) {
+    if ((a->pf.phase_open & (1u << j)) != 0u) {
+      type[j] = LEG_OPEN;
+    } else {
+      type[j] = on[j][1] ? LEG_HI : (on[j][0] ? LEG_LO : LEG_FLOAT);
+    }
+  }
 }
 
 void plant_inverter_sw_period(plant_t *pl, const double on[3], const double off[3], bool gates_on,
@@ -531,6 +576,9 @@ void plant_inverter_sw_period(plant_t *pl, const double on[3], const double off[
       for (int j = 0; j < 3; j++) {
         type[j] = gates_on ? leg_type_at(&ed[j], mid, td) : LEG_FLOAT;
       }
+      if (a->pf_any) {
+        sw_fault_legs(a, type);
+      }
       sw_setup(pl, &cf, x, type);
       if (!vf_init && a->star_n > 0) {
         a->star_vf = sw_star(pl, &cf, t, x);
@@ -545,7 +593,7 @@ void plant_inverter_sw_period(plant_t *pl, const double on[3], const double off[
 
   /* memory for the next period */
   for (int j = 0; j < 3; j++) {
-    a->cond[j] = cf.type[j] == LEG_FLOAT ? cf.cond[j] : COND_NONE;
+    a->cond[j] = cf.type[j] == LEG_FLOAT || cf.type[j] == LEG_OPEN ? cf.cond[j] : COND_NONE;
     if (gates_on) {
       a->edge_t[j] = ed[j].te[ed[j].n - 1] - ts;
       a->edge_cmd[j] = ed[j].cmd[ed[j].n - 1];

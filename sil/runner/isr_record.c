@@ -76,7 +76,8 @@ void isr_record_observer(void *user, const sil_step_t *st) {
   memset(in, 0, sizeof *in);
   const hal_sample_t *s = st->adc;
   in->flags = (s->enc_valid ? ISR_IN_ENC_VALID : 0u) | (s->valid ? ISR_IN_VALID : 0u) |
-              (st->hw_tripped ? ISR_IN_HW_TRIPPED : 0u);
+              (st->hw_tripped ? ISR_IN_HW_TRIPPED : 0u) |
+              ((st->hw_source & HAL_BREAK_GATE_DRIVER) != 0u ? ISR_IN_GATE_DRIVER : 0u);
   in->time_us = (uint32_t)(uint64_t)(st->t * 1e6);
   memcpy(in->i_abc, s->i_abc, sizeof in->i_abc);
   in->v_dc = s->v_dc;

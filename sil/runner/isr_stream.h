@@ -32,9 +32,10 @@
 #define ISR_STREAM_FORCE_APPLIED (1u << 0)
 
 /* isr_stream_in_t.flags */
-#define ISR_IN_ENC_VALID  (1u << 0) /* hal_sample_t.enc_valid */
-#define ISR_IN_VALID      (1u << 1) /* hal_sample_t.valid */
-#define ISR_IN_HW_TRIPPED (1u << 2) /* hal_fault_hw_tripped() at the start of this ISR */
+#define ISR_IN_ENC_VALID   (1u << 0) /* hal_sample_t.enc_valid */
+#define ISR_IN_VALID       (1u << 1) /* hal_sample_t.valid */
+#define ISR_IN_HW_TRIPPED  (1u << 2) /* hal_fault_hw_tripped() at the start of this ISR */
+#define ISR_IN_GATE_DRIVER (1u << 3) /* and hal_fault_hw_source() has the gate driver */
 
 /* isr_stream_out_t.flags */
 #define ISR_OUT_GATES_ON (1u << 0)

@@ -817,6 +817,42 @@ static int parse_can_faults(ctx_t *c, const cJSON *o, scenario_t *sc) {
   return 0;
 }
 
+/* A power-stage fault: {"switch" | "phase": name, "active": profile}; it
+ * acts on the switch-level circuit (the switching inverter model). */
+static int parse_power_fault(ctx_t *c, const cJSON *o, const char *key, int is_switch, int *target,
+                             profile_t *active) {
+  static const char *const switches[] = {"a_low", "a_high", "b_low", "b_high",
+                                         "c_low", "c_high", NULL};
+  static const char *const phases[] = {"a", "b", "c", NULL};
+  const cJSON *f = cJSON_GetObjectItemCaseSensitive(o, key);
+  if (f == NULL) {
+    return 0;
+  }
+  char p[160];
+  join(p, sizeof p, "inject", key);
+  const char *sel = is_switch ? "switch" : "phase";
+  const char *const keys[] = {sel, "active", NULL};
+  if (check_keys(c, f, p, keys) != 0) {
+    return -1;
+  }
+  if (cJSON_GetObjectItemCaseSensitive(f, sel) == NULL) {
+    char q[160];
+    join(q, sizeof q, p, sel);
+    return fail(c, q, "required (%s)",
+                is_switch ? "a_low, a_high, b_low, b_high, c_low or c_high" : "a, b or c");
+  }
+  if (cJSON_GetObjectItemCaseSensitive(f, "active") == NULL) {
+    char q[160];
+    join(q, sizeof q, p, "active");
+    return fail(c, q, "required (a profile: the fault acts while it is > 0.5)");
+  }
+  if (get_enum(c, f, p, sel, is_switch ? switches : phases, target) ||
+      get_profile(c, f, p, "active", active)) {
+    return -1;
+  }
+  return 0;
+}
+
 #define FAULT_NAME(E, n, d) #n,
 static int parse_inject(ctx_t *c, const cJSON *o, scenario_t *sc) {
   static const char *const keys[] = {"encoder_error",
@@ -835,6 +871,11 @@ static int parse_inject(ctx_t *c, const cJSON *o, scenario_t *sc) {
                                      "encoder",
                                      "can",
                                      "isr_overrun",
+                                     "gate_driver",
+                                     "switch_open",
+                                     "switch_closed",
+                                     "phase_lost",
+                                     "phase_open",
                                      NULL};
   static const char *const faults[] = {DRIVE_FAULT_LIST(FAULT_NAME) NULL};
   const char *P = "inject";
@@ -859,8 +900,26 @@ static int parse_inject(ctx_t *c, const cJSON *o, scenario_t *sc) {
       get_bounded_profile(c, o, P, "rs_scale", 0.0, 1, PLANT_RS_SCALE_MAX, &pf->rs_scale) ||
       get_bounded_profile(c, o, P, "lambda_m_scale", 0.0, 0, PLANT_LAMBDA_M_SCALE_MAX,
                           &pf->lambda_m_scale) ||
-      get_bounded_profile(c, o, P, "c_scale", 0.0, 1, PLANT_C_SCALE_MAX, &pf->c_scale)) {
+      get_bounded_profile(c, o, P, "c_scale", 0.0, 1, PLANT_C_SCALE_MAX, &pf->c_scale) ||
+      get_profile(c, o, P, "gate_driver", &sc->gate_driver) ||
+      parse_power_fault(c, o, "switch_open", 1, &sc->switch_open.target, &sc->switch_open.active) ||
+      parse_power_fault(c, o, "switch_closed", 1, &sc->switch_closed.target,
+                        &sc->switch_closed.active) ||
+      parse_power_fault(c, o, "phase_lost", 0, &sc->phase_lost.target, &sc->phase_lost.active) ||
+      parse_power_fault(c, o, "phase_open", 0, &sc->phase_open.target, &sc->phase_open.active)) {
     return -1;
+  }
+  static const char *const power[] = {"switch_open", "switch_closed", "phase_lost", "phase_open"};
+  for (size_t k = 0; k < sizeof power / sizeof power[0]; ++k) {
+    if (cJSON_GetObjectItemCaseSensitive(o, power[k]) == NULL) {
+      continue;
+    }
+    sc->power_faults = 1;
+    if (sc->plant.inverter.model != PLANT_INV_SWITCHING) {
+      char p[160];
+      join(p, sizeof p, P, power[k]);
+      return fail(c, p, "needs inverter.model: switching (a fault of the switch-level circuit)");
+    }
   }
   const cJSON *cur = cJSON_GetObjectItemCaseSensitive(o, "current");
   if (cur != NULL && parse_current_faults(c, cur, sc) != 0) {

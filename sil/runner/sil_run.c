@@ -165,7 +165,39 @@ void sil_sample(sil_ctx_t *x, const scenario_t *sc, double t) {
   }
 }
 
+/* A break input latched: gates off in hardware (hal_sil_t, like TIM1 MOE). */
+static void hw_break(sil_ctx_t *x, uint32_t source) {
+  x->hal.hw_tripped = true;
+  x->hal.hw_source |= source;
+  x->hal.gates_on = false;
+  x->hal.asc = false; /* MOE cleared: the short too */
+}
+
+/* The power-stage faults in force at t, into the plant. */
+static void set_power_faults(sil_ctx_t *x, const scenario_t *sc, double t) {
+  plant_power_fault_t f = {0u, 0u, 0u};
+  if (injected(&sc->switch_open.active, t)) {
+    f.open |= 1u << sc->switch_open.target;
+  }
+  if (injected(&sc->phase_lost.active, t)) {
+    f.open |= PLANT_SW_LOW(sc->phase_lost.target) | PLANT_SW_HIGH(sc->phase_lost.target);
+  }
+  if (injected(&sc->switch_closed.active, t)) {
+    f.closed |= 1u << sc->switch_closed.target;
+  }
+  if (injected(&sc->phase_open.active, t)) {
+    f.phase_open |= 1u << sc->phase_open.target;
+  }
+  (void)plant_set_power_faults(&x->plant, &f); /* one stuck-closed switch: never refused */
+}
+
 void sil_advance(sil_ctx_t *x, const scenario_t *sc, double t) {
+  if (injected(&sc->gate_driver, t)) {
+    hw_break(x, HAL_BREAK_GATE_DRIVER); /* nFAULT: gates off at once, latched */
+  }
+  if (sc->power_faults) {
+    set_power_faults(x, sc, t);
+  }
   if (!(t < x->v_src_end)) {
     x->v_src = profile_eval_span(&sc->v_source, t, &x->v_src_end);
   }
@@ -179,6 +211,9 @@ void sil_advance(sil_ctx_t *x, const scenario_t *sc, double t) {
     plant_step_pattern(&x->plant, low, low, true);
   } else {
     plant_step_pattern(&x->plant, x->pwm_on, x->pwm_off, x->hal.gates_on);
+  }
+  if (sc->power_faults && plant_take_desat(&x->plant)) {
+    hw_break(x, HAL_BREAK_GATE_DRIVER); /* desaturation: the driver's nFAULT */
   }
   double v[PLANT_STAR_MAX];
   x->star_got = plant_star_read(&x->plant, v);
@@ -206,9 +241,7 @@ void sil_advance(sil_ctx_t *x, const scenario_t *sc, double t) {
     plant_get_brief(&x->plant, &br);
     if (fabs(br.i_abc[0]) > sc->hw_trip || fabs(br.i_abc[1]) > sc->hw_trip ||
         fabs(br.i_abc[2]) > sc->hw_trip) {
-      x->hal.hw_tripped = true;
-      x->hal.gates_on = false;
-      x->hal.asc = false;
+      hw_break(x, HAL_BREAK_OVERCURRENT);
     }
   }
 }
@@ -287,6 +320,7 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
     sil_sample(&x, sc, t);
     /* 2. ISR (unless the interrupt is stuck) */
     const bool hw_in = x.hal.hw_tripped;
+    const uint32_t hw_src = x.hal.hw_source;
     if (!injected(&sc->isr_stall, t)) {
       x.isr_late = injected(&sc->isr_overrun, t); /* it ends after the next valley */
       if (x.isr_late) {
@@ -342,7 +376,8 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
                       x.hal.gates_on,
                       x.hal.asc,
                       hw_in,
-                      x.hal.timer_counts};
+                      x.hal.timer_counts,
+                      hw_src};
       obs(user, &s);
     }
     /* 4. plant over [t_k, t_k+1) */

@@ -31,6 +31,12 @@
  * modelled: the main loop starved by the busy CPU, a third interrupt
  * coalesced (an ISR longer than two periods).
  *
+ * Power-stage faults:
+ * at step 4 the power-stage faults in force at t_k are set in the plant,
+ * gate_driver (or a shoot-through the plant reports after the step)
+ * latches the break input with the gate-driver source and turns the gates
+ * off in hardware, like the overcurrent comparator (inverter.hw_trip).
+ *
  * With CAN (sil_opts_t.can, fluxdrive-sil --can): at step 0 the transport
  * moves frames from the bus into the HAL queue, can_proto_poll() handles
  * them after drive_background() (telemetry copy, watchdog), commands are
@@ -64,6 +70,7 @@ typedef struct {
   bool asc;                 /* active short circuit over [t_k, t_{k+1}) */
   bool hw_tripped;          /* the break input as ISR k found it */
   uint32_t timer_counts;    /* the SIL board's compare steps per period */
+  uint32_t hw_source;       /* which break input (HAL_BREAK_*) as ISR k found it */
 } sil_step_t;
 
 typedef void (*sil_observer_fn)(void *user, const sil_step_t *st);

@@ -200,6 +200,33 @@ static void hw_break_cannot_be_overridden(void **state) {
   assert_false(hal.gates_on);
 }
 
+/* The break's source names the cause: the comparator, the gate driver's
+ * nFAULT, both; a board that cannot tell reports the comparator's. */
+static void hw_break_source_names_the_cause(void **state) {
+  (void)state;
+  static const struct {
+    uint32_t source, faults;
+  } cases[] = {
+      {0u, DRIVE_FAULT_HW_OVERCURRENT},
+      {HAL_BREAK_OVERCURRENT, DRIVE_FAULT_HW_OVERCURRENT},
+      {HAL_BREAK_GATE_DRIVER, DRIVE_FAULT_GATE_DRIVER},
+      {HAL_BREAK_OVERCURRENT | HAL_BREAK_GATE_DRIVER,
+       DRIVE_FAULT_HW_OVERCURRENT | DRIVE_FAULT_GATE_DRIVER},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+    setup_drive();
+    sample(0.0f, 0.0f, 0.0f, 310.0f);
+    hal.hw_tripped = true;
+    hal.hw_source = cases[i].source;
+    drive_isr(&drv);
+    assert_int_equal(drv.faults, cases[i].faults);
+    hal_pwm_enable();
+    assert_false(hal.gates_on);
+    hal.hw_tripped = false;
+    hal.hw_source = 0u;
+  }
+}
+
 static void bad_samples_fault(void **state) {
   (void)state;
   setup_drive();
@@ -554,6 +581,7 @@ int main(void) {
                                      cmocka_unit_test(clear_racing_a_trip_stays_safe),
                                      cmocka_unit_test(fault_requests_and_clears_keep_order),
                                      cmocka_unit_test(hw_break_cannot_be_overridden),
+                                     cmocka_unit_test(hw_break_source_names_the_cause),
                                      cmocka_unit_test(bad_samples_fault),
                                      cmocka_unit_test(invalid_position_faults),
                                      cmocka_unit_test(commands_are_clamped_and_posted),

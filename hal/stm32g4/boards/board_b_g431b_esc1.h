@@ -54,6 +54,8 @@
 /* BKF = 0111: f_DTS / 4, N = 8: 8 x 4 / 170 MHz = 188 ns of the switching
  * edges' ringing ignored */
 #define BOARD_BREAK_FILTER 0x7u
+/* The kit's L6387E gate drivers have no fault output: no break 2. */
+#define BOARD_HAS_BKIN2 0
 
 /* FDCAN1: PA11 RX / PB9 TX (AF9), transceiver on the ESC board. */
 #define BOARD_CAN_RX_PIN                                                                           \

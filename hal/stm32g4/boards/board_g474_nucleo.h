@@ -41,6 +41,16 @@
 #define BOARD_BKIN_ACTIVE_HIGH 0
 #define BOARD_BKIN_FILTER      0x3u /* BKF: fCK_INT, N = 8 (47 ns at 170 MHz) */
 
+/* Gate driver fault output nFAULT (desaturation / shoot-through, driver
+ * supply undervoltage; open drain, active low) on TIM1_BKIN2. ASSUMPTION:
+ * PC3 = TIM1_BKIN2 on AF6 (check against the datasheet's alternate-function
+ * table and the power board). Filter as BKIN. */
+#define BOARD_HAS_BKIN2 1
+#define BOARD_BKIN2_PIN                                                                            \
+  { PORT_C, 3, 6 }
+#define BOARD_BKIN2_ACTIVE_HIGH 0
+#define BOARD_BKIN2_FILTER      0x3u /* BK2F */
+
 /* FDCAN1: PA11 RX / PA12 TX (AF9) */
 #define BOARD_CAN_RX_PIN                                                                           \
   { PORT_A, 11, 9 }

@@ -1,0 +1,307 @@
+/*
+ * SIL: power-stage faults injected into the switching inverter model
+ * (scenario inject.gate_driver, switch_open, switch_closed, phase_lost,
+ * phase_open; docs/faults.md "Injected in the SIL"). Base: the Rubino 2020
+ * SPM (p = 21, Rs = 7.1 Ohm, Ls = 57 mH, lambda_m = 0.19 Vs, 310 V) in
+ * torque mode on a dynamometer at 300 rpm, a 10 N m step at 50 ms, the
+ * fault from 150 ms. At 300 rpm w_e = 659.7 rad/s: the line-to-line
+ * back-EMF peak sqrt(3) lambda_m w_e = 217 V is below the 310 V link (below
+ * the rectifier speed, 429 rpm), so with the gates off the diodes block.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "drive.h"
+#include "sil_test_util.h"
+
+#define PI    3.14159265358979323846
+#define T_INJ 0.15
+#define T_REF 10.0 /* N m */
+#define P     21.0
+#define RS    7.1
+#define LS    0.057
+#define LM    0.19
+#define VDC   310.0
+#define W_E   (P * 300.0 * 2.0 * PI / 60.0)
+#define KT    (1.5 * P * LM)                     /* N m per A of current amplitude */
+#define Z_ABS sqrt(RS *RS + W_E * LS * W_E * LS) /* phase impedance at w_e */
+#define I_SC  (LM * W_E / Z_ABS)                 /* three-phase short-circuit current */
+
+/* The true currents of phases a and b and the phase-balance check's
+ * requests beside the common trace. */
+static double *g_ia, *g_ib;
+static unsigned *g_ph_trips;
+
+static void observer(void *user, const sil_step_t *st) {
+  trace_t *tr = user;
+  if (tr->n < tr->cap) {
+    g_ia[tr->n] = st->plant->i_abc[0];
+    g_ib[tr->n] = st->plant->i_abc[1];
+    g_ph_trips[tr->n] = st->drive->host.ph.trips;
+  }
+  trace_observer(user, st);
+}
+
+static void run_fault(const char *inject, trace_t *tr, scenario_t *sc) {
+  sil_result_t res;
+  char err[512];
+  char js[2048];
+  snprintf(js, sizeof js,
+           "{\"duration\": 0.3, \"machine\": {\"preset\": \"rubino2020_spm\"}, \"inverter\": "
+           "{\"model\": \"switching\"}, \"sensors\": {\"i_noise\": 0.005}, \"mechanics\": "
+           "{\"mode\": \"imposed\", \"speed\": {\"unit\": \"rpm\", \"terms\": [{\"type\": "
+           "\"const\", \"value\": 300}]}}, \"controller\": {\"mode\": \"torque\"}, "
+           "\"references\": {\"torque\": [{\"type\": \"step\", \"t\": 0.05, \"value\": %g}]}, "
+           "\"inject\": {%s}}",
+           T_REF, inject);
+  int r = scenario_parse(js, "test", sc, err, sizeof err);
+  if (r != 0) {
+    fprintf(stderr, "%s\n", err);
+  }
+  assert_int_equal(r, 0);
+  const size_t cap = (size_t)(sc->duration / sc->plant.ts) + 2;
+  trace_alloc(tr, cap);
+  free(g_ia);
+  free(g_ib);
+  free(g_ph_trips);
+  g_ia = calloc(cap, sizeof(double));
+  g_ib = calloc(cap, sizeof(double));
+  g_ph_trips = calloc(cap, sizeof(unsigned));
+  r = sil_run(sc, observer, tr, &res, err, sizeof err);
+  assert_int_equal(r, 0);
+}
+
+#define ACTIVE_FROM_INJ "\"active\": [{\"type\": \"step\", \"t\": 0.15, \"value\": 1}]"
+
+static double mean_over(const double *x, const trace_t *tr, double t0, double t1) {
+  double s = 0.0;
+  size_t n = 0;
+  for (size_t k = idx_at(tr, t0); k < tr->n && tr->t[k] < t1; ++k, ++n) {
+    s += x[k];
+  }
+  return n > 0 ? s / (double)n : NAN;
+}
+
+static double max_over(const double *x, const trace_t *tr, double t0, double t1) {
+  double m = 0.0;
+  for (size_t k = idx_at(tr, t0); k < tr->n && tr->t[k] < t1; ++k) {
+    m = fmax(m, x[k]);
+  }
+  return m;
+}
+
+/* The trip: gate_driver alone, reported by the ISR after the period in
+ * which the break latched (at most two periods after t_from), gates off
+ * and the cause latched to the end. */
+static size_t check_gate_driver_trip(const trace_t *tr, const scenario_t *sc, double t_from,
+                                     const char *what) {
+  const size_t k = first_fault(tr);
+  assert_true(k < tr->n);
+  printf("%s: injected at %.6f s, gate_driver reported at %.6f s (%.2f periods), faults 0x%x\n",
+         what, t_from, tr->t[k], (tr->t[k] - t_from) / sc->plant.ts, tr->faults[k]);
+  assert_true(tr->t[k] >= t_from);
+  assert_true(tr->t[k] <= t_from + 2.0 * sc->plant.ts + 1e-9);
+  assert_int_equal(tr->faults[k], DRIVE_FAULT_GATE_DRIVER);
+  for (size_t j = k; j < tr->n; ++j) {
+    assert_int_equal(tr->gates[j], 0);
+    assert_int_equal(tr->state[j], DRIVE_STATE_FAULT);
+    assert_int_equal(tr->faults[j], DRIVE_FAULT_GATE_DRIVER);
+  }
+  return k;
+}
+
+/* nFAULT asserted for 1 ms: gates off in hardware at once, gate_driver
+ * reported by the next ISR and latched after the input is released; below
+ * the rectifier speed the currents die out (the diodes block once the
+ * inductances have emptied into the link: L I / (v_dc - e) < 1 ms). */
+static void gate_driver_input(void **state) {
+  (void)state;
+  trace_t tr;
+  scenario_t sc;
+  run_fault("\"gate_driver\": [{\"type\": \"step\", \"t\": 0.15, \"value\": 1}, {\"type\": "
+            "\"step\", \"t\": 0.151, \"value\": -1}]",
+            &tr, &sc);
+  const size_t k = check_gate_driver_trip(&tr, &sc, T_INJ, "gate driver nFAULT");
+  /* the break acts on the period starting at the injection: the next ISR
+   * is the first that can see it */
+  assert_true(fabs(tr.t[k] - (T_INJ + sc.plant.ts)) < 1e-9);
+  const double i_late = max_over(tr.imax_abs, &tr, T_INJ + 0.005, 0.3);
+  printf("gate driver nFAULT: largest phase current from 5 ms after: %.3g A\n", i_late);
+  assert_true(i_late < 1e-6);
+  trace_free(&tr);
+}
+
+/* The high side of leg a stuck closed: the low side's next turn-on is a
+ * shoot-through, which the gate driver's desaturation detection ends
+ * (gate_driver within two periods). With the gates off the stuck switch
+ * and the diodes keep a rectifier path: braking torque, currents between
+ * half the three-phase short-circuit current and twice the largest the
+ * six-step voltage and the back-EMF drive through the phase impedance. */
+static void switch_stuck_closed(void **state) {
+  (void)state;
+  trace_t tr;
+  scenario_t sc;
+  run_fault("\"switch_closed\": {\"switch\": \"a_high\", " ACTIVE_FROM_INJ "}", &tr, &sc);
+  check_gate_driver_trip(&tr, &sc, T_INJ, "a_high stuck closed");
+  const double torque = mean_over(tr.torque, &tr, 0.2, 0.3);
+  const double i_pk = max_over(tr.imax_abs, &tr, T_INJ, 0.3);
+  const double i_hi = 2.0 * (2.0 * VDC / PI + LM * W_E) / Z_ABS;
+  printf("a_high stuck closed: mean torque 0.2-0.3 s %.3f N m, peak current %.3f A (bounds %.3f, "
+         "%.3f A)\n",
+         torque, i_pk, 0.5 * I_SC, i_hi);
+  assert_true(torque < 0.0 && torque > -T_REF * 2.0);
+  assert_true(i_pk > 0.5 * I_SC && i_pk < i_hi);
+  trace_free(&tr);
+}
+
+/* The drive's phase-balance check (drive_phase_check.h, main loop)
+ * requests lost_control after two unbalanced electrical revolutions in a
+ * row: not before one whole revolution with the fault (T_E after the
+ * injection), at most three revolutions and two main-loop periods after it
+ * (the revolution under way when the fault came may still look balanced;
+ * the request is taken by the next ISR). */
+#define T_E (2.0 * PI / W_E)
+static void check_phase_trip(const trace_t *tr, const char *what) {
+  const size_t k = first_fault(tr);
+  assert_true(k < tr->n);
+  printf("%s: lost_control at %.4f s, %.2f electrical revolutions (%.2f ms) after the injection, "
+         "faults 0x%x, phase-check requests %u, lc_cause 0x%x\n",
+         what, tr->t[k], (tr->t[k] - T_INJ) / T_E, 1e3 * (tr->t[k] - T_INJ), tr->faults[k],
+         g_ph_trips[k], tr->lc_cause[k]);
+  assert_true(tr->t[k] >= T_INJ + T_E);
+  assert_true(tr->t[k] <= T_INJ + 3.0 * T_E + 2e-3);
+  assert_int_equal(tr->faults[k], DRIVE_FAULT_LOST_CONTROL);
+  assert_int_equal(g_ph_trips[k], 1);
+  assert_int_equal(tr->lc_cause[k], 0); /* none of the ISR's own conditions */
+  for (size_t j = k + 1; j < tr->n; ++j) {
+    assert_int_equal(tr->gates[j], 0);
+    assert_int_equal(tr->faults[j], DRIVE_FAULT_LOST_CONTROL);
+  }
+}
+
+/* The largest |i_a| from 1 ms after the injection to the trip. */
+static double ia_until_trip(const trace_t *tr) {
+  double ia = 0.0;
+  for (size_t k = idx_at(tr, T_INJ + 1e-3); k < first_fault(tr); ++k) {
+    ia = fmax(ia, fabs(g_ia[k]));
+  }
+  return ia;
+}
+
+/* The same run without a fault (the injection after the end) does not
+ * trip: the torque step at 50 ms and the steady 10 N m are balanced. */
+static void healthy_does_not_trip(void **state) {
+  (void)state;
+  trace_t tr;
+  scenario_t sc;
+  run_fault("\"phase_open\": {\"phase\": \"a\", \"active\": [{\"type\": \"step\", \"t\": 1, "
+            "\"value\": 1}]}",
+            &tr, &sc);
+  const double torque = mean_over(tr.torque, &tr, 0.2, 0.3);
+  printf("healthy: faults 0x%x, mean torque 0.2-0.3 s %.3f N m\n", tr.faults[tr.n - 1], torque);
+  assert_true(first_fault(&tr) >= tr.n);
+  assert_true(fabs(torque - T_REF) < 0.02 * T_REF);
+  trace_free(&tr);
+}
+
+/* The high side of leg a stuck open: phase a carries positive current only
+ * through its low diode (leg at 0 V): less torque than asked, nothing the
+ * drive checks is exceeded: ridden through undetected (docs/faults.md). */
+static void switch_stuck_open(void **state) {
+  (void)state;
+  trace_t tr;
+  scenario_t sc;
+  run_fault("\"switch_open\": {\"switch\": \"a_high\", " ACTIVE_FROM_INJ "}", &tr, &sc);
+  const double torque = mean_over(tr.torque, &tr, 0.2, 0.3);
+  const double i_pk = max_over(tr.imax_abs, &tr, T_INJ, 0.3);
+  printf("a_high stuck open: faults 0x%x, mean torque 0.2-0.3 s %.3f N m (ref %.1f), peak "
+         "current %.3f A\n",
+         tr.faults[tr.n - 1], torque, T_REF, i_pk);
+  assert_true(first_fault(&tr) >= tr.n);
+  assert_true(torque > 0.0 && torque < T_REF);
+  assert_true(i_pk < sc.drive.i_trip);
+  trace_free(&tr);
+}
+
+/* Phase a without current (lead open: exactly zero) or without drive
+ * (both switches of leg a off: only its diodes conduct, when the floating
+ * terminal would leave [0, v_dc]: at most 5 % of the healthy amplitude
+ * T_REF / KT): the phase-balance check trips. */
+static void phase_lost(void **state) {
+  (void)state;
+  trace_t tr;
+  scenario_t sc;
+  run_fault("\"phase_lost\": {\"phase\": \"a\", " ACTIVE_FROM_INJ "}", &tr, &sc);
+  check_phase_trip(&tr, "phase a lost");
+  const double ia = ia_until_trip(&tr);
+  printf("phase a lost: max |i_a| until the trip %.3g A\n", ia);
+  assert_true(ia <= 0.05 * T_REF / KT);
+  trace_free(&tr);
+}
+
+static void phase_open(void **state) {
+  (void)state;
+  trace_t tr;
+  scenario_t sc;
+  run_fault("\"phase_open\": {\"phase\": \"a\", " ACTIVE_FROM_INJ "}", &tr, &sc);
+  check_phase_trip(&tr, "phase a open");
+  const double ia = ia_until_trip(&tr);
+  printf("phase a open: max |i_a| until the trip %.3g A\n", ia);
+  assert_true(ia <= 1e-9);
+  trace_free(&tr);
+}
+
+/* Refused: the faults of the switch-level circuit on the average model,
+ * unknown switches, missing fields; each error names the field. */
+static void bad_injections_named(void **state) {
+  (void)state;
+  static const struct {
+    const char *inject, *inverter, *expect;
+  } cases[] = {
+      {"\"phase_open\": {\"phase\": \"a\", " ACTIVE_FROM_INJ "}", "average",
+       "inject.phase_open: needs inverter.model: switching"},
+      {"\"switch_closed\": {\"switch\": \"a_hi\", " ACTIVE_FROM_INJ "}", "switching",
+       "inject.switch_closed.switch: "},
+      {"\"switch_open\": {\"phase\": \"a\", " ACTIVE_FROM_INJ "}", "switching",
+       "inject.switch_open.phase: unknown field"},
+      {"\"phase_lost\": {\"phase\": \"d\", " ACTIVE_FROM_INJ "}", "switching",
+       "inject.phase_lost.phase: "},
+      {"\"phase_lost\": {\"phase\": \"a\"}", "switching", "inject.phase_lost.active: required"},
+      {"\"switch_open\": {" ACTIVE_FROM_INJ "}", "switching",
+       "inject.switch_open.switch: required"},
+      {"\"gate_driver\": \"on\"", "switching", "inject.gate_driver"},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+    char js[1024], err[512] = "";
+    scenario_t sc;
+    snprintf(js, sizeof js,
+             "{\"duration\": 0.1, \"inverter\": {\"model\": \"%s\"}, \"inject\": {%s}}",
+             cases[i].inverter, cases[i].inject);
+    const int r = scenario_parse(js, "t", &sc, err, sizeof err);
+    printf("%s\n", err);
+    assert_int_equal(r, -1);
+    assert_non_null(strstr(err, cases[i].expect));
+  }
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(gate_driver_input),
+      cmocka_unit_test(switch_stuck_closed),
+      cmocka_unit_test(healthy_does_not_trip),
+      cmocka_unit_test(switch_stuck_open),
+      cmocka_unit_test(phase_lost),
+      cmocka_unit_test(phase_open),
+      cmocka_unit_test(bad_injections_named),
+  };
+  const int r = cmocka_run_group_tests(tests, NULL, NULL);
+  free(g_ia);
+  free(g_ib);
+  free(g_ph_trips);
+  return r;
+}

@@ -210,6 +210,9 @@ static void esc1_tim1_break_from_the_comparators(void **state) {
   printf("break filter %.0f ns\n", 8.0 * 4.0 / 170e6 * 1e9);
   check_bdtr_common();
   assert_int_equal(s_af_n, 6u); /* the six PWM pins, no BKIN pin */
+  /* no gate-driver fault output on the kit: break 2 off */
+  assert_int_equal(s_tim1.AF2, 0u);
+  assert_true((s_tim1.BDTR & TIM_BDTR_BK2E) == 0u);
 }
 
 #else /* the NUCLEO-G474 header: external comparator on BKIN (PA6, AF6), active low */
@@ -222,11 +225,23 @@ static void g474_tim1_break_from_bkin(void **state) {
   assert_true((s_tim1.BDTR & TIM_BDTR_BKP) == 0u); /* active low */
   assert_int_equal(field(s_tim1.BDTR, 16, 4), 3u);
   check_bdtr_common();
-  assert_int_equal(s_af_n, 7u);
+  assert_int_equal(s_af_n, 8u);
   assert_int_equal(s_af_pins[6].port, PORT_A);
   assert_int_equal(s_af_pins[6].pin, 6u);
   assert_int_equal(s_af_pins[6].af, 6u);
   assert_int_equal(s_af_pull[6], 1u); /* pulled up: the inactive level */
+  /* break 2: the gate driver's nFAULT (open drain, active low) on BKIN2 */
+  printf("TIM1_AF2 0x%08x, BK2E %u, BK2P %u, BK2F 0x%x\n", (unsigned)s_tim1.AF2,
+         (unsigned)((s_tim1.BDTR & TIM_BDTR_BK2E) != 0u),
+         (unsigned)((s_tim1.BDTR & TIM_BDTR_BK2P) != 0u), (unsigned)field(s_tim1.BDTR, 20, 4));
+  assert_int_equal(s_tim1.AF2, TIM1_AF2_BK2INE);
+  assert_true((s_tim1.BDTR & TIM_BDTR_BK2E) != 0u);
+  assert_true((s_tim1.BDTR & TIM_BDTR_BK2P) == 0u); /* active low */
+  assert_int_equal(field(s_tim1.BDTR, 20, 4), 3u);
+  assert_int_equal(s_af_pins[7].port, PORT_C);
+  assert_int_equal(s_af_pins[7].pin, 3u);
+  assert_int_equal(s_af_pins[7].af, 6u);
+  assert_int_equal(s_af_pull[7], 1u);
 }
 
 static void g474_no_comparators(void **state) {

@@ -498,8 +498,6 @@ static FD_NOINLINE void drive_window_sample(const drive_t *drv, float i[3], floa
   }
 }
 
-/* The speed loop, every slow_div ISRs, on the angle rate averaged over that
- * period (no lag under acceleration). */
 /* The three measured phase currents sum to zero (Kirchhoff, star
  * connection): a gain error, an offset drift or a lost channel shows as a
  * sum beyond i_sum_rel of the largest current (and the noise floor
@@ -534,6 +532,8 @@ static FD_NOINLINE void drive_pos_check_step(drive_t *drv) {
   }
 }
 
+/* The speed loop, every slow_div ISRs, on the angle rate averaged over that
+ * period (no lag under acceleration), with the slow-rate checks. */
 static void drive_speed_loop(drive_t *drv) {
   const drive_config_t *c = &drv->cfg;
   const uint32_t phase = (drv->isr_count - 1u) % c->slow_div;

@@ -137,4 +137,30 @@ static inline size_t idx_at(const trace_t *tr, double t0) {
   return k;
 }
 
+/* Largest, smallest and mean of x over the indices [k0, k1) (-inf, +inf,
+ * NaN when empty). */
+static inline double trace_max(const double *x, size_t k0, size_t k1) {
+  double m = -INFINITY;
+  for (size_t k = k0; k < k1; ++k) {
+    m = fmax(m, x[k]);
+  }
+  return m;
+}
+
+static inline double trace_min(const double *x, size_t k0, size_t k1) {
+  double m = INFINITY;
+  for (size_t k = k0; k < k1; ++k) {
+    m = fmin(m, x[k]);
+  }
+  return m;
+}
+
+static inline double trace_mean(const double *x, size_t k0, size_t k1) {
+  double s = 0.0;
+  for (size_t k = k0; k < k1; ++k) {
+    s += x[k];
+  }
+  return k1 > k0 ? s / (double)(k1 - k0) : NAN;
+}
+
 #endif

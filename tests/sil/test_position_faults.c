@@ -40,34 +40,14 @@ static void run_case(const char *law, const char *tol, const char *inject, doubl
   run_json(json, sc, tr, &res);
 }
 
-/* min over [k0, n) */
-static double min_from(const double *x, size_t k0, size_t n) {
-  double m = INFINITY;
-  for (size_t k = k0; k < n; ++k) {
-    m = fmin(m, x[k]);
-  }
-  return m;
-}
-
-static size_t index_at(const trace_t *tr, double t) {
-  size_t k = 0;
-  while (k < tr->n && tr->t[k] < t) {
-    ++k;
-  }
-  return k;
-}
-
 /* The fault trips `position` alone within [t_lo, t_hi]; the rotor is not
  * driven backwards; the current stays below i_trip. */
 static void expect_position_trip(const trace_t *tr, const scenario_t *sc, double t_lo, double t_hi,
                                  const char *what) {
   const size_t k = first_fault(tr);
-  const size_t k0 = index_at(tr, 0.6);
-  double i_pk = 0.0;
-  for (size_t j = k0; j < tr->n; ++j) {
-    i_pk = fmax(i_pk, tr->imax_abs[j]);
-  }
-  const double w_min = min_from(tr->speed, k0, tr->n) * 30.0 / PI;
+  const size_t k0 = idx_at(tr, 0.6);
+  const double i_pk = trace_max(tr->imax_abs, k0, tr->n);
+  const double w_min = trace_min(tr->speed, k0, tr->n) * 30.0 / PI;
   printf("%s: trip at %.4f s (faults 0x%x), slowest %.1f rpm, peak current %.2f A\n", what,
          k < tr->n ? tr->t[k] : -1.0, k < tr->n ? tr->faults[k] : 0u, w_min, i_pk);
   assert_true(k < tr->n);
@@ -106,7 +86,7 @@ static void slip_without_the_check(void **state) {
            "0.14959965}]",
            0.9, &sc, &tr);
   const size_t k = first_fault(&tr);
-  const double w_min = min_from(tr.speed, index_at(&tr, 0.6), tr.n) * 30.0 / PI;
+  const double w_min = trace_min(tr.speed, idx_at(&tr, 0.6), tr.n) * 30.0 / PI;
   printf("check off: first fault 0x%x at %.4f s, slowest %.1f rpm\n", k < tr.n ? tr.faults[k] : 0u,
          k < tr.n ? tr.t[k] : -1.0, w_min);
   assert_true(k == tr.n || (tr.faults[k] & DRIVE_FAULT_POSITION) == 0u);
@@ -170,7 +150,7 @@ static void jitter_is_ridden_through(void **state) {
   run_case("foc", "0.5", "\"encoder\": {\"jitter\": 5e-5, \"seed\": 3}", 1.0, &sc, &tr);
   assert_int_equal(first_fault(&tr), tr.n);
   double lo = INFINITY, hi = -INFINITY;
-  for (size_t j = index_at(&tr, 0.6); j < tr.n; ++j) {
+  for (size_t j = idx_at(&tr, 0.6); j < tr.n; ++j) {
     lo = fmin(lo, tr.speed[j]);
     hi = fmax(hi, tr.speed[j]);
   }

@@ -78,23 +78,6 @@ static void run_fault(const char *inject, trace_t *tr, scenario_t *sc) {
 
 #define ACTIVE_FROM_INJ "\"active\": [{\"type\": \"step\", \"t\": 0.15, \"value\": 1}]"
 
-static double mean_over(const double *x, const trace_t *tr, double t0, double t1) {
-  double s = 0.0;
-  size_t n = 0;
-  for (size_t k = idx_at(tr, t0); k < tr->n && tr->t[k] < t1; ++k, ++n) {
-    s += x[k];
-  }
-  return n > 0 ? s / (double)n : NAN;
-}
-
-static double max_over(const double *x, const trace_t *tr, double t0, double t1) {
-  double m = 0.0;
-  for (size_t k = idx_at(tr, t0); k < tr->n && tr->t[k] < t1; ++k) {
-    m = fmax(m, x[k]);
-  }
-  return m;
-}
-
 /* The trip: gate_driver alone, reported by the ISR after the period in
  * which the break latched (at most two periods after t_from), gates off
  * and the cause latched to the end. */
@@ -130,7 +113,7 @@ static void gate_driver_input(void **state) {
   /* the break acts on the period starting at the injection: the next ISR
    * is the first that can see it */
   assert_true(fabs(tr.t[k] - (T_INJ + sc.plant.ts)) < 1e-9);
-  const double i_late = max_over(tr.imax_abs, &tr, T_INJ + 0.005, 0.3);
+  const double i_late = trace_max(tr.imax_abs, idx_at(&tr, T_INJ + 0.005), idx_at(&tr, 0.3));
   printf("gate driver nFAULT: largest phase current from 5 ms after: %.3g A\n", i_late);
   assert_true(i_late < 1e-6);
   trace_free(&tr);
@@ -148,8 +131,8 @@ static void switch_stuck_closed(void **state) {
   scenario_t sc;
   run_fault("\"switch_closed\": {\"switch\": \"a_high\", " ACTIVE_FROM_INJ "}", &tr, &sc);
   check_gate_driver_trip(&tr, &sc, T_INJ, "a_high stuck closed");
-  const double torque = mean_over(tr.torque, &tr, 0.2, 0.3);
-  const double i_pk = max_over(tr.imax_abs, &tr, T_INJ, 0.3);
+  const double torque = trace_mean(tr.torque, idx_at(&tr, 0.2), idx_at(&tr, 0.3));
+  const double i_pk = trace_max(tr.imax_abs, idx_at(&tr, T_INJ), idx_at(&tr, 0.3));
   const double i_hi = 2.0 * (2.0 * VDC / PI + LM * W_E) / Z_ABS;
   printf("a_high stuck closed: mean torque 0.2-0.3 s %.3f N m, peak current %.3f A (bounds %.3f, "
          "%.3f A)\n",
@@ -202,7 +185,7 @@ static void healthy_does_not_trip(void **state) {
   run_fault("\"phase_open\": {\"phase\": \"a\", \"active\": [{\"type\": \"step\", \"t\": 1, "
             "\"value\": 1}]}",
             &tr, &sc);
-  const double torque = mean_over(tr.torque, &tr, 0.2, 0.3);
+  const double torque = trace_mean(tr.torque, idx_at(&tr, 0.2), idx_at(&tr, 0.3));
   printf("healthy: faults 0x%x, mean torque 0.2-0.3 s %.3f N m\n", tr.faults[tr.n - 1], torque);
   assert_true(first_fault(&tr) >= tr.n);
   assert_true(fabs(torque - T_REF) < 0.02 * T_REF);
@@ -217,8 +200,8 @@ static void switch_stuck_open(void **state) {
   trace_t tr;
   scenario_t sc;
   run_fault("\"switch_open\": {\"switch\": \"a_high\", " ACTIVE_FROM_INJ "}", &tr, &sc);
-  const double torque = mean_over(tr.torque, &tr, 0.2, 0.3);
-  const double i_pk = max_over(tr.imax_abs, &tr, T_INJ, 0.3);
+  const double torque = trace_mean(tr.torque, idx_at(&tr, 0.2), idx_at(&tr, 0.3));
+  const double i_pk = trace_max(tr.imax_abs, idx_at(&tr, T_INJ), idx_at(&tr, 0.3));
   printf("a_high stuck open: faults 0x%x, mean torque 0.2-0.3 s %.3f N m (ref %.1f), peak "
          "current %.3f A\n",
          tr.faults[tr.n - 1], torque, T_REF, i_pk);

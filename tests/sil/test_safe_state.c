@@ -48,22 +48,6 @@ static double asc_current(const plant_machine_t *m, double w_e) {
   return m->lambda_m * w_e / sqrt(m->rs * m->rs + w_e * w_e * m->ld * m->ld);
 }
 
-static double max_from(const double *x, size_t k0, size_t n) {
-  double m = -INFINITY;
-  for (size_t k = k0; k < n; ++k) {
-    m = fmax(m, x[k]);
-  }
-  return m;
-}
-
-static double mean_from(const double *x, size_t k0, size_t n) {
-  double s = 0.0;
-  for (size_t k = k0; k < n; ++k) {
-    s += x[k];
-  }
-  return s / (double)(n - k0);
-}
-
 /* The short engages in the ISR of the trip and holds; the link stays at
  * the source; the current is the short's, the braking torque the short's. */
 static void rubino_short_at_top_speed(void **state) {
@@ -83,11 +67,11 @@ static void rubino_short_at_top_speed(void **state) {
     assert_int_equal(tr.gates[j], 0);
     assert_int_equal(tr.asc[j], 1);
   }
-  const double v_max = max_from(tr.v_dc, k, tr.n);
-  const double i_pk = max_from(tr.imax_abs, k, tr.n);
+  const double v_max = trace_max(tr.v_dc, k, tr.n);
+  const double i_pk = trace_max(tr.imax_abs, k, tr.n);
   const size_t k_ss = k + (size_t)(0.1 / sc.plant.ts); /* 12 L/R after the trip */
-  const double t_ss = mean_from(tr.torque, k_ss, tr.n);
-  const double i_ss = max_from(tr.imax_abs, k_ss, tr.n);
+  const double t_ss = trace_mean(tr.torque, k_ss, tr.n);
+  const double i_ss = trace_max(tr.imax_abs, k_ss, tr.n);
   printf("after the trip: v_dc max %.2f V (v_dc_max %.1f), peak current %.3f A, steady %.3f A "
          "(short %.3f A), torque %.4f N m (short %.4f N m)\n",
          v_max, (double)sc.drive.v_dc_max, i_pk, i_ss, asc_current(m, w_e), t_ss,
@@ -109,7 +93,7 @@ static void rubino_all_off_pumps_the_link(void **state) {
   sil_result_t res;
   run_json(RUBINO("0", TOP_SPEED "," TRIP), &sc, &tr, &res);
   const size_t k = first_fault(&tr);
-  const double v_max = max_from(tr.v_dc, k, tr.n);
+  const double v_max = trace_max(tr.v_dc, k, tr.n);
   const double emf = sqrt(3.0) * sc.plant.machine.lambda_m * 125.66 * sc.plant.machine.pole_pairs;
   printf("all off: v_dc max %.1f V (line back-EMF peak %.1f V, v_dc_max %.1f V)\n", v_max, emf,
          (double)sc.drive.v_dc_max);
@@ -161,7 +145,7 @@ static void short_ends_below_the_rectifier_speed(void **state) {
   const double v0 = sc.plant.dclink.v_source;
   const double i_sc = m->lambda_m / m->ld;
   const double v_dump = sqrt(v0 * v0 + 1.5 * m->ld * i_sc * i_sc / sc.plant.dclink.c);
-  const double v_max = max_from(tr.v_dc, k, tr.n);
+  const double v_max = trace_max(tr.v_dc, k, tr.n);
   printf("v_dc max after the trip %.2f V (the short's energy on %.0f V: %.2f V)\n", v_max, v0,
          v_dump);
   assert_true(v_max <= v_dump + 0.5 && v_max > v0 + 0.5 * (v_dump - v0));
@@ -204,8 +188,8 @@ static void active_load_after_a_trip_at_standstill(void **state) {
       w_min = fmin(w_min, tr.speed[j]);
       shorts += j > k && tr.asc[j] == 1u && tr.asc[j - 1] == 0u;
     }
-    const double v_max = max_from(tr.v_dc, k, tr.n);
-    const double i_pk = max_from(tr.imax_abs, k, tr.n);
+    const double v_max = trace_max(tr.v_dc, k, tr.n);
+    const double i_pk = trace_max(tr.imax_abs, k, tr.n);
     printf("load %s N m, asc_speed %s: speed at the trip %.1f rpm, fastest backwards %.1f rpm "
            "(rectifier %.1f rpm), %u shorts, v_dc max %.2f V, peak current %.3f A\n",
            loads[r], asc[r], tr.speed[k] * 30.0 / PI, w_min * 30.0 / PI, rect_m * 30.0 / PI, shorts,
@@ -275,9 +259,9 @@ static void presets_below_the_rectifier_speed_go_all_off(void **state) {
       assert_int_equal(tr.gates[j], 0);
       assert_int_equal(tr.asc[j], 0);
     }
-    const double v_max = max_from(tr.v_dc, k, tr.n);
+    const double v_max = trace_max(tr.v_dc, k, tr.n);
     const size_t k_late = k + (size_t)(0.05 / sc.plant.ts);
-    const double i_late = max_from(tr.imax_abs, k_late, tr.n);
+    const double i_late = trace_max(tr.imax_abs, k_late, tr.n);
     printf("%s: speed at the trip %.0f rpm, v_dc max %.2f V (v_dc_max %.1f), current 50 ms "
            "later %.2e A\n",
            sc.plant.machine.map != NULL ? "flux map" : "linear", tr.speed[k] * 30.0 / PI, v_max,

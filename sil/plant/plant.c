@@ -249,10 +249,17 @@ int plant_set_power_faults(plant_t *pl, const plant_power_fault_t *f) {
       return -1;
     }
   }
+  const unsigned sh = f->shorted & 0x7u;
+  if ((sh != 0u && sh != 0x3u && sh != 0x5u && sh != 0x6u) || (sh & f->phase_open) != 0u) {
+    return -1; /* one pair; an open lead cannot be shorted to its partner */
+  }
   pl->aux.pf.open = f->open & 0x3Fu;
   pl->aux.pf.closed = f->closed & 0x3Fu;
   pl->aux.pf.phase_open = f->phase_open & 0x7u;
-  pl->aux.pf_any = (pl->aux.pf.open | pl->aux.pf.closed | pl->aux.pf.phase_open) != 0u;
+  pl->aux.pf.ground = f->ground & 0x7u;
+  pl->aux.pf.shorted = sh;
+  pl->aux.pf_any = (pl->aux.pf.open | pl->aux.pf.closed | pl->aux.pf.phase_open |
+                    pl->aux.pf.ground | pl->aux.pf.shorted) != 0u;
   return 0;
 }
 

@@ -191,6 +191,10 @@ typedef struct {
   unsigned closed;     /* switches that conduct whatever the gates (at most one per leg) */
   unsigned phase_open; /* bit x: phase x's lead disconnected (its current is zero,
                           its terminal floats) */
+  unsigned ground;     /* bit x: phase x's lead shorted to earth, which is the
+                          link's negative rail (bolted: the leg's output tied to it) */
+  unsigned shorted;    /* two bits: those phases' leads shorted together (bolted),
+                          0: none */
 } plant_power_fault_t;
 
 /* Internal working data of plant_t (constants precomputed by plant_init,
@@ -321,7 +325,8 @@ void plant_get_state(const plant_t *pl, plant_state_t *out);
  * healthy). They act on the switch-level circuit: with gates on they need
  * the switching model (the average model's periods are routed to it while
  * any is set). Returns -1 (nothing changed) for two stuck-closed switches
- * in one leg. */
+ * in one leg, a short of other than two leads, or a short with an open
+ * lead. */
 int plant_set_power_faults(plant_t *pl, const plant_power_fault_t *f);
 /* A shoot-through since the last call: a stuck-closed switch's partner was
  * commanded on. The gate driver's desaturation detection turns that switch

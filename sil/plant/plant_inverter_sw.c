@@ -33,6 +33,19 @@
  * its terminal at whatever potential keeps its current zero, without the
  * [0, v_dc] bound of a diode leg (no EV_U events, unbounded in the
  * all-zero state).
+ * A lead shorted to earth (the negative rail) ties its leg's output to that
+ * rail: a stuck-closed low side that no desaturation turns off. Two leads
+ * shorted together (x, y) tie their legs' outputs: legs of opposite
+ * commanded states shoot through the short (desaturation, as above); one
+ * leg commanded sets both; with both floating the pair is one node on
+ * their four diodes carrying -i_z. Only the potential of z relative to the
+ * node acts on the machine (v_ab = (2/3)(v_z - v_node) c_z), so the node is
+ * taken as the reference (both legs LEG_LO) and leg z floats between rails
+ * that are its own range less the node's: [-v_dc, v_dc] with z floating
+ * too (i_z > 0: z on its low diode, the node on its high ones), [0, v_dc]
+ * with z high, [-v_dc, 0] with z low; the real potentials are restored
+ * (offset) for the star point, and the link current is i_z times z's rail
+ * in units of v_dc in every case.
  */
 #include "plant_internal.h"
 
@@ -53,7 +66,10 @@ typedef struct {
   int type[3];
   int cond[3];
   int all_zero;
-  int blocked; /* the single blocked leg when not all_zero, else -1 */
+  int blocked;  /* the single blocked leg when not all_zero, else -1 */
+  double rl[3]; /* a floating leg's rails, in units of v_dc: 0 and 1 but */
+  double rh[3]; /* for leg z of a floating shorted pair (header comment) */
+  int node;     /* that leg z, else -1 */
 } sw_cfg_t;
 
 typedef struct {
@@ -77,15 +93,30 @@ static void phase_currents(const plant_t *pl, const double *x, double i[3], doub
   i[2] = -i[0] - i[1];
 }
 
-/* Allowed leg potential range for the all-zero state. */
-static void leg_range(int type, double vdc, double *lo, double *hi) {
+/* Allowed potential range of leg j for the all-zero state. */
+static void leg_range(const sw_cfg_t *cf, int j, double vdc, double *lo, double *hi) {
+  const int type = cf->type[j];
   if (type == LEG_OPEN) {
     *lo = -1e300;
     *hi = 1e300;
     return;
   }
-  *lo = type == LEG_HI ? vdc : 0.0;
-  *hi = type == LEG_LO ? 0.0 : vdc;
+  *lo = type == LEG_HI ? vdc : (type == LEG_LO ? 0.0 : cf->rl[j] * vdc);
+  *hi = type == LEG_LO ? 0.0 : (type == LEG_HI ? vdc : cf->rh[j] * vdc);
+}
+
+/* The potential of the node of a floating shorted pair (the reference of
+ * the pattern, header comment) above the negative rail, w the potential
+ * of leg z against it. */
+static double node_offset(const sw_cfg_t *cf, double w, double vdc) {
+  const int z = cf->node;
+  if (cf->rl[z] >= 0.0) {
+    return vdc - w; /* z high */
+  }
+  if (cf->rh[z] <= 0.0) {
+    return -w; /* z low */
+  }
+  return w <= 0.0 ? -w : vdc - w;
 }
 
 static void backemf(const plant_t *pl, const double *x, double w, double e[3]) {
@@ -116,7 +147,7 @@ static void sw_deriv(const plant_t *pl, const sw_cfg_t *cf, const double *x, dou
     backemf(pl, x, w, e);
     for (int j = 0; j < 3; j++) {
       double lo, hi;
-      leg_range(cf->type[j], vdc, &lo, &hi);
+      leg_range(cf, j, vdc, &lo, &hi);
       lo_max = fmax(lo_max, lo - e[j]);
       hi_min = fmin(hi_min, hi - e[j]);
     }
@@ -137,9 +168,13 @@ static void sw_deriv(const plant_t *pl, const sw_cfg_t *cf, const double *x, dou
     const double i[3] = {ial, -0.5 * ial + PLANT_SQRT3_2 * ibe, -0.5 * ial - PLANT_SQRT3_2 * ibe};
     double v[3];
     for (int j = 0; j < 3; j++) {
-      const int hi = cf->type[j] == LEG_HI || (cf->type[j] == LEG_FLOAT && cf->cond[j] == COND_HI);
-      v[j] = hi ? vdc : 0.0;
-      idc += hi ? i[j] : 0.0;
+      const int fl = cf->type[j] == LEG_FLOAT;
+      const double k = cf->type[j] == LEG_HI            ? 1.0
+                       : (fl && cf->cond[j] == COND_HI) ? cf->rh[j]
+                       : (fl && cf->cond[j] == COND_LO) ? cf->rl[j]
+                                                        : 0.0;
+      v[j] = k * vdc;
+      idc += k * i[j];
     }
     const double val = (2.0 * v[0] - v[1] - v[2]) * (1.0 / 3.0);
     const double vbe = (v[1] - v[2]) * PLANT_INV_SQRT3;
@@ -163,6 +198,12 @@ static void sw_deriv(const plant_t *pl, const sw_cfg_t *cf, const double *x, dou
       dlq += (2.0 / 3.0) * u * p2;
       v[j] = u;
       o->u = u;
+    }
+    if (cf->node >= 0) {
+      const double c0 = node_offset(cf, v[cf->node], vdc);
+      for (int j = 0; j < 3; j++) {
+        v[j] += c0;
+      }
     }
     o->gap = 0.0;
     vn0 = (v[0] + v[1] + v[2]) * (1.0 / 3.0);
@@ -256,8 +297,8 @@ static void sw_events(const plant_t *pl, const sw_cfg_t *cf, double t, const dou
     double dx[X_N];
     sw_out_t o;
     sw_deriv(pl, cf, x, plant_mech_input(pl, t), dx, &o);
-    z[EV_U_LO] = -o.u;
-    z[EV_U_HI] = o.u - o.vdc;
+    z[EV_U_LO] = cf->rl[cf->blocked] * o.vdc - o.u;
+    z[EV_U_HI] = o.u - cf->rh[cf->blocked] * o.vdc;
   }
 }
 
@@ -267,7 +308,7 @@ static void exit_all_zero(const plant_t *pl, sw_cfg_t *cf, double t, const doubl
   const double vdc = plant_dclink_voltage(pl, x);
   backemf(pl, x, plant_mech_speed(pl, x, plant_mech_input(pl, t)), e);
   for (int j = 0; j < 3; j++) {
-    leg_range(cf->type[j], vdc, &lo, &hi);
+    leg_range(cf, j, vdc, &lo, &hi);
     if (lo - e[j] > best_lo) {
       best_lo = lo - e[j];
       jx = j;
@@ -285,7 +326,7 @@ static void exit_all_zero(const plant_t *pl, sw_cfg_t *cf, double t, const doubl
   if (jy == jx) {
     best_hi = 1e300;
     for (int j = 0; j < 3; j++) {
-      leg_range(cf->type[j], vdc, &lo, &hi);
+      leg_range(cf, j, vdc, &lo, &hi);
       if (j != jx && hi - e[j] < best_hi) {
         best_hi = hi - e[j];
         jy = j;
@@ -319,8 +360,9 @@ static void sw_transition(const plant_t *pl, sw_cfg_t *cf, double t, double *x, 
     double dx[X_N];
     sw_out_t o;
     sw_deriv(pl, cf, x, plant_mech_input(pl, t), dx, &o);
-    if (o.u > o.vdc || o.u < 0.0) { /* current reverses into the other diode */
-      cf->cond[j] = o.u > o.vdc ? COND_HI : COND_LO;
+    const double lo = cf->rl[j] * o.vdc, hi = cf->rh[j] * o.vdc;
+    if (o.u > hi || o.u < lo) { /* current reverses into the other diode */
+      cf->cond[j] = o.u > hi ? COND_HI : COND_LO;
       cf->blocked = -1;
     }
   }
@@ -420,12 +462,24 @@ static void sw_integrate(plant_t *pl, sw_cfg_t *cf, double *t, double *x, double
   }
 }
 
+/* The leg states of an interval: types, a floating leg's rails (units of
+ * v_dc) and the floating shorted pair's leg z (-1: none). */
+typedef struct {
+  int type[3];
+  double rl[3], rh[3];
+  int node;
+} sw_legs_t;
+
 /* Sets the leg types for a new interval and the diode state of legs that
  * start to float. */
-static void sw_setup(const plant_t *pl, sw_cfg_t *cf, double *x, const int type[3]) {
+static void sw_setup(const plant_t *pl, sw_cfg_t *cf, double *x, const sw_legs_t *lg) {
+  const int *type = lg->type;
   double i[3], ial, ibe;
   phase_currents(pl, x, i, &ial, &ibe);
+  cf->node = lg->node;
   for (int j = 0; j < 3; j++) {
+    cf->rl[j] = lg->rl[j];
+    cf->rh[j] = lg->rh[j];
     if (type[j] == LEG_FLOAT) {
       if (cf->type[j] != LEG_FLOAT || cf->cond[j] == COND_NONE) {
         cf->cond[j] = fabs(i[j]) <= SW_I_EPS ? COND_BLOCK : (i[j] > 0.0 ? COND_LO : COND_HI);
@@ -475,19 +529,54 @@ static int leg_type_at(const edges_t *e, double tau, double td) {
   return e->cmd[k] ? LEG_HI : LEG_LO;
 }
 
+/* The shorted pair x, y and the third phase z of a fault mask (two bits). */
+static void short_pair(unsigned sh, int *x, int *y, int *z) {
+  *z = (sh & 1u) == 0u ? 0 : ((sh & 2u) == 0u ? 1 : 2);
+  *x = (*z + 1) % 3;
+  *y = (*z + 2) % 3;
+}
+
+/* A floating shorted pair as the reference node, leg z between shifted
+ * rails (header comment). */
+static void short_node(sw_legs_t *lg, int x, int y, int z) {
+  int *type = lg->type;
+  const int ix = type[x] == LEG_HI || type[x] == LEG_LO;
+  const int iy = type[y] == LEG_HI || type[y] == LEG_LO;
+  if (ix || iy) {
+    type[ix ? y : x] = type[ix ? x : y]; /* one leg commanded sets both */
+    return;
+  }
+  type[x] = LEG_LO;
+  type[y] = LEG_LO;
+  if (type[z] != LEG_OPEN) {
+    lg->rl[z] = type[z] == LEG_HI ? 0.0 : -1.0;
+    lg->rh[z] = type[z] == LEG_LO ? 0.0 : 1.0;
+    type[z] = LEG_FLOAT;
+    lg->node = z;
+  }
+}
+
 /* The leg states the power-stage faults leave of the commanded ones
  * (header comment). */
-static void sw_fault_legs(plant_aux_t *a, int type[3]) {
+static void sw_fault_legs(plant_aux_t *a, sw_legs_t *lg) {
+  int *type = lg->type;
   int on[3][2] = {{0, 0}, {0, 0}, {0, 0}};
+  int x = 0, y = 0, z = 0;
+  if (a->pf.shorted != 0u) {
+    short_pair(a->pf.shorted, &x, &y, &z);
+  }
   for (int pass = 0; pass < 2; pass++) {
     int shoot = 0;
     for (int j = 0; j < 3; j++) {
       const int cmd_lo = !a->desat && type[j] == LEG_LO, cmd_hi = !a->desat && type[j] == LEG_HI;
       on[j][0] = (cmd_lo && (a->pf.open & PLANT_SW_LOW(j)) == 0u) ||
-                 (a->pf.closed & PLANT_SW_LOW(j)) != 0u;
+                 (a->pf.closed & PLANT_SW_LOW(j)) != 0u || (a->pf.ground & (1u << j)) != 0u;
       on[j][1] = (cmd_hi && (a->pf.open & PLANT_SW_HIGH(j)) == 0u) ||
                  (a->pf.closed & PLANT_SW_HIGH(j)) != 0u;
       shoot |= on[j][0] && on[j][1];
+    }
+    if (a->pf.shorted != 0u) { /* through the short */
+      shoot |= (on[x][0] && on[y][1]) || (on[x][1] && on[y][0]);
     }
     if (!shoot) {
       break;
@@ -500,6 +589,9 @@ static void sw_fault_legs(plant_aux_t *a, int type[3]) {
     } else {
       type[j] = on[j][1] ? LEG_HI : (on[j][0] ? LEG_LO : LEG_FLOAT);
     }
+  }
+  if (a->pf.shorted != 0u) {
+    short_node(lg, x, y, z);
   }
 }
 
@@ -562,7 +654,10 @@ void plant_inverter_sw_period(plant_t *pl, const double on[3], const double off[
   for (int j = 0; j < 3; j++) {
     cf.type[j] = a->cond[j] == COND_NONE ? LEG_LO : LEG_FLOAT;
     cf.cond[j] = a->cond[j];
+    cf.rl[j] = 0.0;
+    cf.rh[j] = 1.0;
   }
+  cf.node = -1;
   cf.all_zero = a->all_zero;
   cf.blocked = -1;
   double t = pl->t;
@@ -572,14 +667,14 @@ void plant_inverter_sw_period(plant_t *pl, const double on[3], const double off[
     const double len = ev[i + 1] - ev[i];
     if (len > 1e-12 * ts) {
       const double mid = 0.5 * (ev[i] + ev[i + 1]);
-      int type[3];
+      sw_legs_t lg = {{LEG_FLOAT, LEG_FLOAT, LEG_FLOAT}, {0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, -1};
       for (int j = 0; j < 3; j++) {
-        type[j] = gates_on ? leg_type_at(&ed[j], mid, td) : LEG_FLOAT;
+        lg.type[j] = gates_on ? leg_type_at(&ed[j], mid, td) : LEG_FLOAT;
       }
       if (a->pf_any) {
-        sw_fault_legs(a, type);
+        sw_fault_legs(a, &lg);
       }
-      sw_setup(pl, &cf, x, type);
+      sw_setup(pl, &cf, x, &lg);
       if (!vf_init && a->star_n > 0) {
         a->star_vf = sw_star(pl, &cf, t, x);
         vf_init = 1;

@@ -817,20 +817,28 @@ static int parse_can_faults(ctx_t *c, const cJSON *o, scenario_t *sc) {
   return 0;
 }
 
-/* A power-stage fault: {"switch" | "phase": name, "active": profile}; it
- * acts on the switch-level circuit (the switching inverter model). */
-static int parse_power_fault(ctx_t *c, const cJSON *o, const char *key, int is_switch, int *target,
+/* A power-stage fault: {"switch" | "phase" | "phases": name, "active":
+ * profile}; it acts on the switch-level circuit (the switching inverter
+ * model). kind: PF_PHASE, PF_SWITCH, PF_PAIR (target: the pair's index in
+ * "ab", "bc", "ca"). */
+enum { PF_PHASE, PF_SWITCH, PF_PAIR };
+static int parse_power_fault(ctx_t *c, const cJSON *o, const char *key, int kind, int *target,
                              profile_t *active) {
   static const char *const switches[] = {"a_low", "a_high", "b_low", "b_high",
                                          "c_low", "c_high", NULL};
   static const char *const phases[] = {"a", "b", "c", NULL};
+  static const char *const pairs[] = {"ab", "bc", "ca", NULL};
+  static const char *const sels[] = {"phase", "switch", "phases"};
+  static const char *const names[] = {"a, b or c", "a_low, a_high, b_low, b_high, c_low or c_high",
+                                      "ab, bc or ca"};
+  const char *const *const choices[] = {phases, switches, pairs};
   const cJSON *f = cJSON_GetObjectItemCaseSensitive(o, key);
   if (f == NULL) {
     return 0;
   }
   char p[160];
   join(p, sizeof p, "inject", key);
-  const char *sel = is_switch ? "switch" : "phase";
+  const char *sel = sels[kind];
   const char *const keys[] = {sel, "active", NULL};
   if (check_keys(c, f, p, keys) != 0) {
     return -1;
@@ -838,16 +846,14 @@ static int parse_power_fault(ctx_t *c, const cJSON *o, const char *key, int is_s
   if (cJSON_GetObjectItemCaseSensitive(f, sel) == NULL) {
     char q[160];
     join(q, sizeof q, p, sel);
-    return fail(c, q, "required (%s)",
-                is_switch ? "a_low, a_high, b_low, b_high, c_low or c_high" : "a, b or c");
+    return fail(c, q, "required (%s)", names[kind]);
   }
   if (cJSON_GetObjectItemCaseSensitive(f, "active") == NULL) {
     char q[160];
     join(q, sizeof q, p, "active");
     return fail(c, q, "required (a profile: the fault acts while it is > 0.5)");
   }
-  if (get_enum(c, f, p, sel, is_switch ? switches : phases, target) ||
-      get_profile(c, f, p, "active", active)) {
+  if (get_enum(c, f, p, sel, choices[kind], target) || get_profile(c, f, p, "active", active)) {
     return -1;
   }
   return 0;
@@ -855,28 +861,13 @@ static int parse_power_fault(ctx_t *c, const cJSON *o, const char *key, int is_s
 
 #define FAULT_NAME(E, n, d) #n,
 static int parse_inject(ctx_t *c, const cJSON *o, scenario_t *sc) {
-  static const char *const keys[] = {"encoder_error",
-                                     "encoder_invalid",
-                                     "main_stall",
-                                     "isr_stall",
-                                     "cm_scale_d",
-                                     "cm_scale_q",
-                                     "current",
-                                     "rs_scale",
-                                     "lambda_m_scale",
-                                     "c_scale",
-                                     "passive_load",
-                                     "trip_at",
-                                     "trip_cause",
-                                     "encoder",
-                                     "can",
-                                     "isr_overrun",
-                                     "gate_driver",
-                                     "switch_open",
-                                     "switch_closed",
-                                     "phase_lost",
-                                     "phase_open",
-                                     NULL};
+  static const char *const keys[] = {
+      "encoder_error",  "encoder_invalid", "main_stall",    "isr_stall",
+      "cm_scale_d",     "cm_scale_q",      "current",       "rs_scale",
+      "lambda_m_scale", "c_scale",         "passive_load",  "trip_at",
+      "trip_cause",     "encoder",         "can",           "isr_overrun",
+      "gate_driver",    "switch_open",     "switch_closed", "phase_lost",
+      "phase_open",     "phase_short",     "ground_short",  NULL};
   static const char *const faults[] = {DRIVE_FAULT_LIST(FAULT_NAME) NULL};
   const char *P = "inject";
   plant_faults_t *pf = &sc->plant.faults;
@@ -902,14 +893,29 @@ static int parse_inject(ctx_t *c, const cJSON *o, scenario_t *sc) {
                           &pf->lambda_m_scale) ||
       get_bounded_profile(c, o, P, "c_scale", 0.0, 1, PLANT_C_SCALE_MAX, &pf->c_scale) ||
       get_profile(c, o, P, "gate_driver", &sc->gate_driver) ||
-      parse_power_fault(c, o, "switch_open", 1, &sc->switch_open.target, &sc->switch_open.active) ||
-      parse_power_fault(c, o, "switch_closed", 1, &sc->switch_closed.target,
+      parse_power_fault(c, o, "switch_open", PF_SWITCH, &sc->switch_open.target,
+                        &sc->switch_open.active) ||
+      parse_power_fault(c, o, "switch_closed", PF_SWITCH, &sc->switch_closed.target,
                         &sc->switch_closed.active) ||
-      parse_power_fault(c, o, "phase_lost", 0, &sc->phase_lost.target, &sc->phase_lost.active) ||
-      parse_power_fault(c, o, "phase_open", 0, &sc->phase_open.target, &sc->phase_open.active)) {
+      parse_power_fault(c, o, "phase_lost", PF_PHASE, &sc->phase_lost.target,
+                        &sc->phase_lost.active) ||
+      parse_power_fault(c, o, "phase_open", PF_PHASE, &sc->phase_open.target,
+                        &sc->phase_open.active) ||
+      parse_power_fault(c, o, "phase_short", PF_PAIR, &sc->phase_short.target,
+                        &sc->phase_short.active) ||
+      parse_power_fault(c, o, "ground_short", PF_PHASE, &sc->ground_short.target,
+                        &sc->ground_short.active)) {
     return -1;
   }
-  static const char *const power[] = {"switch_open", "switch_closed", "phase_lost", "phase_open"};
+  if (cJSON_GetObjectItemCaseSensitive(o, "phase_short") != NULL &&
+      cJSON_GetObjectItemCaseSensitive(o, "phase_open") != NULL &&
+      (sc->phase_open.target == sc->phase_short.target ||
+       sc->phase_open.target == (sc->phase_short.target + 1) % 3)) {
+    return fail(c, "inject.phase_short",
+                "shares a lead with inject.phase_open (an open lead cannot be shorted)");
+  }
+  static const char *const power[] = {"switch_open", "switch_closed", "phase_lost",
+                                      "phase_open",  "phase_short",   "ground_short"};
   for (size_t k = 0; k < sizeof power / sizeof power[0]; ++k) {
     if (cJSON_GetObjectItemCaseSensitive(o, power[k]) == NULL) {
       continue;

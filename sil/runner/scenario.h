@@ -39,13 +39,15 @@ typedef struct {
   profile_t isr_stall;       /* the PWM-period interrupt does not run */
   profile_t gate_driver;     /* the gate driver's nFAULT (break 2) is asserted */
   /* power-stage faults (switching model): `target` a switch (leg * 2 + 1
-   * for the high side: PLANT_SW_* bit index) or a phase (0..2), active while
-   * `active` > 0.5 (an empty profile: not injected) */
+   * for the high side: PLANT_SW_* bit index), a phase (0..2) or, for
+   * phase_short, a pair of phases (0 ab, 1 bc, 2 ca: phases target and
+   * target + 1 mod 3), active while `active` > 0.5 (an empty profile: not
+   * injected) */
   struct {
     int target;
     profile_t active;
-  } switch_open, switch_closed, phase_lost, phase_open;
-  int power_faults; /* any of the four given */
+  } switch_open, switch_closed, phase_lost, phase_open, phase_short, ground_short;
+  int power_faults; /* any of the six given */
   /* the controller's flux-map error (LIVE parameters cm_scale_d, cm_scale_q,
    * written by the main loop as over CAN when the profile changes) */
   profile_t cm_scale_d, cm_scale_q;

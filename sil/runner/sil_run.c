@@ -175,7 +175,7 @@ static void hw_break(sil_ctx_t *x, uint32_t source) {
 
 /* The power-stage faults in force at t, into the plant. */
 static void set_power_faults(sil_ctx_t *x, const scenario_t *sc, double t) {
-  plant_power_fault_t f = {0u, 0u, 0u};
+  plant_power_fault_t f = {0u, 0u, 0u, 0u, 0u};
   if (injected(&sc->switch_open.active, t)) {
     f.open |= 1u << sc->switch_open.target;
   }
@@ -188,7 +188,16 @@ static void set_power_faults(sil_ctx_t *x, const scenario_t *sc, double t) {
   if (injected(&sc->phase_open.active, t)) {
     f.phase_open |= 1u << sc->phase_open.target;
   }
-  (void)plant_set_power_faults(&x->plant, &f); /* one stuck-closed switch: never refused */
+  if (injected(&sc->ground_short.active, t)) {
+    f.ground |= 1u << sc->ground_short.target;
+  }
+  if (injected(&sc->phase_short.active, t)) {
+    const unsigned p0 = (unsigned)sc->phase_short.target;
+    f.shorted = (1u << p0) | (1u << ((p0 + 1u) % 3u));
+  }
+  /* one stuck-closed switch, one short pair never on an open lead (the
+   * parser): never refused */
+  (void)plant_set_power_faults(&x->plant, &f);
 }
 
 void sil_advance(sil_ctx_t *x, const scenario_t *sc, double t) {

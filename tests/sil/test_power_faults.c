@@ -1,7 +1,8 @@
 /*
  * SIL: power-stage faults injected into the switching inverter model
  * (scenario inject.gate_driver, switch_open, switch_closed, phase_lost,
- * phase_open; docs/faults.md "Injected in the SIL"). Base: the Rubino 2020
+ * phase_open, phase_short, ground_short; docs/faults.md "Injected in the
+ * SIL"). Base: the Rubino 2020
  * SPM (p = 21, Rs = 7.1 Ohm, Ls = 57 mH, lambda_m = 0.19 Vs, 310 V) in
  * torque mode on a dynamometer at 300 rpm, a 10 N m step at 50 ms, the
  * fault from 150 ms. At 300 rpm w_e = 659.7 rad/s: the line-to-line
@@ -36,9 +37,23 @@
  * requests beside the common trace. */
 static double *g_ia, *g_ib;
 static unsigned *g_ph_trips;
+/* Energy over [E_T0, E_T1): from the shaft, into the link, into copper
+ * (true states, period averages where the plant keeps them) [J] */
+#define E_T0 0.2
+#define E_T1 0.3
+static double g_e_shaft, g_e_link, g_e_cu;
 
 static void observer(void *user, const sil_step_t *st) {
   trace_t *tr = user;
+  const plant_state_t *p = st->plant;
+  const double ts = 1.0 / 16000.0;
+  if (p->t >= E_T0 && p->t < E_T1) {
+    g_e_shaft -= p->torque_avg * p->omega_m * ts;
+    g_e_link -= p->v_dc * p->i_dc * ts;
+    g_e_cu += RS *
+              (p->i_abc[0] * p->i_abc[0] + p->i_abc[1] * p->i_abc[1] + p->i_abc[2] * p->i_abc[2]) *
+              ts;
+  }
   if (tr->n < tr->cap) {
     g_ia[tr->n] = st->plant->i_abc[0];
     g_ib[tr->n] = st->plant->i_abc[1];
@@ -47,7 +62,8 @@ static void observer(void *user, const sil_step_t *st) {
   trace_observer(user, st);
 }
 
-static void run_fault(const char *inject, trace_t *tr, scenario_t *sc) {
+/* rpm: the speed from 160 ms on (300 rpm before, a ramp over 20 ms). */
+static void run_fault_at(const char *inject, double rpm, trace_t *tr, scenario_t *sc) {
   sil_result_t res;
   char err[512];
   char js[2048];
@@ -55,10 +71,14 @@ static void run_fault(const char *inject, trace_t *tr, scenario_t *sc) {
            "{\"duration\": 0.3, \"machine\": {\"preset\": \"rubino2020_spm\"}, \"inverter\": "
            "{\"model\": \"switching\"}, \"sensors\": {\"i_noise\": 0.005}, \"mechanics\": "
            "{\"mode\": \"imposed\", \"speed\": {\"unit\": \"rpm\", \"terms\": [{\"type\": "
-           "\"const\", \"value\": 300}]}}, \"controller\": {\"mode\": \"torque\"}, "
+           "\"const\", \"value\": 300}, {\"type\": \"ramp\", \"t0\": 0.16, \"t1\": 0.18, "
+           "\"value\": %g}]}}, \"controller\": {\"mode\": \"torque\"}, "
            "\"references\": {\"torque\": [{\"type\": \"step\", \"t\": 0.05, \"value\": %g}]}, "
            "\"inject\": {%s}}",
-           T_REF, inject);
+           rpm - 300.0, T_REF, inject);
+  g_e_shaft = 0.0;
+  g_e_link = 0.0;
+  g_e_cu = 0.0;
   int r = scenario_parse(js, "test", sc, err, sizeof err);
   if (r != 0) {
     fprintf(stderr, "%s\n", err);
@@ -74,6 +94,11 @@ static void run_fault(const char *inject, trace_t *tr, scenario_t *sc) {
   g_ph_trips = calloc(cap, sizeof(unsigned));
   r = sil_run(sc, observer, tr, &res, err, sizeof err);
   assert_int_equal(r, 0);
+  assert_true(fabs(sc->plant.ts - 1.0 / 16000.0) < 1e-15); /* the observer's step */
+}
+
+static void run_fault(const char *inject, trace_t *tr, scenario_t *sc) {
+  run_fault_at(inject, 300.0, tr, sc);
 }
 
 #define ACTIVE_FROM_INJ "\"active\": [{\"type\": \"step\", \"t\": 0.15, \"value\": 1}]"
@@ -136,6 +161,96 @@ static void switch_stuck_closed(void **state) {
   const double i_hi = 2.0 * (2.0 * VDC / PI + LM * W_E) / Z_ABS;
   printf("a_high stuck closed: mean torque 0.2-0.3 s %.3f N m, peak current %.3f A (bounds %.3f, "
          "%.3f A)\n",
+         torque, i_pk, 0.5 * I_SC, i_hi);
+  assert_true(torque < 0.0 && torque > -T_REF * 2.0);
+  assert_true(i_pk > 0.5 * I_SC && i_pk < i_hi);
+  trace_free(&tr);
+}
+
+/* Leads a and b shorted together (bolted): the first period in which legs
+ * a and b are commanded apart shoots through the short, which the gate
+ * driver's desaturation detection ends (gate_driver within two periods).
+ * Then the gates are off and the machine works into its own line-to-line
+ * short: below the rectifier speed of the node (a, b) against c (the
+ * back-EMF 1.5 lambda_m w_e = 188 V < v_dc) phase c's diodes block once
+ * the trip's transient has died out (L / R = 8 ms), and the loop a-b alone
+ * carries the current the line-to-line back-EMF sqrt(3) lambda_m w_e drives
+ * through 2 Z: sqrt(3) / 2 of I_SC, dissipating 2 R I^2 / 2 in copper, all
+ * of it from the shaft: the mean torque is -R I^2 / w_m. Both to 2 %
+ * over 0.2-0.3 s (five time constants after the trip). */
+static void phase_to_phase_short(void **state) {
+  (void)state;
+  trace_t tr;
+  scenario_t sc;
+  run_fault("\"phase_short\": {\"phases\": \"ab\", " ACTIVE_FROM_INJ "}", &tr, &sc);
+  check_gate_driver_trip(&tr, &sc, T_INJ, "a-b short");
+  const size_t k0 = idx_at(&tr, 0.2), k1 = idx_at(&tr, 0.3);
+  const double torque = trace_mean(tr.torque, k0, k1);
+  double ia = 0.0, ic = 0.0;
+  for (size_t k = k0; k < k1; ++k) {
+    ia = fmax(ia, fabs(g_ia[k]));
+    ic = fmax(ic, fabs(g_ia[k] + g_ib[k]));
+  }
+  const double i_ll = 0.5 * sqrt(3.0) * I_SC;
+  const double t_ll = -RS * i_ll * i_ll / (W_E / P);
+  printf("a-b short: 0.2-0.3 s peak |i_a| %.4f A (line-to-line short %.4f A), peak |i_c| %.3g A, "
+         "mean torque %.4f N m (expected %.4f)\n",
+         ia, i_ll, ic, torque, t_ll);
+  assert_true(fabs(ia - i_ll) < 0.02 * i_ll);
+  assert_true(ic < 1e-6);
+  assert_true(fabs(torque - t_ll) < 0.02 * fabs(t_ll));
+  trace_free(&tr);
+}
+
+/* The same short, the dynamometer then at 600 rpm: the node (a, b) against c now rectifies
+ * (1.5 lambda_m w_e = 376 V > v_dc): phase c's diodes conduct and the
+ * ideal link takes power. The circuit's energy balance checks the
+ * shorted pair's diode node (plant_inverter_sw.c): over 0.2-0.3 s the
+ * shaft's energy equals the link's plus the copper's to 1 %, the link's
+ * share above a tenth, and the phase current stays below twice the
+ * line-to-line short's. */
+static void phase_to_phase_short_rectifying(void **state) {
+  (void)state;
+  trace_t tr;
+  scenario_t sc;
+  run_fault_at("\"phase_short\": {\"phases\": \"ab\", " ACTIVE_FROM_INJ "}", 600.0, &tr, &sc);
+  check_gate_driver_trip(&tr, &sc, T_INJ, "a-b short at 600 rpm");
+  double ic = 0.0;
+  for (size_t k = idx_at(&tr, E_T0); k < idx_at(&tr, E_T1); ++k) {
+    ic = fmax(ic, fabs(g_ia[k] + g_ib[k]));
+  }
+  const double w_e = 2.0 * W_E, z = sqrt(RS * RS + w_e * LS * w_e * LS);
+  const double i_ll = 0.5 * sqrt(3.0) * LM * w_e / z;
+  const double i_pk = trace_max(tr.imax_abs, idx_at(&tr, E_T0), idx_at(&tr, E_T1));
+  const double bal = g_e_shaft - g_e_link - g_e_cu;
+  printf("a-b short at 600 rpm, 0.2-0.3 s: shaft %.4f J, link %.4f J, copper %.4f J, balance "
+         "%.2e J (%.3f %%); peak |i_c| %.3f A; peak current %.3f A (line-to-line short %.3f "
+         "A)\n",
+         g_e_shaft, g_e_link, g_e_cu, bal, 100.0 * bal / g_e_shaft, ic, i_pk, i_ll);
+  assert_true(g_e_shaft > 0.0);
+  assert_true(fabs(bal) < 0.01 * g_e_shaft);
+  assert_true(g_e_link > 0.1 * g_e_shaft);
+  assert_true(ic > 0.05 * i_ll);
+  assert_true(i_pk < 2.0 * i_ll);
+  trace_free(&tr);
+}
+
+/* Lead a shorted to earth, the link's negative rail (bolted): the next
+ * turn-on of a's high side shoots through the short (gate_driver within
+ * two periods). Then phase a stays tied to the negative rail: the circuit
+ * of a stuck-closed low side, braking through the low diodes of b and c,
+ * with the bounds of switch_stuck_closed. */
+static void phase_to_ground_short(void **state) {
+  (void)state;
+  trace_t tr;
+  scenario_t sc;
+  run_fault("\"ground_short\": {\"phase\": \"a\", " ACTIVE_FROM_INJ "}", &tr, &sc);
+  check_gate_driver_trip(&tr, &sc, T_INJ, "a-earth short");
+  const double torque = trace_mean(tr.torque, idx_at(&tr, 0.2), idx_at(&tr, 0.3));
+  const double i_pk = trace_max(tr.imax_abs, idx_at(&tr, T_INJ), idx_at(&tr, 0.3));
+  const double i_hi = 2.0 * (2.0 * VDC / PI + LM * W_E) / Z_ABS;
+  printf("a-earth short: mean torque 0.2-0.3 s %.3f N m, peak current %.3f A (bounds %.3f, %.3f "
+         "A)\n",
          torque, i_pk, 0.5 * I_SC, i_hi);
   assert_true(torque < 0.0 && torque > -T_REF * 2.0);
   assert_true(i_pk > 0.5 * I_SC && i_pk < i_hi);
@@ -258,6 +373,15 @@ static void bad_injections_named(void **state) {
       {"\"switch_open\": {" ACTIVE_FROM_INJ "}", "switching",
        "inject.switch_open.switch: required"},
       {"\"gate_driver\": \"on\"", "switching", "inject.gate_driver"},
+      {"\"phase_short\": {\"phases\": \"ac\", " ACTIVE_FROM_INJ "}", "switching",
+       "inject.phase_short.phases: "},
+      {"\"phase_short\": {\"phase\": \"a\", " ACTIVE_FROM_INJ "}", "switching",
+       "inject.phase_short.phase: unknown field"},
+      {"\"ground_short\": {\"phase\": \"a\", " ACTIVE_FROM_INJ "}", "average",
+       "inject.ground_short: needs inverter.model: switching"},
+      {"\"phase_short\": {\"phases\": \"ca\", " ACTIVE_FROM_INJ "}, \"phase_open\": "
+       "{\"phase\": \"a\", " ACTIVE_FROM_INJ "}",
+       "switching", "inject.phase_short: shares a lead with inject.phase_open"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
     char js[1024], err[512] = "";
@@ -276,6 +400,9 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(gate_driver_input),
       cmocka_unit_test(switch_stuck_closed),
+      cmocka_unit_test(phase_to_phase_short),
+      cmocka_unit_test(phase_to_phase_short_rectifying),
+      cmocka_unit_test(phase_to_ground_short),
       cmocka_unit_test(healthy_does_not_trip),
       cmocka_unit_test(switch_stuck_open),
       cmocka_unit_test(phase_lost),

@@ -688,6 +688,8 @@ static void drive_publish(drive_t *drv, const hal_sample_t *s, const float i[3])
   tm->i_abc[2] = i[2];
   tm->v_ab_applied[0] = drv->v_applied.alpha;
   tm->v_ab_applied[1] = drv->v_applied.beta;
+  tm->v_ab_filt[0] += DRIVE_VF_K * (drv->v_applied.alpha - tm->v_ab_filt[0]);
+  tm->v_ab_filt[1] += DRIVE_VF_K * (drv->v_applied.beta - tm->v_ab_filt[1]);
   tm->omega_m = drv->omega_m;
   tm->pos_health = drv->pos.out.health;
   tm->load_est = drv->pos.out.load;

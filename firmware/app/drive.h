@@ -59,6 +59,10 @@ enum {
 };
 #define DRIVE_LC_COUNT 5
 
+/* Low-pass of the applied voltage for the main loop's voltage balance
+ * (drive_telemetry_t.v_ab_filt): the share of each ISR's voltage. */
+#define DRIVE_VF_K 0.0625f
+
 /* Everything the drive exposes for telemetry (CAN) and logs. */
 typedef struct {
   uint32_t isr_count; /* written first ... */
@@ -70,6 +74,9 @@ typedef struct {
   float i_abc[3];        /* offset-corrected phase currents [A] */
   float i_dq[2];         /* rotor frame currents [A] */
   float v_ab_applied[2]; /* voltage the last pattern applies [V] */
+  float v_ab_filt[2];    /* v_ab_applied through a first-order low-pass of
+                            DRIVE_VF_K per ISR (about 1 ms at 16 kHz): the
+                            main loop's phase check, drive_phase_check.h [V] */
   float duty[3];         /* duties as the HAL applies them */
   float theta_e;         /* electrical angle at the current sample [rad] */
   float omega_m;         /* mechanical speed estimate [rad/s] */

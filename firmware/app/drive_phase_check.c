@@ -13,22 +13,94 @@
 
 static void window_clear(drive_phase_check_t *p) {
   memset(p->abs, 0, sizeof p->abs);
+  memset(p->r1, 0, sizeof p->r1);
+  memset(p->r2, 0, sizeof p->r2);
+  memset(p->r3, 0, sizeof p->r3);
+  memset(p->s1, 0, sizeof p->s1);
+  memset(p->st1, 0, sizeof p->st1);
+  p->st = 0.0f;
+  p->stt = 0.0f;
   p->angle = 0.0f;
   p->n = 0;
 }
 
+/* One sample into the window: x = v_applied - R_s i in (alpha, beta) at
+ * the electrical angle theta, tau the fraction of a revolution swept
+ * (drive_phase_check.h). */
+static void window_add(drive_phase_check_t *p, const drive_telemetry_t *tm, float rs, float tau) {
+  const float ia = tm->i_abc[0];
+  const float ib = (tm->i_abc[0] + 2.0f * tm->i_abc[1]) * FRAMES_INV_SQRT3;
+  const float xa = tm->v_ab_filt[0] - rs * ia;
+  const float xb = tm->v_ab_filt[1] - rs * ib;
+  const float c = cosf(tm->theta_e);
+  const float s = sinf(tm->theta_e);
+  const float ya = xa * c + xb * s; /* x e^{-j theta} */
+  const float yb = xb * c - xa * s;
+  p->r1[0] += xa;
+  p->r1[1] += xb;
+  p->r2[0] += ya;
+  p->r2[1] += yb;
+  p->r3[0] += tau * ya;
+  p->r3[1] += tau * yb;
+  p->s1[0] += c;
+  p->s1[1] += s;
+  p->st1[0] += tau * c;
+  p->st1[1] += tau * s;
+  p->st += tau;
+  p->stt += tau * tau;
+  for (int x = 0; x < 3; ++x) {
+    p->abs[x] += fabsf(tm->i_abc[x]);
+  }
+  p->n++;
+}
+
+/* |D| of the window (drive_phase_check.h); -1 when the samples do not
+ * separate D from the fundamental's terms. */
+static float window_dc(const drive_phase_check_t *p) {
+  const float n = (float)p->n;
+  const float det = n * p->stt - p->st * p->st;
+  if (!(det > 1e-6f * n * p->stt)) {
+    return -1.0f;
+  }
+  /* w = c B^-1 (row), B^-1 = [stt, -st; -st, n] / det */
+  const float w1[2] = {(p->s1[0] * p->stt - p->st1[0] * p->st) / det,
+                       (p->s1[1] * p->stt - p->st1[1] * p->st) / det};
+  const float w2[2] = {(p->st1[0] * n - p->s1[0] * p->st) / det,
+                       (p->st1[1] * n - p->s1[1] * p->st) / det};
+  /* den = n - w c^H (real), num = r1 - w rF */
+  const float den =
+      n - (w1[0] * p->s1[0] + w1[1] * p->s1[1] + w2[0] * p->st1[0] + w2[1] * p->st1[1]);
+  if (!(den > 0.25f * n)) {
+    return -1.0f;
+  }
+  const float na =
+      p->r1[0] - (w1[0] * p->r2[0] - w1[1] * p->r2[1]) - (w2[0] * p->r3[0] - w2[1] * p->r3[1]);
+  const float nb =
+      p->r1[1] - (w1[0] * p->r2[1] + w1[1] * p->r2[0]) - (w2[0] * p->r3[1] + w2[1] * p->r3[0]);
+  return sqrtf(na * na + nb * nb) / den;
+}
+
 /* 1 unbalanced, 0 balanced, -1 not judged. */
-static int verdict(const drive_phase_check_t *p, float i_max) {
+static int verdict(drive_phase_check_t *p, float i_max, float v_dc) {
   const float big = fd_maxf(p->abs[0], fd_maxf(p->abs[1], p->abs[2]));
   if (p->n < DRIVE_PH_MIN_N || !(big > DRIVE_PH_FLOOR * i_max * (float)p->n)) {
     return -1;
   }
+  int v = 0;
   for (int x = 0; x < 3; ++x) {
     if (p->abs[x] < DRIVE_PH_OPEN * big) {
-      return 1;
+      v = 1;
     }
   }
-  return 0;
+  const float d = window_dc(p);
+  if (d >= 0.0f && v_dc > 0.0f) {
+    p->vdef = d / v_dc;
+    p->vdef_max = fd_maxf(p->vdef_max, p->vdef);
+    if (p->vdef > DRIVE_PH_VDEF) {
+      v = 1;
+    }
+  }
+  return v;
 }
 
 void drive_phase_check(drive_t *drv) {
@@ -46,11 +118,8 @@ void drive_phase_check(drive_t *drv) {
     p->bad = 0;
     return;
   }
-  for (int x = 0; x < 3; ++x) {
-    p->abs[x] += fabsf(tm->i_abc[x]);
-  }
-  p->n++;
   p->angle += fabsf(tm->omega_m) * c->pole_pairs * (float)isrs * c->ts;
+  window_add(p, tm, c->rs, p->angle * (1.0f / FRAMES_2PI));
   if (p->angle < FRAMES_2PI) {
     if (p->n >= DRIVE_PH_MAX_N) { /* too slow: no verdict */
       window_clear(p);
@@ -58,7 +127,7 @@ void drive_phase_check(drive_t *drv) {
     }
     return;
   }
-  const int v = verdict(p, c->i_max);
+  const int v = verdict(p, c->i_max, tm->v_dc);
   p->bad = v > 0 ? p->bad + 1 : 0;
   window_clear(p);
   if (p->bad >= DRIVE_PH_TRIP) {

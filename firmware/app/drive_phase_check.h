@@ -16,9 +16,30 @@
  * revolutions in a row (one not judged starts the count again; a transient
  * such as a torque step unbalances one) requests lost_control
  * (drive_request_fault: taken by the next ISR) and counts in `trips`.
- * Not judged: a phase conducting one way only (a switch stuck open): the
- * controller's own transients (a current vector that lags the rotor over a
- * revolution, e.g. the decoupled DFVC after a speed ramp) look the same.
+ *
+ * Voltage balance, on the same revolutions: a switch stuck open (or a leg
+ * that cannot reach one rail) takes from its phase the voltage the drive
+ * believes it applied, in one half-wave only: the drive's own v_ab_applied
+ * less R_s i_ab, whose mean over a revolution is the flux change (zero in
+ * steady state: v - R i = d lambda / dt), then carries a stationary (DC)
+ * component along that phase's axis, the missing voltage. A healthy drive's
+ * is the dead-time compensation's asymmetry and R_s errors times a DC
+ * current: millivolts. The main loop's samples are not uniform in angle,
+ * so the DC part D is fitted by least squares over the revolution's
+ * samples together with the rotor-frame voltage turning with the rotor,
+ * (F0 + F1 tau) e^{j theta} (the back-EMF, the largest term, and its drift
+ * over the revolution: tau the fraction of it swept, so ramps of speed,
+ * torque and flux do not leak into D): x_k = D + (F0 + F1 tau_k) e^{j
+ * theta_k}. With the real block B = [n, St; St, Stt] of the fundamental's
+ * two terms (St = sum tau_k, Stt = sum tau_k^2), c = (S1, St1)
+ * (S1 = sum e^{j theta_k}, St1 = sum tau_k e^{j theta_k}) and the right
+ * sides r1 = sum x_k, rF = (sum x_k e^{-j theta_k}, sum tau_k x_k e^{-j
+ * theta_k}): D = (r1 - c B^-1 rF) / (n - c B^-1 c^H). A revolution with
+ * |D| > DRIVE_PH_VDEF v_dc is unbalanced like one with a dead phase (the
+ * same count of DRIVE_PH_TRIP in a row, the same request); `vdef` keeps
+ * |D| / v_dc of the last judged revolution, `vdef_max` the largest. A step
+ * (torque, flux) still leaks into D for the revolution it falls in: two in
+ * a row are needed.
  */
 #ifndef FLUXDRIVE_DRIVE_PHASE_CHECK_H
 #define FLUXDRIVE_DRIVE_PHASE_CHECK_H
@@ -33,9 +54,25 @@
  * stationary current at light load, tests/python/test_fabbri2022_kf.py) */
 #define DRIVE_PH_OPEN  0.08f
 #define DRIVE_PH_FLOOR 0.05f
+/* the missing voltage of a switch stuck open at 300 rpm on the Rubino SPM:
+ * 0.045 v_dc at 2 N m, 0.08 at 10 N m; the healthy run 0.0017 in steady
+ * state (tests/sil/test_power_faults.c, docs/faults.md) */
+#define DRIVE_PH_VDEF 0.02f
 
 typedef struct {
-  float abs[3];      /* sums of |i_x| over the window [A] */
+  float abs[3]; /* sums of |i_x| over the window [A] */
+  /* least-squares sums over the window (complex: [0] real, [1] imaginary;
+     x = v_applied - R_s i in (alpha, beta) [V], tau the revolution's
+     fraction swept) */
+  float r1[2];       /* sum x */
+  float r2[2];       /* sum x e^{-j theta} */
+  float r3[2];       /* sum tau x e^{-j theta} */
+  float s1[2];       /* sum e^{j theta} */
+  float st1[2];      /* sum tau e^{j theta} */
+  float st;          /* sum tau */
+  float stt;         /* sum tau^2 */
+  float vdef;        /* |D| / v_dc of the last judged revolution */
+  float vdef_max;    /* the largest vdef since start-up */
   float angle;       /* electrical angle swept [rad] */
   int32_t n;         /* samples in the window */
   int32_t bad;       /* unbalanced revolutions in a row */

@@ -400,6 +400,7 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
   res->steps = n;
   res->sim_time = (double)n * ts;
   res->pwm_clamped = x.hal.pwm_clamped;
+  res->voltage_balance_max = (double)x.drv.host.ph.vdef_max;
   if (can) {
     res->can = proto.stats;
   }

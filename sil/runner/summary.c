@@ -46,6 +46,7 @@ char *summary_json(const scenario_t *sc, const sil_result_t *r) {
   cJSON_AddNumberToObject(o, "watchdog_resets", (double)r->watchdog_resets);
   cJSON_AddNumberToObject(o, "first_watchdog_t", r->first_watchdog_t);
   cJSON_AddNumberToObject(o, "pwm_clamped", (double)r->pwm_clamped);
+  cJSON_AddNumberToObject(o, "voltage_balance_max", r->voltage_balance_max);
   char *s = cJSON_Print(o);
   cJSON_Delete(o);
   return s;

@@ -23,19 +23,6 @@ void deadtime_comp_reset(deadtime_comp_t *d) {
   d->dt_ratio = d->cfg.td / d->cfg.ts;
 }
 
-float deadtime_comp_sign(const deadtime_comp_t *d, float i) {
-  if (!fd_isfinite(i)) {
-    return 0.0f;
-  }
-  if (i >= d->cfg.i_band) {
-    return (i > 0.0f) ? 1.0f : 0.0f; /* i_band = 0 and i = 0: no correction */
-  }
-  if (i <= -d->cfg.i_band) {
-    return (i < 0.0f) ? -1.0f : 0.0f;
-  }
-  return i / d->cfg.i_band; /* |i| < i_band implies i_band > 0 */
-}
-
 void deadtime_comp_apply(const deadtime_comp_t *d, const float duty_in[3], abc_t i_pred,
                          float duty_out[3]) {
   const float ix[3] = {i_pred.a, i_pred.b, i_pred.c};

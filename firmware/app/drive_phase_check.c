@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "drive.h"
+#include "math/fast_trig.h"
 #include "math/fd_math.h"
 #include "math/frames.h"
 
@@ -32,8 +33,9 @@ static void window_add(drive_phase_check_t *p, const drive_telemetry_t *tm, floa
   const float ib = (tm->i_abc[0] + 2.0f * tm->i_abc[1]) * FRAMES_INV_SQRT3;
   const float xa = tm->v_ab_filt[0] - rs * ia;
   const float xb = tm->v_ab_filt[1] - rs * ib;
-  const float c = cosf(tm->theta_e);
-  const float s = sinf(tm->theta_e);
+  float s;
+  float c;
+  fd_sincosf(tm->theta_e, &s, &c);
   const float ya = xa * c + xb * s; /* x e^{-j theta} */
   const float yb = xb * c - xa * s;
   p->r1[0] += xa;

@@ -56,13 +56,13 @@ static void window_add(drive_phase_check_t *p, const drive_telemetry_t *tm, floa
   p->n++;
 }
 
-/* |D| of the window (drive_phase_check.h); -1 when the samples do not
- * separate D from the fundamental's terms. */
-static float window_dc(const drive_phase_check_t *p) {
+/* D of the window (drive_phase_check.h) in (alpha, beta) [V]; -1 when the
+ * samples do not separate it from the fundamental's terms, else 0. */
+static int window_dc(const drive_phase_check_t *p, float d[2]) {
   const float n = (float)p->n;
   const float det = n * p->stt - p->st * p->st;
   if (!(det > 1e-6f * n * p->stt)) {
-    return -1.0f;
+    return -1;
   }
   /* w = c B^-1 (row), B^-1 = [stt, -st; -st, n] / det */
   const float w1[2] = {(p->s1[0] * p->stt - p->st1[0] * p->st) / det,
@@ -73,13 +73,15 @@ static float window_dc(const drive_phase_check_t *p) {
   const float den =
       n - (w1[0] * p->s1[0] + w1[1] * p->s1[1] + w2[0] * p->st1[0] + w2[1] * p->st1[1]);
   if (!(den > 0.25f * n)) {
-    return -1.0f;
+    return -1;
   }
   const float na =
       p->r1[0] - (w1[0] * p->r2[0] - w1[1] * p->r2[1]) - (w2[0] * p->r3[0] - w2[1] * p->r3[1]);
   const float nb =
       p->r1[1] - (w1[0] * p->r2[1] + w1[1] * p->r2[0]) - (w2[0] * p->r3[1] + w2[1] * p->r3[0]);
-  return sqrtf(na * na + nb * nb) / den;
+  d[0] = na / den;
+  d[1] = nb / den;
+  return 0;
 }
 
 /* 1 unbalanced, 0 balanced, -1 not judged. */
@@ -94,9 +96,11 @@ static int verdict(drive_phase_check_t *p, float i_max, float v_dc) {
       v = 1;
     }
   }
-  const float d = window_dc(p);
-  if (d >= 0.0f && v_dc > 0.0f) {
-    p->vdef = d / v_dc;
+  float d[2];
+  if (window_dc(p, d) == 0 && v_dc > 0.0f) {
+    p->vdef_ab[0] = d[0] / v_dc;
+    p->vdef_ab[1] = d[1] / v_dc;
+    p->vdef = sqrtf(p->vdef_ab[0] * p->vdef_ab[0] + p->vdef_ab[1] * p->vdef_ab[1]);
     p->vdef_max = fd_maxf(p->vdef_max, p->vdef);
     if (p->vdef > DRIVE_PH_VDEF) {
       v = 1;

@@ -36,8 +36,10 @@
  * sides r1 = sum x_k, rF = (sum x_k e^{-j theta_k}, sum tau_k x_k e^{-j
  * theta_k}): D = (r1 - c B^-1 rF) / (n - c B^-1 c^H). A revolution with
  * |D| > DRIVE_PH_VDEF v_dc is unbalanced like one with a dead phase (the
- * same count of DRIVE_PH_TRIP in a row, the same request); `vdef` keeps
- * |D| / v_dc of the last judged revolution, `vdef_max` the largest. A step
+ * same count of DRIVE_PH_TRIP in a row, the same request); `vdef_ab` keeps
+ * D / v_dc of the last judged revolution (its direction names the phase:
+ * a high side stuck open along +x, a low side along -x, x its phase's
+ * axis), `vdef` its magnitude, `vdef_max` the largest. A step
  * (torque, flux) still leaks into D for the revolution it falls in: two in
  * a row are needed.
  */
@@ -71,6 +73,7 @@ typedef struct {
   float st1[2];      /* sum tau e^{j theta} */
   float st;          /* sum tau */
   float stt;         /* sum tau^2 */
+  float vdef_ab[2];  /* D / v_dc of the last judged revolution (alpha, beta) */
   float vdef;        /* |D| / v_dc of the last judged revolution */
   float vdef_max;    /* the largest vdef since start-up */
   float angle;       /* electrical angle swept [rad] */

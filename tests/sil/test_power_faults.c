@@ -37,7 +37,8 @@
  * requests beside the common trace. */
 static double *g_ia, *g_ib;
 static unsigned *g_ph_trips;
-static float *g_vdef; /* the phase check's last judged voltage deficit |D| / v_dc */
+static float *g_vdef;      /* the phase check's last judged voltage deficit |D| / v_dc */
+static float g_vdef_ab[2]; /* its D / v_dc at the end of the run (alpha, beta) */
 /* Energy over [E_T0, E_T1): from the shaft, into the link, into copper
  * (true states, period averages where the plant keeps them) [J] */
 #define E_T0 0.2
@@ -60,6 +61,8 @@ static void observer(void *user, const sil_step_t *st) {
     g_ib[tr->n] = st->plant->i_abc[1];
     g_ph_trips[tr->n] = st->drive->host.ph.trips;
     g_vdef[tr->n] = st->drive->host.ph.vdef;
+    g_vdef_ab[0] = st->drive->host.ph.vdef_ab[0];
+    g_vdef_ab[1] = st->drive->host.ph.vdef_ab[1];
   }
   trace_observer(user, st);
 }
@@ -329,8 +332,10 @@ static void healthy_does_not_trip(void **state) {
  * half-wave), so the voltage the drive believes it applied is missing
  * there: the phase check's stationary voltage deficit (drive_phase_check.h)
  * exceeds DRIVE_PH_VDEF and it trips as for a dead phase (check_phase_trip's
- * time bounds), the deficit then at least DRIVE_PH_VDEF; the current stays
- * below i_trip meanwhile (the healthy amplitude). */
+ * time bounds), the deficit then at least DRIVE_PH_VDEF and along the
+ * phase's own axis, outwards for a high side (the believed voltage above
+ * the one applied), inwards for a low side, within 15 deg; the current
+ * stays below i_trip meanwhile (the healthy amplitude). */
 static void check_stuck_open(const char *sw, double torque) {
   trace_t tr;
   scenario_t sc;
@@ -347,6 +352,14 @@ static void check_stuck_open(const char *sw, double torque) {
          what, (double)g_vdef[k], (double)DRIVE_PH_VDEF, i_pk, sc.drive.i_trip);
   assert_true(g_vdef[k] > DRIVE_PH_VDEF);
   assert_true(i_pk < sc.drive.i_trip);
+  /* the phase's axis (a 0, b 120, c 240 deg), reversed for a low side */
+  const int leg = sw[0] - 'a';
+  const double axis = 2.0 * PI / 3.0 * leg + (strstr(sw, "low") != NULL ? PI : 0.0);
+  const double ang = atan2(g_vdef_ab[1], g_vdef_ab[0]);
+  const double off = fabs(remainder(ang - axis, 2.0 * PI));
+  printf("%s: deficit direction %.1f deg, the stuck switch's phase axis %.1f deg (off by %.1f)\n",
+         what, ang * 180.0 / PI, remainder(axis, 2.0 * PI) * 180.0 / PI, off * 180.0 / PI);
+  assert_true(off < 15.0 * PI / 180.0);
   trace_free(&tr);
 }
 
@@ -354,6 +367,7 @@ static void switch_stuck_open(void **state) {
   (void)state;
   check_stuck_open("a_high", T_REF);
   check_stuck_open("b_low", T_REF);
+  check_stuck_open("c_high", T_REF);
   check_stuck_open("a_high", 0.2 * T_REF); /* light load */
 }
 

@@ -157,27 +157,32 @@ static void gate_driver_input(void **state) {
   trace_free(&tr);
 }
 
-/* The high side of leg a stuck closed: the low side's next turn-on is a
+/* A leg tied to one rail whatever its gates (a switch stuck closed, a
+ * lead shorted to earth): the other switch's next turn-on is a
  * shoot-through, which the gate driver's desaturation detection ends
- * (gate_driver within two periods). With the gates off the stuck switch
- * and the diodes keep a rectifier path: braking torque, currents between
- * half the three-phase short-circuit current and twice the largest the
- * six-step voltage and the back-EMF drive through the phase impedance. */
-static void switch_stuck_closed(void **state) {
-  (void)state;
+ * (gate_driver within two periods). With the gates off the tie and the
+ * diodes keep a rectifier path: braking torque, currents between half the
+ * three-phase short-circuit current and twice the largest the six-step
+ * voltage and the back-EMF drive through the phase impedance. */
+static void check_tied_leg(const char *inject, const char *what) {
   trace_t tr;
   scenario_t sc;
-  run_fault("\"switch_closed\": {\"switch\": \"a_high\", " ACTIVE_FROM_INJ "}", &tr, &sc);
-  check_gate_driver_trip(&tr, &sc, T_INJ, "a_high stuck closed");
+  run_fault(inject, &tr, &sc);
+  check_gate_driver_trip(&tr, &sc, T_INJ, what);
   const double torque = trace_mean(tr.torque, idx_at(&tr, 0.2), idx_at(&tr, 0.3));
   const double i_pk = trace_max(tr.imax_abs, idx_at(&tr, T_INJ), idx_at(&tr, 0.3));
   const double i_hi = 2.0 * (2.0 * VDC / PI + LM * W_E) / Z_ABS;
-  printf("a_high stuck closed: mean torque 0.2-0.3 s %.3f N m, peak current %.3f A (bounds %.3f, "
-         "%.3f A)\n",
+  printf("%s: mean torque 0.2-0.3 s %.3f N m, peak current %.3f A (bounds %.3f, %.3f A)\n", what,
          torque, i_pk, 0.5 * I_SC, i_hi);
   assert_true(torque < 0.0 && torque > -T_REF * 2.0);
   assert_true(i_pk > 0.5 * I_SC && i_pk < i_hi);
   trace_free(&tr);
+}
+
+static void switch_stuck_closed(void **state) {
+  (void)state;
+  check_tied_leg("\"switch_closed\": {\"switch\": \"a_high\", " ACTIVE_FROM_INJ "}",
+                 "a_high stuck closed");
 }
 
 /* Leads a and b shorted together (bolted): the first period in which legs
@@ -248,26 +253,12 @@ static void phase_to_phase_short_rectifying(void **state) {
   trace_free(&tr);
 }
 
-/* Lead a shorted to earth, the link's negative rail (bolted): the next
- * turn-on of a's high side shoots through the short (gate_driver within
- * two periods). Then phase a stays tied to the negative rail: the circuit
- * of a stuck-closed low side, braking through the low diodes of b and c,
- * with the bounds of switch_stuck_closed. */
+/* Lead a shorted to earth, the link's negative rail (bolted): phase a
+ * tied to that rail, the circuit of a stuck-closed low side, braking
+ * through the low diodes of b and c. */
 static void phase_to_ground_short(void **state) {
   (void)state;
-  trace_t tr;
-  scenario_t sc;
-  run_fault("\"ground_short\": {\"phase\": \"a\", " ACTIVE_FROM_INJ "}", &tr, &sc);
-  check_gate_driver_trip(&tr, &sc, T_INJ, "a-earth short");
-  const double torque = trace_mean(tr.torque, idx_at(&tr, 0.2), idx_at(&tr, 0.3));
-  const double i_pk = trace_max(tr.imax_abs, idx_at(&tr, T_INJ), idx_at(&tr, 0.3));
-  const double i_hi = 2.0 * (2.0 * VDC / PI + LM * W_E) / Z_ABS;
-  printf("a-earth short: mean torque 0.2-0.3 s %.3f N m, peak current %.3f A (bounds %.3f, %.3f "
-         "A)\n",
-         torque, i_pk, 0.5 * I_SC, i_hi);
-  assert_true(torque < 0.0 && torque > -T_REF * 2.0);
-  assert_true(i_pk > 0.5 * I_SC && i_pk < i_hi);
-  trace_free(&tr);
+  check_tied_leg("\"ground_short\": {\"phase\": \"a\", " ACTIVE_FROM_INJ "}", "a-earth short");
 }
 
 /* The drive's phase-balance check (drive_phase_check.h, main loop)

@@ -12,23 +12,10 @@
 #include "math/fd_math.h"
 #include "math/frames.h"
 
-static void window_clear(drive_phase_check_t *p) {
-  memset(p->abs, 0, sizeof p->abs);
-  memset(p->r1, 0, sizeof p->r1);
-  memset(p->r2, 0, sizeof p->r2);
-  memset(p->r3, 0, sizeof p->r3);
-  memset(p->s1, 0, sizeof p->s1);
-  memset(p->st1, 0, sizeof p->st1);
-  p->st = 0.0f;
-  p->stt = 0.0f;
-  p->angle = 0.0f;
-  p->n = 0;
-}
-
 /* One sample into the window: x = v_applied - R_s i in (alpha, beta) at
  * the electrical angle theta, tau the fraction of a revolution swept
  * (drive_phase_check.h). */
-static void window_add(drive_phase_check_t *p, const drive_telemetry_t *tm, float rs, float tau) {
+static void window_add(drive_ph_window_t *p, const drive_telemetry_t *tm, float rs, float tau) {
   const float ia = tm->i_abc[0];
   const float ib = (tm->i_abc[0] + 2.0f * tm->i_abc[1]) * FRAMES_INV_SQRT3;
   const float xa = tm->v_ab_filt[0] - rs * ia;
@@ -58,7 +45,7 @@ static void window_add(drive_phase_check_t *p, const drive_telemetry_t *tm, floa
 
 /* D of the window (drive_phase_check.h) in (alpha, beta) [V]; -1 when the
  * samples do not separate it from the fundamental's terms, else 0. */
-static int window_dc(const drive_phase_check_t *p, float d[2]) {
+static int window_dc(const drive_ph_window_t *p, float d[2]) {
   const float n = (float)p->n;
   const float det = n * p->stt - p->st * p->st;
   if (!(det > 1e-6f * n * p->stt)) {
@@ -86,18 +73,19 @@ static int window_dc(const drive_phase_check_t *p, float d[2]) {
 
 /* 1 unbalanced, 0 balanced, -1 not judged. */
 static int verdict(drive_phase_check_t *p, float i_max, float v_dc) {
-  const float big = fd_maxf(p->abs[0], fd_maxf(p->abs[1], p->abs[2]));
-  if (p->n < DRIVE_PH_MIN_N || !(big > DRIVE_PH_FLOOR * i_max * (float)p->n)) {
+  const drive_ph_window_t *w = &p->w;
+  const float big = fd_maxf(w->abs[0], fd_maxf(w->abs[1], w->abs[2]));
+  if (w->n < DRIVE_PH_MIN_N || !(big > DRIVE_PH_FLOOR * i_max * (float)w->n)) {
     return -1;
   }
   int v = 0;
   for (int x = 0; x < 3; ++x) {
-    if (p->abs[x] < DRIVE_PH_OPEN * big) {
+    if (w->abs[x] < DRIVE_PH_OPEN * big) {
       v = 1;
     }
   }
   float d[2];
-  if (window_dc(p, d) == 0 && v_dc > 0.0f) {
+  if (window_dc(w, d) == 0 && v_dc > 0.0f) {
     p->vdef_ab[0] = d[0] / v_dc;
     p->vdef_ab[1] = d[1] / v_dc;
     p->vdef = sqrtf(p->vdef_ab[0] * p->vdef_ab[0] + p->vdef_ab[1] * p->vdef_ab[1]);
@@ -120,22 +108,22 @@ void drive_phase_check(drive_t *drv) {
   const bool first = p->isr_last == 0u;
   p->isr_last = tm->isr_count;
   if (tm->state != DRIVE_STATE_RUN || first) {
-    window_clear(p);
+    memset(&p->w, 0, sizeof p->w);
     p->bad = 0;
     return;
   }
-  p->angle += fabsf(tm->omega_m) * c->pole_pairs * (float)isrs * c->ts;
-  window_add(p, tm, c->rs, p->angle * (1.0f / FRAMES_2PI));
-  if (p->angle < FRAMES_2PI) {
-    if (p->n >= DRIVE_PH_MAX_N) { /* too slow: no verdict */
-      window_clear(p);
+  p->w.angle += fabsf(tm->omega_m) * c->pole_pairs * (float)isrs * c->ts;
+  window_add(&p->w, tm, c->rs, p->w.angle * (1.0f / FRAMES_2PI));
+  if (p->w.angle < FRAMES_2PI) {
+    if (p->w.n >= DRIVE_PH_MAX_N) { /* too slow: no verdict */
+      memset(&p->w, 0, sizeof p->w);
       p->bad = 0;
     }
     return;
   }
   const int v = verdict(p, c->i_max, tm->v_dc);
   p->bad = v > 0 ? p->bad + 1 : 0;
-  window_clear(p);
+  memset(&p->w, 0, sizeof p->w);
   if (p->bad >= DRIVE_PH_TRIP) {
     p->bad = 0;
     p->trips++;

@@ -61,26 +61,30 @@
  * state (tests/sil/test_power_faults.c, docs/faults.md) */
 #define DRIVE_PH_VDEF 0.02f
 
+/* The sums over one window (one revolution): complex ones [0] real, [1]
+ * imaginary; x = v_applied - R_s i in (alpha, beta) [V], tau the
+ * revolution's fraction swept. */
 typedef struct {
-  float abs[3]; /* sums of |i_x| over the window [A] */
-  /* least-squares sums over the window (complex: [0] real, [1] imaginary;
-     x = v_applied - R_s i in (alpha, beta) [V], tau the revolution's
-     fraction swept) */
-  float r1[2];       /* sum x */
-  float r2[2];       /* sum x e^{-j theta} */
-  float r3[2];       /* sum tau x e^{-j theta} */
-  float s1[2];       /* sum e^{j theta} */
-  float st1[2];      /* sum tau e^{j theta} */
-  float st;          /* sum tau */
-  float stt;         /* sum tau^2 */
-  float vdef_ab[2];  /* D / v_dc of the last judged revolution (alpha, beta) */
-  float vdef;        /* |D| / v_dc of the last judged revolution */
-  float vdef_max;    /* the largest vdef since start-up */
-  float angle;       /* electrical angle swept [rad] */
-  int32_t n;         /* samples in the window */
-  int32_t bad;       /* unbalanced revolutions in a row */
-  uint32_t isr_last; /* isr_count of the last sample (0: none) */
-  uint32_t trips;    /* lost_control requests made */
+  float abs[3]; /* sum |i_x| [A] */
+  float r1[2];  /* sum x */
+  float r2[2];  /* sum x e^{-j theta} */
+  float r3[2];  /* sum tau x e^{-j theta} */
+  float s1[2];  /* sum e^{j theta} */
+  float st1[2]; /* sum tau e^{j theta} */
+  float st;     /* sum tau */
+  float stt;    /* sum tau^2 */
+  float angle;  /* electrical angle swept [rad] */
+  int32_t n;    /* samples */
+} drive_ph_window_t;
+
+typedef struct {
+  drive_ph_window_t w; /* the window under way */
+  float vdef_ab[2];    /* D / v_dc of the last judged revolution (alpha, beta) */
+  float vdef;          /* |D| / v_dc of the last judged revolution */
+  float vdef_max;      /* the largest vdef since start-up */
+  int32_t bad;         /* unbalanced revolutions in a row */
+  uint32_t isr_last;   /* isr_count of the last sample (0: none) */
+  uint32_t trips;      /* lost_control requests made */
 } drive_phase_check_t;
 
 struct drive_s;

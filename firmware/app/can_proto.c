@@ -112,20 +112,29 @@ static void reply_error(reply_t *r, can_result_t res, can_sig_t s) {
   r->signal = s;
 }
 
-static void handle_param(can_proto_t *p, drive_t *drv, const uint8_t *d, reply_t *r) {
-  uint8_t id = (uint8_t)can_codec_get_raw(CAN_SIG_PARAM_ID, d);
-  bool set = can_codec_get_raw(CAN_SIG_PARAM_OP, d) == 1u;
-  float v = can_codec_get(CAN_SIG_PARAM_VALUE, d);
+/* The parameter a PARAM_REQ names and its value in force, into the reply
+ * (also when the request is refused before it is handled). False when no
+ * such parameter. */
+static bool param_echo(const can_proto_t *p, const drive_t *drv, const uint8_t *d, reply_t *r) {
+  const uint8_t id = (uint8_t)can_codec_get_raw(CAN_SIG_PARAM_ID, d);
   r->param = id;
-  bool proto = id >= CAN_PROTO_PARAM_FIRST && id < CAN_PROTO_PARAM_LAST;
-  float now;
-  bool known =
+  float now = 0.0f;
+  const bool proto = id >= CAN_PROTO_PARAM_FIRST && id < CAN_PROTO_PARAM_LAST;
+  const bool known =
       proto ? can_proto_param_get(p, id, &now) : drive_params_get(drv, id, &now) == DRIVE_PARAM_OK;
-  if (!known) {
+  r->value = now;
+  return known;
+}
+
+static void handle_param(can_proto_t *p, drive_t *drv, const uint8_t *d, reply_t *r) {
+  const uint8_t id = (uint8_t)can_codec_get_raw(CAN_SIG_PARAM_ID, d);
+  const bool set = can_codec_get_raw(CAN_SIG_PARAM_OP, d) == 1u;
+  const float v = can_codec_get(CAN_SIG_PARAM_VALUE, d);
+  const bool proto = id >= CAN_PROTO_PARAM_FIRST && id < CAN_PROTO_PARAM_LAST;
+  if (!param_echo(p, drv, d, r)) {
     reply_error(r, CAN_RESULT_UNKNOWN_PARAM, CAN_SIG_PARAM_ID);
     return;
   }
-  r->value = now;
   if (!set) {
     return;
   }
@@ -197,6 +206,9 @@ static void handle_state(const can_proto_t *p, drive_t *drv, const uint8_t *d, r
   } else if (law >= (uint32_t)DRIVE_LAW_COUNT && law != CAN_KEEP) {
     reply_error(r, CAN_RESULT_OUT_OF_RANGE, CAN_SIG_LAW);
   } else if (!p->ramp) {
+    /* the clear first: it clears the faults latched before it and leaves
+     * the enable as it is; an enable = 1 in the same frame is posted after
+     * it, so it restarts a cleared drive (docs/can.md, "Enable and clear") */
     if (can_codec_get_raw(CAN_SIG_CLEAR_FAULT, d) == 1u) {
       drive_cmd_clear_fault(drv);
     }
@@ -312,6 +324,9 @@ static bool handle_frame(can_proto_t *p, drive_t *drv, const hal_can_frame_t *f,
     if (bad != NO_SIGNAL) {
       reply_error(&r, CAN_RESULT_OUT_OF_RANGE, bad);
       r.value = value_in_force(drv, m);
+      if (m == CAN_MSG_PARAM_REQ) {
+        param_echo(p, drv, f->data, &r); /* a NaN or inf value: name the parameter */
+      }
     } else if (m == CAN_MSG_PARAM_REQ) {
       handle_param(p, drv, f->data, &r);
     } else {
@@ -386,7 +401,8 @@ static void send_periodic(can_proto_t *p, can_period_t which, const drive_t *drv
     can_codec_set_raw(CAN_SIG_FAULTS, f.data, tm->faults);
     can_codec_set(CAN_SIG_V_DC, f.data, tm->v_dc);
     can_codec_set_raw(CAN_SIG_TIMEOUT_RAMP, f.data, p->ramp ? 1u : 0u);
-    can_codec_set_raw(CAN_SIG_CMD_ENABLED, f.data, drive_commands(drv)->enable != 0u ? 1u : 0u);
+    /* the enable in force as the ISR holds it (armed), not the level posted */
+    can_codec_set_raw(CAN_SIG_CMD_ENABLED, f.data, tm->cmd_enabled);
     can_codec_set_raw(CAN_SIG_ERR_COUNT, f.data, p->stats.rx_errors & 0xFFu);
     p->st_state = tm->state;
     p->st_faults = tm->faults;

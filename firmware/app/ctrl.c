@@ -30,11 +30,31 @@ const char *ctrl_unavailable(const ctrl_t *c, drive_law_t law) {
   return (c->available & (1u << (unsigned)law)) != 0u ? NULL : row->check(&c->su);
 }
 
-int ctrl_select(ctrl_t *c, drive_law_t law) {
+FD_COLD const char *ctrl_law_refusal(drive_law_t law, const ctrl_setup_t *su) {
   const ctrl_law_t *row = ctrl_law(law);
-  if (row == NULL || ctrl_unavailable(c, law) != NULL || row->init(&c->st, &c->su) != 0) {
+  if (row == NULL) {
+    return "no such law";
+  }
+  const char *why = row->check(su);
+  if (why != NULL) {
+    return why;
+  }
+  ctrl_state_t scratch; /* what the law's init refuses, without touching a drive */
+  return row->init(&scratch, su) == 0 ? NULL : "the law's initialisation refused the parameter set";
+}
+
+FD_COLD int ctrl_select(ctrl_t *c, drive_law_t law) {
+  const ctrl_law_t *row = ctrl_law(law);
+  if (row == NULL || ctrl_unavailable(c, law) != NULL) {
     return -1;
   }
+  /* into a scratch state first: a refused init leaves the law in force,
+   * its state and its row exactly as they were (issue 22, point 2) */
+  ctrl_state_t st;
+  if (row->init(&st, &c->su) != 0) {
+    return -1;
+  }
+  c->st = st;
   c->law = law;
   c->impl = row;
   return 0;

@@ -120,7 +120,13 @@ int ctrl_init(ctrl_t *c, const drive_config_t *cfg, const machine_t *machine, fl
               drive_law_t law, const char **reason);
 /* Why `law` cannot run (NULL: it can). */
 const char *ctrl_unavailable(const ctrl_t *c, drive_law_t law);
-/* Switches to `law` (gates off): initialises its state. 0 or -1. */
+/* Why `law` cannot run with su (NULL: it can): its check, then its init
+ * into a scratch state (nothing else is touched). The main loop's full
+ * validation of a law switch or a parameter set (drive_config_validate). */
+const char *ctrl_law_refusal(drive_law_t law, const ctrl_setup_t *su);
+/* Switches to `law` (gates off): initialises its state into a scratch copy
+ * and takes it only on success. 0, or -1 with the law in force, its state
+ * and its row unchanged. */
 int ctrl_select(ctrl_t *c, drive_law_t law);
 /* Resets the law in force (on enable). */
 void ctrl_reset(ctrl_t *c);

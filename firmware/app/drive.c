@@ -44,6 +44,11 @@ static FD_NOINLINE void drive_trip(drive_t *drv, uint32_t bits) {
   }
   drv->faults |= bits;
   drv->state = DRIVE_STATE_FAULT;
+  /* the enable commands posted so far do not restart the drive after the
+   * clear: only one posted after this trip does (docs/can.md, "Enable and
+   * clear") */
+  drv->armed = false;
+  drv->arm_mark = drv->cmd.enable_count;
 }
 
 /* ------------------------------------------------------------ configure */
@@ -143,6 +148,32 @@ FD_COLD int drive_config_fits_board(const drive_config_t *cfg, const hal_caps_t 
                   "voltage beyond it reads as the full scale and would never trip";
     return -1;
   }
+  const pos_source_row_t *ps = pos_source(cfg->pos_source);
+  const uint32_t need = HAL_CAP_STAR_POINT | HAL_CAP_ASYM_EDGES;
+  if (ps != NULL && (ps->caps & POS_CAP_GATED) != 0u && (caps->features & need) != need) {
+    err->field = "pos_source";
+    err->reason = "the board has no star-point samples with asymmetric PWM edges (DFC window)";
+    return -1;
+  }
+  return 0;
+}
+
+FD_COLD int drive_config_validate(const drive_config_t *cfg, drive_law_t law,
+                                  const hal_caps_t *caps, machine_t *m, flux_map_t *map,
+                                  drive_config_err_t *err) {
+  if (drive_config_usable(cfg, law, m, map, err) != 0 ||
+      drive_config_fits_board(cfg, caps, err) != 0) {
+    return -1;
+  }
+  /* what the law's initialisation refuses beyond its check (into a
+   * scratch state): nothing validated here is refused later by the ISR */
+  const ctrl_setup_t su = {cfg, m, 1.5f * cfg->ts - caps->t_i};
+  const char *why = ctrl_law_refusal(law, &su);
+  if (why != NULL) {
+    err->field = "law";
+    err->reason = why;
+    return -1;
+  }
   return 0;
 }
 
@@ -153,13 +184,6 @@ FD_COLD static int drive_configure(drive_t *drv, const drive_config_t *cfg, driv
   flux_map_t map;
   if (drive_config_usable(cfg, law, &m, &map, err) != 0 ||
       drive_config_fits_board(cfg, drv->caps, err) != 0) {
-    return -1;
-  }
-  const uint32_t need = HAL_CAP_STAR_POINT | HAL_CAP_ASYM_EDGES;
-  if ((pos_source(cfg->pos_source)->caps & POS_CAP_GATED) != 0u &&
-      (drv->caps->features & need) != need) {
-    err->field = "pos_source";
-    err->reason = "the board has no star-point samples with asymmetric PWM edges (DFC window)";
     return -1;
   }
   drv->cfg = *cfg;
@@ -242,16 +266,19 @@ FD_COLD int drive_init(drive_t *drv, const drive_config_t *cfg, drive_config_err
   }
   memset(drv, 0, sizeof *drv);
   drv->caps = hal_caps();
-  if (drive_configure(drv, cfg, cfg->law, err) != 0) {
+  machine_t m;
+  flux_map_t map;
+  if (drive_config_validate(cfg, cfg->law, drv->caps, &m, &map, err) != 0 ||
+      drive_configure(drv, cfg, cfg->law, err) != 0) {
     return -1;
   }
+  drv->law_refused = DRIVE_LAW_COUNT;
   drv->state = DRIVE_STATE_IDLE;
   drv->cmd.law = cfg->law;
   drv->cmd.mode = cfg->mode;
   drv->armed = true;
   drv->req.cmd = drv->cmd;
   drv->creq.cfg = *cfg;
-  drive_machine_copy(&drv->host.machine, &drv->host.map, &drv->machine, &drv->map);
   if (hal_reset_by_watchdog()) {
     drv->faults = DRIVE_FAULT_WATCHDOG;
     drv->state = DRIVE_STATE_FAULT;
@@ -283,6 +310,13 @@ static void take_config(drive_t *drv) {
     drv->cfg_pending = configure_live(drv, &drv->creq.cfg);
     return;
   }
+  /* nothing written in a fault or under the short changes how the safe
+   * state is held (asc_speed, i_max, the machine ...): the set waits until
+   * the fault is cleared and the short has ended (issue 22, point 1) */
+  if (drv->state == DRIVE_STATE_FAULT || drv->safe.asc) {
+    drv->cfg_pending = true;
+    return;
+  }
   drv->cfg_pending = false;
   const drive_config_t prev = drv->cfg;
   const drive_law_t prev_law = drv->ctrl.law;
@@ -311,7 +345,11 @@ static FD_NOINLINE void take_fault_requests(drive_t *drv) {
 }
 
 /* The main loop's command block (req): references, enable, law and mode,
- * then fault requests and clears in the order the main loop made them. */
+ * then the clear, then the fault requests not yet taken. A clear clears
+ * the faults latched before it, never a request it has not seen: a request
+ * posted in the same period, before or after the clear, latches after it
+ * (issue 22, point 3). A clear that clears a fault disarms: the drive
+ * starts again on an enable command posted after the clear. */
 static void take_commands(drive_t *drv) {
   const uint32_t seq = drv->req.seq;
   if ((seq & 1u) != 0u || seq == drv->cmd.seq) {
@@ -322,13 +360,12 @@ static void take_commands(drive_t *drv) {
   drv->cmd.seq = seq;
   if (drv->cmd.clear_count != drv->clear_seen) {
     drv->clear_seen = drv->cmd.clear_count;
-    /* requests made before the clear are void */
-    memcpy(drv->fault_seen, drv->cmd.clear_mark, sizeof drv->fault_seen);
     if (drv->state == DRIVE_STATE_FAULT) {
       hal_fault_hw_clear();
       drv->faults = 0u;
       drv->state = DRIVE_STATE_IDLE;
-      drv->armed = false; /* a fresh enable is needed */
+      drv->armed = false; /* an enable posted after the clear is needed */
+      drv->arm_mark = drv->cmd.clear_enable_mark;
     }
   }
   if (drv->cmd.fault_total != drv->fault_total_seen) {
@@ -431,6 +468,19 @@ static void drive_monitor(drive_t *drv, const ctrl_in_t *in, const ctrl_out_t *o
   if (trip != 0u) {
     drv->tm.lc_cause = trip;
     drive_trip(drv, DRIVE_FAULT_LOST_CONTROL);
+  }
+}
+
+/* The commanded law, gates off. The main loop validated it
+ * (drive_config_validate); if it is refused all the same, the law in force
+ * stays exactly as it was (ctrl_select) and the refusal trips config once
+ * (no retry until another law is commanded). */
+static FD_NOINLINE void drive_select_law(drive_t *drv) {
+  if (ctrl_select(&drv->ctrl, drv->cmd.law) != 0) {
+    drv->law_refused = drv->cmd.law;
+    drive_trip(drv, DRIVE_FAULT_CONFIG);
+  } else {
+    drv->law_refused = DRIVE_LAW_COUNT;
   }
 }
 
@@ -694,6 +744,7 @@ static void drive_publish(drive_t *drv, const hal_sample_t *s, const float i[3])
   tm->pos_health = drv->pos.out.health;
   tm->load_est = drv->pos.out.load;
   tm->cmd_seq = drv->cmd.seq;
+  tm->cmd_enabled = (drv->cmd.enable != 0u && drv->armed) ? 1u : 0u;
   if (drv->state != DRIVE_STATE_RUN) {
     tm->theta_e = drv->pos.out.theta;
   }
@@ -728,15 +779,15 @@ void drive_isr(drive_t *drv) {
   if (f != 0u) {
     drive_trip(drv, f);
   }
-  if (!drv->cmd.enable) {
-    drv->armed = true;
+  if (drv->cmd.enable_count != drv->arm_mark) {
+    drv->armed = true; /* an enable command since the last disarm */
   }
   const bool enable = drv->cmd.enable && drv->armed;
 
   switch (drv->state) {
   case DRIVE_STATE_IDLE:
-    if (drv->cmd.law != drv->ctrl.law) {
-      (void)ctrl_select(&drv->ctrl, drv->cmd.law); /* refused: the law in force stays */
+    if (drv->cmd.law != drv->ctrl.law && drv->cmd.law != drv->law_refused) {
+      drive_select_law(drv);
     }
     if (enable && !drv->safe.asc) { /* the short first ends (drive_safe.c) */
       drv->offset_acc[0] = drv->offset_acc[1] = drv->offset_acc[2] = 0.0f;

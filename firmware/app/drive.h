@@ -87,6 +87,8 @@ typedef struct {
   float load_est;        /* position source's load torque estimate (Kalman filter) [N m] */
   uint32_t lc_cause;     /* DRIVE_LC_* that tripped lost_control */
   uint32_t cmd_seq;      /* last command block taken (drive_cmd_t.seq) */
+  uint32_t cmd_enabled;  /* 1: the enable in force (commanded, and armed: posted after the
+                            last trip and the last clear that cleared a fault) */
   ctrl_telemetry_t law_tm;
   uint32_t isr_count_end; /* ... and last: equal to isr_count in a consistent copy */
 } drive_telemetry_t;
@@ -101,9 +103,10 @@ typedef struct {
   float speed;                             /* mechanical [rad/s] */
   float id, iq;                            /* current mode [A] */
   float flux;                              /* stator flux amplitude reference, 0 = automatic [Vs] */
+  uint32_t enable_count;                   /* drive_cmd_enable(true) calls */
   uint32_t clear_count;                    /* drive_cmd_clear_fault() calls */
+  uint32_t clear_enable_mark;              /* enable_count at the last clear */
   uint32_t fault_count[DRIVE_FAULT_COUNT]; /* drive_request_fault() per bit */
-  uint32_t clear_mark[DRIVE_FAULT_COUNT];  /* fault_count at the last clear */
   uint32_t fault_total;                    /* drive_request_fault() calls, all bits */
 } drive_cmd_t;
 
@@ -127,8 +130,9 @@ typedef struct drive_s {
   uint32_t isr_count;
   drive_cmd_t cmd;   /* the commands in force (the ISR's copy of req) */
   uint32_t cfg_seen; /* creq.seq taken */
-  bool cfg_pending;  /* a parameter set waits for the gates to go off */
-  bool armed;        /* enable seen low since the last clear */
+  bool cfg_pending;  /* a parameter set waits for the gates to go off (or
+                        for the fault and the short to end) */
+  bool armed;        /* an enable command posted since the last disarm (arm_mark) */
 
   /* offset calibration */
   float offset[3];
@@ -189,8 +193,6 @@ typedef struct drive_s {
     drive_config_t cfg;
   } creq;
   struct {
-    machine_t machine;      /* of the requested parameter set (law checks) */
-    flux_map_t map;         /* its flux map (machine.map points here) */
     uint32_t isr_seen;      /* ISR count at the last watchdog refresh */
     drive_telemetry_t tm;   /* last consistent telemetry copy */
     uint32_t tm_retries;    /* copies that had to be retried (preemption) */
@@ -201,6 +203,9 @@ typedef struct drive_s {
    * periodic path's fields stay within the load offsets of the Cortex-M's
    * single instructions from the drive's base) ===== */
   uint32_t clear_seen;       /* req.clear_count taken */
+  uint32_t arm_mark;         /* cmd.enable_count at the last disarm: a trip, or a clear
+                                that cleared a fault (cmd.clear_enable_mark) */
+  drive_law_t law_refused;   /* a law whose switch the ISR refused (DRIVE_LAW_COUNT: none) */
   uint32_t fault_total_seen; /* req.fault_total taken */
   uint32_t fault_seen[DRIVE_FAULT_COUNT];
   int32_t i_sum_n;   /* the current-sensor check's leaky count (drive.c) */
@@ -234,10 +239,18 @@ int drive_config_usable(const drive_config_t *cfg, drive_law_t law, machine_t *m
 /* Whether cfg's protections can see what they protect on this board: the
  * current trip below the current ADC's full scale, the overvoltage trip
  * below the DC-link ADC's (a quantity beyond its ADC's range reads as the
- * full scale and would never trip). 0, or -1 with *err. Ranges not known
- * (0 in hal_caps_t) are not checked. */
+ * full scale and would never trip); a star-point position source only on
+ * a board with the star-point samples and asymmetric edges. 0, or -1 with
+ * *err. Ranges not known (0 in hal_caps_t) are not checked. */
 int drive_config_fits_board(const drive_config_t *cfg, const hal_caps_t *caps,
                             drive_config_err_t *err);
+/* The one validation of a parameter set with a law on a board, for every
+ * path (parameter writes, law switches, scenario files, start-up):
+ * drive_config_usable, drive_config_fits_board (the star-point window
+ * included) and the law's initialisation into a scratch state. What it
+ * accepts the ISR never refuses. 0, or -1 with *err (field and reason). */
+int drive_config_validate(const drive_config_t *cfg, drive_law_t law, const hal_caps_t *caps,
+                          machine_t *m, flux_map_t *map, drive_config_err_t *err);
 /* *dm, *dmap = *m, *map with dm's map pointer on dmap. */
 void drive_machine_copy(machine_t *dm, flux_map_t *dmap, const machine_t *m, const flux_map_t *map);
 
@@ -258,8 +271,10 @@ void drive_background(drive_t *drv);
 /* Commands (main loop), in force from the next ISR. Values are clamped to
  * the configured limits (non-finite: 0). */
 void drive_cmd_enable(drive_t *drv, bool enable);
-/* Clears the latched faults (the drive returns to idle) and drops the
- * enable: the operator enables again. */
+/* Clears the faults latched before the ISR takes it (the drive returns to
+ * idle); requests it has not seen still latch. The enable command is left
+ * as it is; after a cleared fault the drive starts again only on an enable
+ * command posted after the clear (docs/can.md, "Enable and clear"). */
 void drive_cmd_clear_fault(drive_t *drv);
 /* NULL when accepted, else why not (unknown law, unavailable on this
  * machine); the law changes when the gates are off. */

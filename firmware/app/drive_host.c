@@ -81,20 +81,15 @@ static float command_clamp(float x, float lo, float hi) {
 void drive_cmd_enable(drive_t *drv, bool enable) {
   drive_cmd_t *c = cmd_begin(drv);
   c->enable = enable ? 1u : 0u;
+  c->enable_count += enable ? 1u : 0u; /* re-arms after a trip (drive.h) */
   cmd_end(drv);
 }
 
 void drive_cmd_clear_fault(drive_t *drv) {
   drive_cmd_t *c = cmd_begin(drv);
   c->clear_count++;
-  memcpy(c->clear_mark, c->fault_count, sizeof c->clear_mark);
-  c->enable = 0u;
+  c->clear_enable_mark = c->enable_count; /* enables before the clear do not restart */
   cmd_end(drv);
-}
-
-static ctrl_setup_t host_setup(const drive_t *drv) {
-  const ctrl_setup_t su = {&drv->creq.cfg, &drv->host.machine, 1.5f * drv->creq.cfg.ts};
-  return su;
 }
 
 const char *drive_cmd_set_law(drive_t *drv, drive_law_t law) {
@@ -102,14 +97,16 @@ const char *drive_cmd_set_law(drive_t *drv, drive_law_t law) {
   if (row == NULL) {
     return "no such law";
   }
-  const ctrl_setup_t su = host_setup(drv);
-  const char *why = row->check(&su); /* a static string, not into su */
-  if (why != NULL) {
-    // cppcheck-suppress returnDanglingLifetime
-    return why;
-  }
   if (drv->req.cmd.mode == DRIVE_MODE_CURRENT && (row->caps & CTRL_CAP_CURRENT) == 0u) {
     return "this law has no current mode: leave current mode first";
+  }
+  /* the whole validation, the law's initialisation included (into a
+   * scratch state): a switch answered here is never refused by the ISR */
+  machine_t m;
+  flux_map_t map;
+  drive_config_err_t err;
+  if (drive_config_validate(&drv->creq.cfg, law, drv->caps, &m, &map, &err) != 0) {
+    return err.reason; /* a static string */
   }
   drive_cmd_t *c = cmd_begin(drv);
   c->law = law;
@@ -189,11 +186,9 @@ int drive_request_config(drive_t *drv, const drive_config_t *cfg, drive_config_e
   }
   machine_t m;
   flux_map_t map;
-  if (drive_config_usable(cfg, drv->req.cmd.law, &m, &map, err) != 0 ||
-      drive_config_fits_board(cfg, drv->caps, err) != 0) {
+  if (drive_config_validate(cfg, drv->req.cmd.law, drv->caps, &m, &map, err) != 0) {
     return -1;
   }
-  drive_machine_copy(&drv->host.machine, &drv->host.map, &m, &map);
   /* first the command block within the new limits (a LIVE speed_max or
    * torque_max lowered while running, an i_max lowered with the gates off
    * under a current reference: fuzz_can's current-limit invariant): the ISR takes

@@ -29,6 +29,9 @@ FD_COLD static const char *dfvc_check(const ctrl_setup_t *su) {
   if (!(su->cfg->flux_min > 0.0f)) {
     return "DFVC needs flux_min > 0";
   }
+  if (!(su->cfg->vsd_max > 0.0f)) {
+    return "DFVC needs vsd_max > 0 (the limit of its d_s voltage)";
+  }
   return NULL;
 }
 

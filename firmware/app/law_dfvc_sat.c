@@ -20,6 +20,10 @@ FD_COLD static const char *dfvc_sat_check(const ctrl_setup_t *su) {
   if (cfg->dfvc_sat_refs == (uint16_t)DFVC_SAT_REFS_LUT && su->machine->kind != MACHINE_FLUX_MAP) {
     return "decoupled DFVC with LUT references (dfvc_sat_refs 0) needs a flux map";
   }
+  if (!(cfg->flux_min <= dfvc_sat_flux_cap(su->machine, cfg->i_max))) {
+    return "decoupled DFVC needs flux_min at most the largest stator flux the machine reaches "
+           "at i_max";
+  }
   return NULL;
 }
 

@@ -24,7 +24,7 @@
 #include "drive.h"
 
 #define ISR_STREAM_MAGIC   0x52534946u /* "FISR" */
-#define ISR_STREAM_VERSION 4u
+#define ISR_STREAM_VERSION 5u
 
 /* isr_stream_header_t.flags: the replay sets the drive's applied-voltage
  * memory (drive_t.v_applied) to the host's before each ISR, see
@@ -81,7 +81,9 @@ typedef struct {
   float flux;
   uint32_t clear_count;
   uint32_t fault_count[ISR_STREAM_FAULT_WORDS];
-  uint32_t clear_mark[ISR_STREAM_FAULT_WORDS];
+  uint32_t enable_count;
+  uint32_t clear_enable_mark;
+  uint32_t reserved[ISR_STREAM_FAULT_WORDS - 2]; /* zero */
   float v_applied[2]; /* host drive_t.v_applied before this ISR (alpha, beta) */
 } isr_stream_in_t;
 
@@ -189,9 +191,11 @@ static inline void isr_stream_cmd_put(uint32_t req_seq, const drive_cmd_t *c, is
   in->iq = c->iq;
   in->flux = c->flux;
   in->clear_count = c->clear_count;
+  in->enable_count = c->enable_count;
+  in->clear_enable_mark = c->clear_enable_mark;
+  memset(in->reserved, 0, sizeof in->reserved);
   for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {
     in->fault_count[b] = c->fault_count[b];
-    in->clear_mark[b] = c->clear_mark[b];
   }
 }
 
@@ -208,9 +212,10 @@ static inline void isr_stream_cmd_get(const isr_stream_in_t *in, uint32_t *req_s
   c->iq = in->iq;
   c->flux = in->flux;
   c->clear_count = in->clear_count;
+  c->enable_count = in->enable_count;
+  c->clear_enable_mark = in->clear_enable_mark;
   for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {
     c->fault_count[b] = in->fault_count[b];
-    c->clear_mark[b] = in->clear_mark[b];
   }
 }
 

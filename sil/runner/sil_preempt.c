@@ -26,7 +26,8 @@ static _Atomic uint64_t g_k; /* periods done (written by the handler) */
 static atomic_bool g_stop;
 static pthread_t g_main;
 static double g_max_gap_us;
-static bool g_need_low; /* handler: a fault was cleared, enable not yet seen low */
+static bool g_need_enable;   /* handler: a trip or a clear disarmed, no enable command since */
+static uint32_t g_need_mark; /* the enable count at that disarm */
 /* What the ISR owns, as the last ISR left it: nobody else may change it. */
 static struct {
   bool valid;
@@ -62,9 +63,9 @@ static bool same_block(const drive_cmd_t *a, const drive_cmd_t *b) {
          !(a->torque < b->torque || a->torque > b->torque) &&
          !(a->speed < b->speed || a->speed > b->speed) && !(a->id < b->id || a->id > b->id) &&
          !(a->iq < b->iq || a->iq > b->iq) && !(a->flux < b->flux || a->flux > b->flux) &&
-         a->clear_count == b->clear_count &&
-         memcmp(a->fault_count, b->fault_count, sizeof a->fault_count) == 0 &&
-         memcmp(a->clear_mark, b->clear_mark, sizeof a->clear_mark) == 0;
+         a->clear_count == b->clear_count && a->enable_count == b->enable_count &&
+         a->clear_enable_mark == b->clear_enable_mark &&
+         memcmp(a->fault_count, b->fault_count, sizeof a->fault_count) == 0;
 }
 
 /* One PWM period, on top of whatever the main thread is doing. */
@@ -85,6 +86,7 @@ static void on_interrupt(int sig) {
     violation("the main loop wrote drive state the ISR owns (state, faults, armed, commands)");
   }
   const drive_state_t st0 = d->state;
+  const uint32_t faults0 = d->faults;
   const uint32_t clear0 = d->clear_seen;
   uint32_t seen0[DRIVE_FAULT_COUNT];
   memcpy(seen0, d->fault_seen, sizeof seen0);
@@ -121,28 +123,33 @@ static void on_interrupt(int sig) {
   } else if (!same_block(&d->cmd, &d->req.cmd)) {
     violation("the ISR's command block differs from the published one");
   }
-  if (d->clear_seen != clear0) {
-    /* a clear that found a fault needs a fresh enable; one that found none
-     * is void (the enable in the same block may start the drive) */
-    g_need_low = g_need_low || st0 == DRIVE_STATE_FAULT;
-  } else {
-    for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {
-      if (d->fault_seen[b] != seen0[b] && (d->faults & (1u << b)) == 0u) {
-        violation("a fault request was taken but not latched");
-      }
+  /* a clear clears only what was latched before it: every request taken
+   * latches, even one posted in the same period as a clear */
+  for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {
+    if (d->fault_seen[b] != seen0[b] && (d->faults & (1u << b)) == 0u) {
+      violation("a fault request was taken but not latched");
     }
   }
-  if (d->cmd.enable == 0u) {
-    g_need_low = false;
-  }
-  if (st0 == DRIVE_STATE_IDLE && st == DRIVE_STATE_OFFSET_CAL) {
-    g_r->starts++;
-    if (d->cmd.enable == 0u || g_need_low) {
-      violation("started without a fresh enable after a clear");
-    }
+  if (d->clear_seen != clear0 && st0 == DRIVE_STATE_FAULT) {
+    /* a clear that found a fault needs an enable command posted after it */
+    g_need_enable = true;
+    g_need_mark = d->cmd.clear_enable_mark;
   }
   if (st0 != DRIVE_STATE_FAULT && st == DRIVE_STATE_FAULT) {
     g_r->trips++;
+  }
+  if (st == DRIVE_STATE_FAULT && d->faults != faults0) {
+    g_need_enable = true; /* a trip: enables posted before it do not count */
+    g_need_mark = d->cmd.enable_count;
+  }
+  if (g_need_enable && d->cmd.enable_count != g_need_mark) {
+    g_need_enable = false;
+  }
+  if (st0 == DRIVE_STATE_IDLE && st == DRIVE_STATE_OFFSET_CAL) {
+    g_r->starts++;
+    if (d->cmd.enable == 0u || g_need_enable) {
+      violation("started without an enable command after a trip or a clear");
+    }
   }
   g_owned.state = d->state;
   g_owned.faults = d->faults;
@@ -300,7 +307,8 @@ int sil_preempt_run(const scenario_t *sc, const sil_preempt_opts_t *opts, sil_pr
   g_sc = sc;
   g_r = r;
   g_max_gap_us = opts->max_gap_us;
-  g_need_low = false;
+  g_need_enable = false;
+  g_need_mark = 0u;
   g_owned.valid = false;
   atomic_store(&g_k, 0u);
   atomic_store(&g_stop, false);

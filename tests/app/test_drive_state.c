@@ -160,33 +160,132 @@ static void clear_racing_a_trip_stays_safe(void **state) {
   assert_int_equal(drv.state, DRIVE_STATE_FAULT);
 }
 
-/* Fault requests of the main loop and clears keep their order. */
-static void fault_requests_and_clears_keep_order(void **state) {
+/* A clear clears only the faults latched before it: a request the ISR has
+ * not seen latches, whether posted before or after the clear in the same
+ * period (issue 22, point 3: a flood of clears swallowed the main loop's
+ * fault requests). Every fault bit. */
+static void clear_never_voids_an_unseen_request(void **state) {
   (void)state;
+  for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {
+    const uint32_t bit = 1u << b;
+    setup_drive();
+    sample(0.0f, 0.0f, 0.0f, 310.0f);
+    /* request, then clear, before the ISR: the request stands */
+    drive_request_fault(&drv, bit);
+    drive_cmd_clear_fault(&drv);
+    drive_isr(&drv);
+    assert_int_equal(drv.faults, bit);
+    assert_int_equal(drv.state, DRIVE_STATE_FAULT);
+    /* clear, then request: the old fault goes, the new request stands */
+    drive_cmd_clear_fault(&drv);
+    drive_request_fault(&drv, bit);
+    drive_isr(&drv);
+    assert_int_equal(drv.faults, bit);
+    /* a clear alone clears it; nothing is applied twice */
+    drive_cmd_clear_fault(&drv);
+    run_isrs(3);
+    assert_int_equal(drv.faults, 0);
+    assert_int_equal(drv.state, DRIVE_STATE_IDLE);
+  }
+  /* two requests between ISRs: one fault, none lost, none applied twice */
   setup_drive();
   sample(0.0f, 0.0f, 0.0f, 310.0f);
-  /* request, then clear, before the ISR: the clear takes it */
   drive_request_fault(&drv, DRIVE_FAULT_CMD_TIMEOUT);
+  drive_request_fault(&drv, DRIVE_FAULT_CMD_TIMEOUT);
+  run_isrs(3);
+  assert_int_equal(drv.faults, DRIVE_FAULT_CMD_TIMEOUT);
   drive_cmd_clear_fault(&drv);
-  drive_isr(&drv);
+  run_isrs(3);
   assert_int_equal(drv.faults, 0);
+}
+
+/* The state machine of enable, clear and keep (docs/can.md, "Enable and
+ * clear"), every transition: a clear on a running drive changes nothing;
+ * after a trip only an enable posted after the trip and after the clear
+ * starts the drive, the clear's own frame included; telemetry's
+ * cmd_enabled says whether the enable is in force (issue 22, point 6). */
+static void enable_clear_keep_transitions(void **state) {
+  (void)state;
+  /* running + clear (enable kept): still running */
+  start_running();
+  drive_cmd_clear_fault(&drv);
+  run_isrs(5);
+  assert_int_equal(drv.state, DRIVE_STATE_RUN);
+  assert_true(hal.gates_on);
+  assert_int_equal(drv.tm.cmd_enabled, 1);
+  /* trip: the enable level stays 1 but is no longer in force */
+  drive_request_fault(&drv, DRIVE_FAULT_CONTROL);
+  drive_isr(&drv);
+  assert_int_equal(drv.state, DRIVE_STATE_FAULT);
+  assert_int_equal(drv.tm.cmd_enabled, 0);
+  /* clear alone: idle, and it stays idle (the enable was posted before) */
+  drive_cmd_clear_fault(&drv);
+  run_isrs(100);
   assert_int_equal(drv.state, DRIVE_STATE_IDLE);
-  /* clear, then request: the request stands */
-  drive_cmd_clear_fault(&drv);
-  drive_request_fault(&drv, DRIVE_FAULT_CMD_TIMEOUT);
+  assert_int_equal(drv.tm.cmd_enabled, 0);
+  assert_false(hal.gates_on);
+  /* a later enable = 1 (without a 0 first) starts it */
+  drive_cmd_enable(&drv, true);
+  run_isrs(drv.cfg.offset_samples + 2);
+  assert_int_equal(drv.state, DRIVE_STATE_RUN);
+  assert_int_equal(drv.tm.cmd_enabled, 1);
+  /* trip, then clear and enable in one step (one CMD_STATE frame): restarts */
+  drive_request_fault(&drv, DRIVE_FAULT_CONTROL);
   drive_isr(&drv);
-  assert_int_equal(drv.faults, DRIVE_FAULT_CMD_TIMEOUT);
-  /* two requests between ISRs: one fault, none lost, none applied twice */
+  assert_int_equal(drv.state, DRIVE_STATE_FAULT);
   drive_cmd_clear_fault(&drv);
+  drive_cmd_enable(&drv, true);
+  run_isrs(drv.cfg.offset_samples + 2);
+  assert_int_equal(drv.state, DRIVE_STATE_RUN);
+  /* trip, enable without a clear: stays in fault; then a clear alone does
+   * not start it (that enable came before the clear) */
+  drive_request_fault(&drv, DRIVE_FAULT_CONTROL);
   drive_isr(&drv);
-  assert_int_equal(drv.faults, 0);
-  drive_request_fault(&drv, DRIVE_FAULT_CMD_TIMEOUT);
-  drive_request_fault(&drv, DRIVE_FAULT_CMD_TIMEOUT);
-  run_isrs(3);
-  assert_int_equal(drv.faults, DRIVE_FAULT_CMD_TIMEOUT);
+  drive_cmd_enable(&drv, true);
+  run_isrs(20);
+  assert_int_equal(drv.state, DRIVE_STATE_FAULT);
+  assert_false(hal.gates_on);
   drive_cmd_clear_fault(&drv);
+  run_isrs(100);
+  assert_int_equal(drv.state, DRIVE_STATE_IDLE);
+  /* disable, then enable: starts */
+  drive_cmd_enable(&drv, false);
   run_isrs(3);
-  assert_int_equal(drv.faults, 0);
+  assert_int_equal(drv.state, DRIVE_STATE_IDLE);
+  assert_int_equal(drv.tm.cmd_enabled, 0);
+  drive_cmd_enable(&drv, true);
+  run_isrs(drv.cfg.offset_samples + 2);
+  assert_int_equal(drv.state, DRIVE_STATE_RUN);
+  /* disable while running: idle at the next ISR */
+  drive_cmd_enable(&drv, false);
+  drive_isr(&drv);
+  assert_int_equal(drv.state, DRIVE_STATE_IDLE);
+  assert_false(hal.gates_on);
+}
+
+/* A parameter set written in a fault waits for the clear: the safe state
+ * is held with the set in force at the trip (issue 22, point 1). */
+static void write_in_fault_waits_for_the_clear(void **state) {
+  (void)state;
+  start_running();
+  const float asc = drv.cfg.asc_speed, i_max = drv.cfg.i_max;
+  drive_request_fault(&drv, DRIVE_FAULT_CONTROL);
+  drive_isr(&drv);
+  assert_int_equal(drv.state, DRIVE_STATE_FAULT);
+  assert_int_equal(drive_params_set(&drv, drive_params_by_name("asc_speed")->id, 0.0f, NULL),
+                   DRIVE_PARAM_OK);
+  assert_int_equal(drive_params_set(&drv, drive_params_by_name("i_max")->id, 1.0f, NULL),
+                   DRIVE_PARAM_OK);
+  run_isrs(50);
+  assert_float_equal(drv.cfg.asc_speed, asc, 0.0f);
+  assert_float_equal(drv.cfg.i_max, i_max, 0.0f);
+  assert_true(drv.cfg_pending);
+  drive_cmd_clear_fault(&drv);
+  run_isrs(2);
+  assert_int_equal(drv.state, DRIVE_STATE_IDLE);
+  assert_float_equal(drv.cfg.asc_speed, 0.0f, 0.0f);
+  assert_float_equal(drv.cfg.i_max, 1.0f, 0.0f);
+  assert_false(drv.cfg_pending);
 }
 
 static void hw_break_cannot_be_overridden(void **state) {
@@ -385,6 +484,98 @@ static void law_change_waits_for_gates_off(void **state) {
   assert_int_equal(drv.ctrl.law, DRIVE_LAW_PI_DFVC);
 }
 
+/* Posts a law in the command block without the main loop's validation
+ * (what a torn or unvalidated path would hand the ISR). */
+static void post_law_unchecked(drive_law_t law) {
+  drv.req.seq++;
+  drv.req.cmd.law = law;
+  drv.req.cmd.seq++;
+  drv.req.seq++;
+}
+
+/* A law switch the target law refuses leaves the law in force exactly as it
+ * was, for every pair of laws with a set the target refuses and the source
+ * runs (issue 22, point 2: the decoupled DFVC's init overwrote the running
+ * law's state, then a null machine was dereferenced on enable). FOC
+ * refuses no valid set; PI and deadbeat DFVC share their check and init,
+ * so no set separates them. */
+static void refused_law_switch_leaves_the_law_as_it_was(void **state) {
+  (void)state;
+  static const struct {
+    drive_law_t to;
+    const char *param;
+    float value;
+  } refusals[] = {{DRIVE_LAW_PI_DFVC, "vsd_max", 0.0f},
+                  {DRIVE_LAW_DB_DFVC, "vsd_max", 0.0f},
+                  {DRIVE_LAW_DFVC_DECOUPLED, "flux_min", 1.76f}};
+  static ctrl_t before;
+  unsigned pairs = 0;
+  for (unsigned f = 0; f < (unsigned)DRIVE_LAW_COUNT; ++f) {
+    for (size_t r = 0; r < sizeof refusals / sizeof refusals[0]; ++r) {
+      const drive_law_t from = (drive_law_t)f, to = refusals[r].to;
+      drive_config_t cfg;
+      drive_config_default(&cfg);
+      cfg.law = from;
+      drive_param_set(&cfg, drive_params_by_name(refusals[r].param), refusals[r].value);
+      drive_config_err_t err;
+      machine_t m;
+      flux_map_t map;
+      if (from == to || drive_config_validate(&cfg, from, hal_caps(), &m, &map, &err) != 0) {
+        continue; /* the source cannot run this set either */
+      }
+      pairs++;
+      setup_with(&cfg);
+      sample(0.0f, 0.0f, 0.0f, 310.0f);
+      drive_cmd_enable(&drv, true);
+      run_isrs(drv.cfg.offset_samples + 4); /* the law's state moves (or it trips: no machine
+                                               behind these samples) */
+      drive_cmd_enable(&drv, false);
+      drive_cmd_clear_fault(&drv);
+      run_isrs(2);
+      assert_int_equal(drv.state, DRIVE_STATE_IDLE);
+      /* the main loop refuses it, with the reason */
+      const char *why = drive_cmd_set_law(&drv, to);
+      assert_non_null(why);
+      assert_int_equal(drv.req.cmd.law, from);
+      /* the ISR refuses it too, touching nothing of the law in force */
+      before = drv.ctrl;
+      post_law_unchecked(to);
+      run_isrs(3);
+      assert_int_equal(drv.ctrl.law, from);
+      assert_memory_equal(&drv.ctrl, &before, sizeof before);
+      assert_int_equal(drv.faults, DRIVE_FAULT_CONFIG);
+      /* back to the source law, cleared and enabled: it runs */
+      post_law_unchecked(from);
+      drive_cmd_clear_fault(&drv);
+      drive_cmd_enable(&drv, true);
+      run_isrs(drv.cfg.offset_samples + 4);
+      assert_int_not_equal(drv.state, DRIVE_STATE_IDLE); /* started (runs, or its law trips) */
+      assert_true((drv.faults & DRIVE_FAULT_CONFIG) == 0u);
+      assert_int_equal(drv.tm.law, from);
+      assert_ptr_equal(drv.ctrl.impl, ctrl_law(from));
+    }
+  }
+  printf("refused law switches: %u pairs\n", pairs);
+  assert_int_equal(pairs, 7); /* foc, pi, db, decoupled -> the three refusing targets */
+
+  /* the init refused after the check passed (the set changed under the
+   * cached availability): the law in force, its state and row unchanged */
+  drive_config_t cfg;
+  drive_config_default(&cfg);
+  static ctrl_t c;
+  machine_t m;
+  assert_int_equal(machine_init_linear(&m, cfg.pole_pairs, cfg.rs, cfg.ld, cfg.lq, cfg.lambda_m),
+                   0);
+  const char *reason = "";
+  assert_int_equal(ctrl_init(&c, &cfg, &m, 1.5f * cfg.ts, DRIVE_LAW_FOC, &reason), 0);
+  assert_null(ctrl_unavailable(&c, DRIVE_LAW_DB_DFVC));
+  cfg.vsd_max = 0.0f; /* the deadbeat's init refuses it */
+  before = c;
+  assert_int_equal(ctrl_select(&c, DRIVE_LAW_DB_DFVC), -1);
+  assert_memory_equal(&c, &before, sizeof before);
+  assert_non_null(ctrl_law_refusal(DRIVE_LAW_DB_DFVC, &c.su));
+}
+
 /* A reluctance machine (no magnet, Lq > Ld): FOC runs it, the SPM laws
  * are unavailable with their reason instead of failing the whole drive. */
 static void syr_machine_runs_foc_only(void **state) {
@@ -579,7 +770,9 @@ int main(void) {
                                      cmocka_unit_test(offset_out_of_range_faults),
                                      cmocka_unit_test(fault_latches_until_cleared),
                                      cmocka_unit_test(clear_racing_a_trip_stays_safe),
-                                     cmocka_unit_test(fault_requests_and_clears_keep_order),
+                                     cmocka_unit_test(clear_never_voids_an_unseen_request),
+                                     cmocka_unit_test(enable_clear_keep_transitions),
+                                     cmocka_unit_test(write_in_fault_waits_for_the_clear),
                                      cmocka_unit_test(hw_break_cannot_be_overridden),
                                      cmocka_unit_test(hw_break_source_names_the_cause),
                                      cmocka_unit_test(bad_samples_fault),
@@ -589,6 +782,7 @@ int main(void) {
                                      cmocka_unit_test(lowered_i_max_reclamps_the_currents),
                                      cmocka_unit_test(protections_must_fit_the_adc_ranges),
                                      cmocka_unit_test(law_change_waits_for_gates_off),
+                                     cmocka_unit_test(refused_law_switch_leaves_the_law_as_it_was),
                                      cmocka_unit_test(syr_machine_runs_foc_only),
                                      cmocka_unit_test(parameter_requests_are_applied_by_the_isr),
                                      cmocka_unit_test(watchdog_needs_both_contexts),

@@ -426,6 +426,236 @@ static void test_keep_and_unavailable_law(void **state) {
   assert_float_equal(rig.drv.cfg.lq, 0.1f, 0.0f);
 }
 
+static uint8_t pid(const char *name) {
+  const drive_param_t *p = drive_params_by_name(name);
+  assert_non_null(p);
+  return p->id;
+}
+
+/* A NaN or inf value is refused naming the parameter it was for, with the
+ * value in force (issue 22, point 7: it was parameter 0, value 0, and the
+ * host matched no reply). */
+static void test_non_finite_value_names_the_parameter(void **state) {
+  (void)state;
+  rig_init();
+  const float bad[3] = {NAN, INFINITY, -INFINITY};
+  for (unsigned i = 0; i < 3; ++i) {
+    push_param(1, pid("i_trip"), bad[i]);
+  }
+  push_param(1, CAN_PROTO_PARAM_FIRST + 1u, NAN); /* a protocol parameter too */
+  slow_tick();
+  reply_t r[8];
+  assert_int_equal(pop_replies(r, 8, NULL), 4);
+  for (unsigned i = 0; i < 3; ++i) {
+    assert_int_equal(r[i].result, CAN_RESULT_OUT_OF_RANGE);
+    assert_int_equal(r[i].param, pid("i_trip"));
+    assert_int_equal(r[i].signal, CAN_SIG_PARAM_VALUE + 1);
+    assert_float_equal(r[i].value, rig.drv.cfg.i_trip, 0.0f);
+  }
+  assert_int_equal(r[3].result, CAN_RESULT_OUT_OF_RANGE);
+  assert_int_equal(r[3].param, CAN_PROTO_PARAM_FIRST + 1u);
+  assert_float_equal(r[3].value, (float)rig.p.cfg.timeout_ms, 0.0f);
+}
+
+/* Runs n slow periods keeping the host alive; no fault may appear. */
+static void idle_ticks(unsigned n) {
+  for (unsigned i = 0; i < n; ++i) {
+    slow_tick();
+    assert_int_equal(rig.drv.faults, 0u);
+  }
+}
+
+/* What is acknowledged is never refused later (issue 22, points 4 and 5),
+ * on a board without the star-point window (this rig's, like the ESC1):
+ * every write and law switch is answered with its verdict, the GET reports
+ * the set in force, enable / disable cycles after it never trip config. */
+static void test_acknowledged_writes_never_trip_later(void **state) {
+  (void)state;
+  rig_init();
+  reply_t r[128];
+  /* pos_source = dfc after align_time = 0.5: refused, naming it */
+  push_param(1, pid("align_time"), 0.5f);
+  push_param(1, pid("pos_source"), (float)POS_SOURCE_DFC);
+  push_param(0, pid("pos_source"), 0.0f);
+  slow_tick();
+  assert_int_equal(pop_replies(r, 128, NULL), 3);
+  assert_int_equal(r[0].result, CAN_RESULT_OK);
+  assert_int_equal(r[1].result, CAN_RESULT_INCONSISTENT);
+  assert_int_equal(r[1].param, pid("pos_source"));
+  assert_float_equal(r[1].value, (float)POS_SOURCE_ENCODER, 0.0f);
+  assert_float_equal(r[2].value, (float)POS_SOURCE_ENCODER, 0.0f);
+  drive_config_err_t err;
+  assert_int_equal(drive_params_set(&rig.drv, pid("pos_source"), (float)POS_SOURCE_DFC, &err),
+                   DRIVE_PARAM_INCONSISTENT);
+  assert_string_equal(err.field, "pos_source");
+  assert_non_null(strstr(err.reason, "star-point"));
+  idle_ticks(20);
+  push_param(1, pid("align_time"), 0.0f);
+  /* DB-DFVC: vsd_max = 0 refused (its deadbeat needs a d_s voltage limit) */
+  push_state(CAN_KEEP, 0, CAN_KEEP, DRIVE_LAW_DB_DFVC);
+  push_param(1, pid("vsd_max"), 0.0f);
+  slow_tick();
+  assert_int_equal(pop_replies(r, 128, NULL), 3);
+  assert_int_equal(r[0].result, CAN_RESULT_OK); /* align_time = 0 */
+  assert_int_equal(r[1].result, CAN_RESULT_OK);
+  assert_int_equal(r[2].result, CAN_RESULT_INCONSISTENT);
+  assert_int_equal(r[2].param, pid("vsd_max"));
+  assert_int_equal(drive_params_set(&rig.drv, pid("vsd_max"), 0.0f, &err),
+                   DRIVE_PARAM_INCONSISTENT);
+  assert_non_null(strstr(err.reason, "vsd_max"));
+  /* the decoupled DFVC: flux_min = 5 Vs (beyond the flux at i_max) refused */
+  push_state(CAN_KEEP, 0, CAN_KEEP, DRIVE_LAW_DFVC_DECOUPLED);
+  push_param(1, pid("flux_min"), 5.0f);
+  slow_tick();
+  assert_int_equal(pop_replies(r, 128, NULL), 2);
+  assert_int_equal(r[0].result, CAN_RESULT_OK);
+  assert_int_equal(rig.drv.ctrl.law, DRIVE_LAW_DFVC_DECOUPLED);
+  assert_int_equal(r[1].result, CAN_RESULT_INCONSISTENT);
+  assert_int_equal(drive_params_set(&rig.drv, pid("flux_min"), 5.0f, &err),
+                   DRIVE_PARAM_INCONSISTENT);
+  assert_non_null(strstr(err.reason, "flux_min"));
+  /* ... and flux_min = 1.76 under DB-DFVC is fine there, but a switch to
+   * the decoupled DFVC with it is unavailable (point 2's sequence) */
+  push_state(CAN_KEEP, 0, CAN_KEEP, DRIVE_LAW_DB_DFVC);
+  push_param(1, pid("flux_min"), 1.76f);
+  push_state(CAN_KEEP, 0, CAN_KEEP, DRIVE_LAW_DFVC_DECOUPLED);
+  slow_tick();
+  assert_int_equal(pop_replies(r, 128, NULL), 3);
+  assert_int_equal(r[1].result, CAN_RESULT_OK);
+  assert_int_equal(r[2].result, CAN_RESULT_UNAVAILABLE);
+  assert_int_equal(r[2].signal, CAN_SIG_LAW + 1);
+  assert_int_equal(rig.drv.ctrl.law, DRIVE_LAW_DB_DFVC);
+  push_param(1, pid("flux_min"), 0.038f);
+  /* FOC: vsd_max = 0 is fine, the switch to DB-DFVC is unavailable and FOC
+   * stays (point 5: it was answered ok, FOC stayed and the next write
+   * tripped config) */
+  push_state(CAN_KEEP, 0, CAN_KEEP, DRIVE_LAW_FOC);
+  push_param(1, pid("vsd_max"), 0.0f);
+  push_state(CAN_KEEP, 0, CAN_KEEP, DRIVE_LAW_DB_DFVC);
+  slow_tick();
+  assert_int_equal(pop_replies(r, 128, NULL), 4);
+  assert_int_equal(r[0].result, CAN_RESULT_OK);
+  assert_int_equal(r[1].result, CAN_RESULT_OK);
+  assert_int_equal(r[2].result, CAN_RESULT_OK);
+  assert_int_equal(r[3].result, CAN_RESULT_UNAVAILABLE);
+  assert_int_equal(rig.drv.ctrl.law, DRIVE_LAW_FOC);
+  assert_int_equal(drive_commands(&rig.drv)->law, DRIVE_LAW_FOC);
+  /* later writes and enable / disable cycles: nothing trips */
+  push_param(1, pid("i_max"), 4.0f);
+  idle_ticks(5);
+  for (unsigned c = 0; c < 3; ++c) {
+    push_state(1, 0, CAN_KEEP, CAN_KEEP);
+    run_until_state(DRIVE_STATE_RUN, 100);
+    push_state(0, 0, CAN_KEEP, CAN_KEEP);
+    idle_ticks(3);
+    push_param(1, pid("speed_bw"), 30.0f + (float)c);
+    idle_ticks(3);
+    pop_replies(r, 128, NULL);
+  }
+  pop_replies(r, 128, NULL);
+  assert_float_equal(rig.drv.cfg.i_max, 4.0f, 0.0f);
+  assert_int_equal(rig.drv.cfg.pos_source, POS_SOURCE_ENCODER);
+}
+
+/* The last STATUS frame's cmd_enabled and state (-1: none sent). */
+static int g_cmd_enabled, g_state;
+static void drain_status(void) {
+  hal_can_frame_t f;
+  while (hal_sil_can_pop(&rig.hal.can_tx, &f)) {
+    if (f.id == can_codec_id(CAN_MSG_STATUS, 3)) {
+      g_cmd_enabled = (int)can_codec_get_raw(CAN_SIG_CMD_ENABLED, f.data);
+      g_state = (int)can_codec_get_raw(CAN_SIG_STATE, f.data);
+    }
+  }
+}
+
+static void status_ticks(unsigned n) {
+  for (unsigned i = 0; i < n; ++i) {
+    push_param(0, 31, 0.0f); /* keeps the host alive */
+    slow_tick();
+    drain_status();
+  }
+}
+
+/* The enable / clear / keep state machine over CAN (docs/can.md, "Enable
+ * and clear"; issue 22, point 6), with STATUS as the host sees it. */
+static void test_enable_clear_keep_over_can(void **state) {
+  (void)state;
+  rig_init();
+  rig.p.cfg.period_ms[CAN_PERIOD_STATUS] = 1u;
+  g_cmd_enabled = g_state = -1;
+  push_state(1, 0, CAN_KEEP, CAN_KEEP);
+  status_ticks(40);
+  assert_int_equal(g_state, DRIVE_STATE_RUN);
+  assert_int_equal(g_cmd_enabled, 1);
+  /* running + {keep, clear}: still running (it disabled the drive) */
+  push_state(CAN_KEEP, 1, CAN_KEEP, CAN_KEEP);
+  status_ticks(5);
+  assert_int_equal(g_state, DRIVE_STATE_RUN);
+  assert_int_equal(g_cmd_enabled, 1);
+  assert_true(rig.hal.gates_on);
+  /* a trip, then {enable 1, clear 1}: answered ok and it restarts */
+  drive_request_fault(&rig.drv, DRIVE_FAULT_CONTROL);
+  status_ticks(2);
+  assert_int_equal(g_state, DRIVE_STATE_FAULT);
+  assert_int_equal(g_cmd_enabled, 0);
+  push_state(1, 1, CAN_KEEP, CAN_KEEP);
+  slow_tick();
+  reply_t r[64];
+  assert_int_equal(pop_replies(r, 64, NULL), 1);
+  assert_int_equal(r[0].result, CAN_RESULT_OK);
+  status_ticks(40);
+  assert_int_equal(g_state, DRIVE_STATE_RUN);
+  assert_int_equal(g_cmd_enabled, 1);
+  /* a trip, then {keep, clear}: idle, not enabled, and it stays so */
+  drive_request_fault(&rig.drv, DRIVE_FAULT_CONTROL);
+  status_ticks(2);
+  push_state(CAN_KEEP, 1, CAN_KEEP, CAN_KEEP);
+  status_ticks(40);
+  assert_int_equal(g_state, DRIVE_STATE_IDLE);
+  assert_int_equal(g_cmd_enabled, 0);
+  assert_false(rig.hal.gates_on);
+  /* then enable = 1 alone starts it (no enable = 0 needed) */
+  push_state(1, 0, CAN_KEEP, CAN_KEEP);
+  status_ticks(40);
+  assert_int_equal(g_state, DRIVE_STATE_RUN);
+  /* a trip, enable = 1 without a clear: still the fault; a clear alone then
+   * leaves it idle (that enable came before the clear) */
+  drive_request_fault(&rig.drv, DRIVE_FAULT_CONTROL);
+  status_ticks(2);
+  push_state(1, 0, CAN_KEEP, CAN_KEEP);
+  status_ticks(10);
+  assert_int_equal(g_state, DRIVE_STATE_FAULT);
+  push_state(CAN_KEEP, 1, CAN_KEEP, CAN_KEEP);
+  status_ticks(40);
+  assert_int_equal(g_state, DRIVE_STATE_IDLE);
+  assert_int_equal(g_cmd_enabled, 0);
+  /* enable = 0: idle; {0, clear} in idle: nothing; keep: nothing */
+  push_state(0, 1, CAN_KEEP, CAN_KEEP);
+  push_state(CAN_KEEP, 0, CAN_KEEP, CAN_KEEP);
+  status_ticks(10);
+  assert_int_equal(g_state, DRIVE_STATE_IDLE);
+  assert_int_equal(g_cmd_enabled, 0);
+}
+
+/* Every main-loop fault request survives a clear frame in the same slow
+ * period, before and after it (issue 22, point 3). */
+static void test_clear_frames_keep_fault_requests(void **state) {
+  (void)state;
+  for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {
+    rig_init();
+    push_state(1, 0, CAN_KEEP, CAN_KEEP);
+    run_until_state(DRIVE_STATE_RUN, 100);
+    /* the main loop posts its request, then the flood's frame is handled */
+    drive_request_fault(&rig.drv, 1u << b);
+    push_state(1, 1, CAN_KEEP, CAN_KEEP);
+    slow_tick();
+    assert_int_equal(rig.drv.faults, 1u << b);
+    assert_int_equal(rig.drv.state, DRIVE_STATE_FAULT);
+    assert_false(rig.hal.gates_on);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_unknown_and_other_nodes_ignored),
@@ -439,6 +669,10 @@ int main(void) {
       cmocka_unit_test(test_no_timeout_when_idle_or_off),
       cmocka_unit_test(test_telemetry_rates),
       cmocka_unit_test(test_keep_and_unavailable_law),
+      cmocka_unit_test(test_non_finite_value_names_the_parameter),
+      cmocka_unit_test(test_acknowledged_writes_never_trip_later),
+      cmocka_unit_test(test_enable_clear_keep_over_can),
+      cmocka_unit_test(test_clear_frames_keep_fault_requests),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

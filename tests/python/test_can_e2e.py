@@ -20,7 +20,7 @@ import pytest
 
 from conftest import REAL_SIL
 from fluxdrive import params
-from fluxdrive.can import Drive, Protocol
+from fluxdrive.can import Drive, DriveError, Protocol
 
 pytestmark = [
     pytest.mark.real_sil,
@@ -92,6 +92,13 @@ def test_enable_speed_param_and_timeout(sil):
         with pytest.raises(Exception) as exc:
             drv.set_speed(5000.0)
         assert exc.value.reply.signal == "cmd_speed_rpm" and exc.value.reply.value == pytest.approx(SPEED)
+        # a non-finite value: refused naming the parameter and its value in
+        # force (issue 22, point 7: it was answered for parameter 0, "no reply")
+        # (an inf is refused by cantools' encoder before it is sent)
+        with pytest.raises(DriveError, match=r"i_trip.*out_of_range \(param_value\)") as exc:
+            drv.set_param("i_trip", float("nan"))
+        assert exc.value.reply.param == "i_trip"
+        assert exc.value.reply.value == pytest.approx(drv.get_param("i_trip"))
         # a shorter timeout for the test (protocol parameters)
         assert drv.set_param("can_timeout_ms", 300) == 300
         assert drv.set_param("can_ramp_ms", 100) == 100

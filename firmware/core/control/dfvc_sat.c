@@ -87,6 +87,17 @@ void dfvc_sat_model(const machine_t *m, dq_t cm_scale, dq_t lambda, dq_t i, dfvc
   dfvc_sat_model_at(m, cm_scale, lambda, i, li, l, 1, 2, q);
 }
 
+FD_COLD float dfvc_sat_flux_cap(const machine_t *m, float i_max) {
+  /* the largest flux amplitude on the current-limit circle (bounded loop) */
+  float cap2 = 0.0f;
+  for (int n = 0; n < 32; ++n) {
+    const sincos_t sc = frames_sincos(0.19634954f * (float)n); /* 2 pi / 32 */
+    const dq_t f = machine_flux(m, (dq_t){i_max * sc.c, i_max * sc.s});
+    cap2 = fd_maxf(cap2, f.d * f.d + f.q * f.q);
+  }
+  return sqrtf(cap2);
+}
+
 FD_COLD int dfvc_sat_init(dfvc_sat_t *c, const dfvc_sat_cfg_t *cfg) {
   memset(c, 0, sizeof(*c));
   c->cfg = *cfg;
@@ -102,13 +113,6 @@ FD_COLD int dfvc_sat_init(dfvc_sat_t *c, const dfvc_sat_cfg_t *cfg) {
   const dq_t mag =
       (m->lq > m->ld && !(m->lambda_m > 0.0f)) ? (dq_t){0.0f, 1.0f} : (dq_t){1.0f, 0.0f};
   const dq_t f0 = machine_flux(m, (dq_t){0.0f, 0.0f});
-  /* the largest flux amplitude on the current-limit circle (bounded loop) */
-  float cap2 = 0.0f;
-  for (int n = 0; n < 32; ++n) {
-    const sincos_t sc = frames_sincos(0.19634954f * (float)n); /* 2 pi / 32 */
-    const dq_t f = machine_flux(m, (dq_t){k->i_max * sc.c, k->i_max * sc.s});
-    cap2 = fd_maxf(cap2, f.d * f.d + f.q * f.q);
-  }
   const dfvc_sat_refs_cfg_t rc = {.machine = m,
                                   .mode = k->refs_mode,
                                   .ts = k->ts,
@@ -118,7 +122,7 @@ FD_COLD int dfvc_sat_init(dfvc_sat_t *c, const dfvc_sat_cfg_t *cfg) {
                                   .k_t = k->k_t,
                                   .k_a = k->k_a,
                                   .lambda_0 = sqrtf(f0.d * f0.d + f0.q * f0.q),
-                                  .lambda_cap = sqrtf(cap2)};
+                                  .lambda_cap = dfvc_sat_flux_cap(m, k->i_max)};
   const dfvc_sat_pi_cfg_t pc = {k->ts, k->omega, k->v_f_max};
   if (flux_observer_init(&c->obs, &oc) != 0 || dfvc_sat_refs_init(&c->refs, &rc) != 0 ||
       dfvc_sat_pi_init(&c->pi, &pc) != 0) {

@@ -109,6 +109,10 @@ typedef struct {
 
 void dfvc_sat_cfg_defaults(dfvc_sat_cfg_t *cfg, const machine_t *machine);
 /* Returns 0, or -1 if a parameter is invalid. */
+/* The largest stator flux amplitude the machine reaches on the current
+ * limit circle |i| = i_max (32 points): the references' ceiling; a flux
+ * floor (lambda_min) above it is refused by dfvc_sat_init. */
+float dfvc_sat_flux_cap(const machine_t *m, float i_max);
 int dfvc_sat_init(dfvc_sat_t *c, const dfvc_sat_cfg_t *cfg);
 void dfvc_sat_reset(dfvc_sat_t *c);
 void dfvc_sat_step(dfvc_sat_t *c, const dfvc_sat_in_t *in, dfvc_sat_out_t *out);

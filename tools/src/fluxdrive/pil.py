@@ -74,7 +74,7 @@ HEADER = np.dtype(
         ("flags", "<u4"),
     ]
 )
-MAGIC, VERSION, FORCE_APPLIED = 0x52534946, 4, 1
+MAGIC, VERSION, FORCE_APPLIED = 0x52534946, 5, 1
 OUT = np.dtype(
     [("duty", "<f4", 3), ("flags", "<u4"), ("faults", "<u4"), ("state", "<u4")]
 )

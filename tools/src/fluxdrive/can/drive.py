@@ -127,7 +127,8 @@ class Drive:
                                  f"within {self.reply_timeout} s ({self.retries + 1} tries)")
         if check and not r.ok:
             what = f" ({r.signal})" if r.signal != "none" else ""
-            raise DriveError(f"{message} rejected: {r.result}{what}", r)
+            name = f" {r.param}" if param is not None else ""
+            raise DriveError(f"{message}{name} rejected: {r.result}{what}", r)
         return r
 
     # --------------------------------------------------------- commands

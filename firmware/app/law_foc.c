@@ -73,10 +73,24 @@ static void foc_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *i
   /* Expected current over the next period: the reference (the loop tracks
    * it), rotated to the centre of that period. */
   out->i_pred = frames_park_inv(i_ref, sc_next);
-  out->torque_min = -t_lim;
-  out->torque_max = t_lim;
   out->fault = 0u;
   const dq_t flux = machine_flux(m, i); /* one lookup for both (a map's is not free) */
+  const float t_now = 1.5f * m->pole_pairs * (flux.d * i.q - flux.q * i.d);
+  /* The torque deliverable now. On the voltage limit (the current loop's
+   * output on the circle v_margin v_lin: a DC-link sag, a speed beyond what
+   * the voltage allows) the present current's torque is all the voltage
+   * gives in the reference's direction, between zero and t_lim; a torque
+   * against the reference, or beyond it, stays a loss of control
+   * (drive_monitor). The speed loop's anti-windup takes the same bound. */
+  out->torque_min = -t_lim;
+  out->torque_max = t_lim;
+  if (s->foc.cc.limited != 0) {
+    if (in->torque_ref > 0.0f) {
+      out->torque_max = fd_clampf(t_now, 0.0f, t_lim);
+    } else if (in->torque_ref < 0.0f) {
+      out->torque_min = fd_clampf(t_now, -t_lim, 0.0f);
+    }
+  }
   /* every field written (no zero-fill call in the ISR): FOC has no flux
    * loop, load angle or observer */
   ctrl_telemetry_t *tm = &out->tm;
@@ -86,7 +100,7 @@ static void foc_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *i
   tm->i_ds = 0.0f;
   tm->i_qs = 0.0f;
   tm->i_qs_ref = 0.0f;
-  tm->torque = 1.5f * m->pole_pairs * (flux.d * i.q - flux.q * i.d);
+  tm->torque = t_now;
   tm->obs_err = 0.0f;
 }
 

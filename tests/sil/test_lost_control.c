@@ -77,26 +77,27 @@ static void check_lost_control(const char *json, uint32_t cause, cond_fn cond, b
 /* The low-inductance Fabbri 2022 Table 5.1 machine driven past its voltage
  * limit by the dynamometer while FOC asks for zero torque: the current
  * grows with the speed (tests/sil/test_faults.c, the overcurrent case). */
-#define OVERDRIVEN(extra)                                                                          \
+#define OVERDRIVEN_AT(extra, torque)                                                               \
   "{\"duration\": 0.3, \"machine\": {\"preset\": \"fabbri2022_t51\"}, \"log\": {\"decimation\": "  \
   "1}, \"sensors\": {\"i_noise\": 0.005},"                                                         \
   "\"mechanics\": {\"mode\": \"imposed\", \"speed\": {\"unit\": \"rpm\", \"terms\": "              \
   "[{\"type\": \"ramp\", \"t0\": 0.02, \"t1\": 0.5, \"value\": 6000}]}},"                          \
   "\"controller\": {\"mode\": \"torque\", \"speed_trip\": 900, " extra                             \
-  "}, \"references\": {\"torque\": 0}}"
+  "}, \"references\": {\"torque\": " torque "}}"
+#define OVERDRIVEN(extra) OVERDRIVEN_AT(extra, "0")
 
 static void current_above_limit(void **state) {
   (void)state;
   check_lost_control(OVERDRIVEN(WIDE_TRACK), DRIVE_LC_CURRENT, over_current, true, "current");
 }
 
-static void torque_off_reference(void **state) {
-  (void)state;
-  /* the braking torque of the overdriven machine against a zero reference */
+/* The overdriven machine's braking torque against the reference `json`
+ * asks for. */
+static void check_torque_off(const char *json, const char *what) {
   scenario_t sc;
   trace_t tr;
   sil_result_t res;
-  run_json(OVERDRIVEN(WIDE_CUR), &sc, &tr, &res);
+  run_json(json, &sc, &tr, &res);
   const size_t k_trip = first_fault(&tr);
   assert_true(k_trip < tr.n);
   /* the monitor's scale: the torque on MTPA at i_max */
@@ -109,7 +110,7 @@ static void torque_off_reference(void **state) {
   while (k_on > 0 && fabs(tr.torque_est[k_on - 1]) > bound) {
     --k_on;
   }
-  printf("torque: |T_est| above the bound from ISR %zu, trip at ISR %zu (%zu ISRs), cause 0x%x\n",
+  printf("%s: |T_est| above the bound from ISR %zu, trip at ISR %zu (%zu ISRs), cause 0x%x\n", what,
          k_on, k_trip, k_trip - k_on, tr.lc_cause[k_trip]);
   assert_int_equal(tr.faults[k_trip], DRIVE_FAULT_LOST_CONTROL);
   assert_int_equal(tr.lc_cause[k_trip], DRIVE_LC_TORQUE);
@@ -119,6 +120,21 @@ static void torque_off_reference(void **state) {
     assert_int_equal(tr.gates[k], 0);
   }
   trace_free(&tr);
+}
+
+static void torque_off_reference(void **state) {
+  (void)state;
+  /* the braking torque of the overdriven machine against a zero reference */
+  check_torque_off(OVERDRIVEN(WIDE_CUR), "torque");
+}
+
+/* FOC on its voltage limit may deliver less than the reference (law_foc.c:
+ * between zero and the reference, not a loss of control:
+ * test_foc_voltage_limit.c), never a torque against it: the overdriven
+ * machine brakes against a motoring reference of a third of torque_max. */
+static void torque_against_reference(void **state) {
+  (void)state;
+  check_torque_off(OVERDRIVEN_AT(WIDE_CUR, "0.1"), "torque against the reference");
 }
 
 /* DB-DFVC at 600 rpm, 10 N m; the encoder error grows slowly (a slipping
@@ -167,9 +183,9 @@ static void flux_off_reference(void **state) {
 
 int main(void) {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(current_above_limit),     cmocka_unit_test(torque_off_reference),
-      cmocka_unit_test(load_angle_beyond_limit), cmocka_unit_test(observer_off_current_model),
-      cmocka_unit_test(flux_off_reference),
+      cmocka_unit_test(current_above_limit),        cmocka_unit_test(torque_off_reference),
+      cmocka_unit_test(torque_against_reference),   cmocka_unit_test(load_angle_beyond_limit),
+      cmocka_unit_test(observer_off_current_model), cmocka_unit_test(flux_off_reference),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

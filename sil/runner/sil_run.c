@@ -409,6 +409,17 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
     }
     /* 4. plant over [t_k, t_k+1) */
     sil_advance(&x, sc, t);
+    if (plant_too_fast(&x.plant)) { /* beyond what its steps cover: end, named */
+      snprintf(err, errlen,
+               "mechanics: at t = %.6g s the rotor turns at %.4g rpm: beyond what the plant "
+               "integrates at this PWM period (%.4g rpm: %d steps of %g electrical rad per "
+               "period); a load (mechanics.load_torque) or an inertia (mechanics.j) that lets "
+               "the rotor run away",
+               t, x.plant.omega_m * 30.0 / SIL_PI,
+               plant_speed_limit_e(&x.plant) / sc->plant.machine.pole_pairs * 30.0 / SIL_PI,
+               PLANT_STEPS_SPEED_MAX, PLANT_HW_MAX);
+      return -1;
+    }
   }
   res->wall_time = wall_now() - t_start;
   plant_get_state(&x.plant, &st);

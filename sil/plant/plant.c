@@ -36,6 +36,39 @@ int plant_substeps_link(const plant_params_t *p) {
   return n < 1.0 ? 1 : (int)n;
 }
 
+int plant_substeps_mech(const plant_params_t *p) {
+  if (p->mech.mode == PLANT_MECH_IMPOSED || !plant_finite_pos(p->mech.j)) {
+    return 1; /* no mechanical state, or one plant_check refuses */
+  }
+  const double lmin = p->machine.map != NULL
+                          ? plant_fluxmap_l_min(p->machine.map)
+                          : (p->machine.ld < p->machine.lq ? p->machine.ld : p->machine.lq);
+  double psi = fabs(p->machine.lambda_m);
+  if (p->machine.map != NULL) {
+    double pd = 0.0, pq = 0.0;
+    plant_fluxmap_flux0(p->machine.map, &pd, &pq);
+    psi = sqrt(pd * pd + pq * pq);
+  }
+  double lo = 1.0, hi = 1.0;
+  if (p->faults.lambda_m_scale.n > 0) {
+    profile_bounds(&p->faults.lambda_m_scale, &lo, &hi);
+    psi *= hi > 1.0 ? hi : 1.0;
+  }
+  double b = p->mech.b;
+  if (p->faults.viscous.n > 0) {
+    profile_bounds(&p->faults.viscous, &lo, &hi);
+    b += hi > 0.0 ? hi : 0.0;
+  }
+  const double w_em = p->machine.pole_pairs * psi * sqrt(1.5 / (lmin * p->mech.j));
+  const double n_em = ceil(p->ts * w_em / PLANT_HW_MAX);
+  const double n_b = ceil(p->ts * b / (PLANT_HC_MAX * p->mech.j));
+  const double n = n_em > n_b ? n_em : n_b;
+  if (!(n < 1e6)) { /* NaN, inf: beyond any limit */
+    return 1000000;
+  }
+  return n < 1.0 ? 1 : (int)n;
+}
+
 int plant_substeps_needed(const plant_params_t *p) {
   const double lmin = p->machine.map != NULL
                           ? plant_fluxmap_l_min(p->machine.map)
@@ -48,8 +81,39 @@ int plant_substeps_needed(const plant_params_t *p) {
   if (!(n < 1e6)) { /* NaN, inf: beyond any limit */
     return 1000000;
   }
-  const int nl = plant_substeps_link(p);
-  return n < 1.0 ? (nl > 1 ? nl : 1) : ((int)n > nl ? (int)n : nl);
+  const int nl = plant_substeps_link(p), nm = plant_substeps_mech(p);
+  const int no = nl > nm ? nl : nm;
+  return n < 1.0 ? (no > 1 ? no : 1) : ((int)n > no ? (int)n : no);
+}
+
+int plant_steps_last(const plant_t *pl) {
+  return pl->aux.steps;
+}
+
+double plant_speed_limit_e(const plant_t *pl) {
+  return PLANT_STEPS_SPEED_MAX * PLANT_HW_MAX / pl->p.ts;
+}
+
+bool plant_too_fast(const plant_t *pl) {
+  return pl->aux.too_fast != 0;
+}
+
+/* This period's steps: the scenario's, or more at speed (plant.h). 0: too
+ * fast to integrate. */
+static int period_steps(const plant_t *pl) {
+  double w = fabs(pl->omega_m);
+  if (pl->p.mech.mode == PLANT_MECH_IMPOSED) {
+    const double w1 = fabs(plant_mech_input(pl, pl->t + pl->p.ts));
+    w = w1 > w ? w1 : w;
+  } else { /* the speed the load alone reaches by the period's end */
+    w += fabs(plant_mech_input(pl, pl->t)) * pl->aux.inv_j * pl->p.ts;
+  }
+  const double we = (double)pl->p.machine.pole_pairs * w;
+  if (!(we <= plant_speed_limit_e(pl))) {
+    return 0;
+  }
+  const int n = (int)ceil(we * pl->p.ts / PLANT_HW_MAX);
+  return n > pl->p.inverter.substeps ? n : pl->p.inverter.substeps;
 }
 
 int plant_check(const plant_params_t *p, const char **field) {
@@ -107,6 +171,8 @@ int plant_init(plant_t *pl, const plant_params_t *p, const char **field) {
   a->l0 = 0.5 * (p->machine.ld + p->machine.lq) + p->machine.aniso.m0;
   a->l2 = (p->machine.ld - p->machine.lq) - 2.0 * p->machine.aniso.m2;
   pl->t = 0.0;
+  a->steps = p->inverter.substeps;
+  a->too_fast = 0;
   plant_mag_flux0(&a->mag, &pl->lambda_d, &pl->lambda_q); /* zero current */
   pl->theta_m = wrap_2pi(p->mech.theta0);
   pl->omega_m =
@@ -144,7 +210,15 @@ void plant_step_pattern(plant_t *pl, const double on_in[3], const double off_in[
     d[j] = off[j] - on[j];
   }
   const double ts = pl->p.ts;
+  if (pl->aux.too_fast) {
+    return; /* the run must end (plant_too_fast) */
+  }
   plant_mech_input_refresh(pl);
+  pl->aux.steps = period_steps(pl);
+  if (pl->aux.steps == 0) {
+    pl->aux.too_fast = 1;
+    return;
+  }
   plant_faults_period_start(pl);
   plant_dclink_chopper(pl);
   double x[X_N] = {pl->lambda_d, pl->lambda_q, pl->theta_m, pl->omega_m, pl->v_dc, 0, 0, 0, 0};

@@ -211,6 +211,8 @@ typedef struct {
   double inv_ts;              /* 1 / ts */
   double inv_band;  /* 1 / width of the smooth sign of the average-model dead time [1/A] */
   uint64_t n_steps; /* periods done: t = n_steps * ts exactly */
+  int steps;        /* integration steps of this period (>= inverter.substeps) */
+  int too_fast;     /* a period began beyond the speed the steps can cover */
   /* switching-level inverter memory, per leg: time of the last commanded
    * edge relative to the start of the next period (<= 0), commanded
    * high-side state after it, diode conduction state of a floating leg */
@@ -288,9 +290,35 @@ int plant_check(const plant_params_t *p, const char **field);
 #define PLANT_RS_SCALE_MAX       4.0
 #define PLANT_LAMBDA_M_SCALE_MAX 2.0
 #define PLANT_C_SCALE_MAX        10.0
+/* The electromechanical mode (the rotor's inertia against the PM flux's
+ * stiffness, w_em = p psi_m sqrt(1.5 / (L_min J)), psi_m the PM flux at its
+ * largest scale) and the friction's pole (b / J, the passive load's viscous
+ * term at its largest included) count too: h w_em <= PLANT_HW_MAX,
+ * h b / J <= PLANT_HC_MAX. A tiny inertia needs more than
+ * PLANT_SUBSTEPS_MAX: the scenario is refused (mechanics.j). */
 int plant_substeps_needed(const plant_params_t *p);
 /* The RC link's share of it alone (1 for an ideal link). */
 int plant_substeps_link(const plant_params_t *p);
+/* Its mechanical share alone (1 when the speed is imposed). */
+int plant_substeps_mech(const plant_params_t *p);
+/* Speed: the rotor frame turns against the stationary-frame voltages at
+ * w_e = p w_m, and the flux's transient oscillates at w_e: each period is
+ * integrated in at least ceil(|w_e| Ts / PLANT_HW_MAX) steps (|w_m| at the
+ * period's start, plus what the load alone adds over it, free; imposed
+ * the larger of its start and end), at most
+ * PLANT_STEPS_SPEED_MAX; beyond that the plant stops advancing
+ * (plant_too_fast) rather than diverge. Without it RK4 leaves its
+ * stability region at |w_e| h = 2.83 (issue 22: 47.6 kA after an active
+ * short at -19,564 rpm on the Rubino SPM, 2.69 rad per period). */
+#define PLANT_HW_MAX          0.5
+#define PLANT_STEPS_SPEED_MAX 256
+/* The steps of the last period; the electrical speed [rad/s] beyond which
+ * a period is not integrated (PLANT_STEPS_SPEED_MAX PLANT_HW_MAX / Ts). */
+int plant_steps_last(const plant_t *pl);
+double plant_speed_limit_e(const plant_t *pl);
+/* True once a period started beyond plant_speed_limit_e: the state is the
+ * last one integrated (finite), the run must end (sil_run reports it). */
+bool plant_too_fast(const plant_t *pl);
 /* Initialises (calls plant_check first). Returns 0 or the error. */
 int plant_init(plant_t *pl, const plant_params_t *p, const char **field);
 /* Advances one PWM period with the given duties (clamped to [0, 1]),

@@ -416,7 +416,7 @@ static double sw_star(const plant_t *pl, const sw_cfg_t *cf, double t, const dou
  * events. */
 static void sw_integrate(plant_t *pl, sw_cfg_t *cf, double *t, double *x, double len) {
   const int star = pl->aux.star_n > 0;
-  const double hmax = pl->p.ts / pl->p.inverter.substeps;
+  const double hmax = pl->p.ts / pl->aux.steps; /* more at speed (plant.h) */
   const int nsub = (int)ceil(len / hmax - 1e-9);
   const double h = len / (nsub > 0 ? nsub : 1);
   for (int k = 0; k < (nsub > 0 ? nsub : 1); k++) {

@@ -1079,6 +1079,21 @@ static int resolve_substeps(ctx_t *c, scenario_t *sc) {
                   "most %d",
                   need, PLANT_SUBSTEPS_MAX);
     }
+    if (need > PLANT_SUBSTEPS_MAX && plant_substeps_mech(p) >= need) {
+      /* the inertia the mechanical share allows with PLANT_SUBSTEPS_MAX
+       * steps: both its rules scale as 1 / sqrt(J) and 1 / J */
+      plant_params_t q = *p;
+      double j_min = p->mech.j;
+      for (int i = 0; i < 200 && plant_substeps_mech(&q) > PLANT_SUBSTEPS_MAX; ++i) {
+        j_min *= 1.1;
+        q.mech.j = j_min;
+      }
+      return fail(c, "mechanics.j",
+                  "the plant cannot integrate this inertia at this PWM period: the rotor against "
+                  "the PM flux (and the friction) needs %d integration steps per period, at most "
+                  "%d: at least %.3g kg m^2 (got %.3g)",
+                  need, PLANT_SUBSTEPS_MAX, j_min, p->mech.j);
+    }
     if (need > PLANT_SUBSTEPS_MAX) {
       const char *key = p->machine.map != NULL           ? "machine.map"
                         : c->ls_given                    ? "machine.ls"

@@ -57,22 +57,34 @@ void sil_command_references(drive_t *drv, const scenario_t *sc, double t) {
   drive_cmd_speed(drv, (float)profile_eval(&sc->ref.speed, t));
   drive_cmd_current(drv, (float)profile_eval(&sc->ref.id, t), (float)profile_eval(&sc->ref.iq, t));
   drive_cmd_flux(drv, (float)profile_eval(&sc->ref.flux, t));
-  /* the injected trip, at the first main-loop period at or after trip_at */
-  if (sc->trip_cause != 0u && t >= sc->trip_at &&
-      t < sc->trip_at + (double)sc->drive.slow_div * sc->plant.ts) {
-    drive_request_fault(drv, sc->trip_cause);
+}
+
+void sil_main_injections(sil_ctx_t *x, const scenario_t *sc, double t) {
+  /* the injected trip, once, at the first main-loop period at or after
+   * trip_at (a flag, not a window: any trip_at fires, a denormal one at
+   * the first period after t = 0) */
+  if (sc->trip_cause != 0u && !x->trip_posted && t >= sc->trip_at) {
+    drive_request_fault(&x->drv, sc->trip_cause);
+    x->trip_posted = true;
   }
-  /* the controller's map error: a parameter write when the profile changes */
+  /* the controller's map error: a parameter write when the profile's value
+   * changes (the first time: when it differs from the set requested), so a
+   * CAN client's own write holds until the profile moves again */
   if (sc->cm_scale_d.n > 0 || sc->cm_scale_q.n > 0) {
-    drive_config_t cfg = *drive_requested_config(drv);
+    drive_config_t cfg = *drive_requested_config(&x->drv);
     const float sd =
         sc->cm_scale_d.n > 0 ? (float)profile_eval(&sc->cm_scale_d, t) : cfg.cm_scale_d;
     const float sq =
         sc->cm_scale_q.n > 0 ? (float)profile_eval(&sc->cm_scale_q, t) : cfg.cm_scale_q;
-    if (sd < cfg.cm_scale_d || sd > cfg.cm_scale_d || sq < cfg.cm_scale_q || sq > cfg.cm_scale_q) {
+    const float ld = x->cm_written ? x->cm_last[0] : cfg.cm_scale_d;
+    const float lq = x->cm_written ? x->cm_last[1] : cfg.cm_scale_q;
+    if (sd < ld || sd > ld || sq < lq || sq > lq) {
       cfg.cm_scale_d = sd;
       cfg.cm_scale_q = sq;
-      (void)drive_request_config(drv, &cfg, NULL); /* out of range: refused, the last holds */
+      (void)drive_request_config(&x->drv, &cfg, NULL); /* out of range: refused, the last holds */
+      x->cm_last[0] = sd;
+      x->cm_last[1] = sq;
+      x->cm_written = true;
     }
   }
 }
@@ -140,6 +152,10 @@ int sil_setup(sil_ctx_t *x, const scenario_t *sc, char *err, size_t errlen) {
   x->v_src = 0.0;
   x->v_src_end = -INFINITY;
   x->isr_late = false;
+  x->trip_posted = false;
+  x->cm_written = false;
+  x->cm_last[0] = 0.0f;
+  x->cm_last[1] = 0.0f;
   sil_adc_faults_reset(&x->adc_faults);
   sil_enc_faults_reset(&x->enc_faults, &sc->encoder_faults);
   return 0;
@@ -313,11 +329,13 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
           }
           drive_background(&x.drv); /* fresh telemetry for the protocol */
           can_proto_poll(&proto, &x.drv, x.hal.time_us);
+          sil_main_injections(&x, sc, t); /* the scenario's faults, as without CAN */
           if (opts->can_io != NULL) {
             opts->can_io(opts->can_user, &x.hal, t);
           }
         } else {
           sil_command_references(&x.drv, sc, t);
+          sil_main_injections(&x, sc, t);
           drive_background(&x.drv);
         }
       }
@@ -391,6 +409,17 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
     }
     /* 4. plant over [t_k, t_k+1) */
     sil_advance(&x, sc, t);
+    if (plant_too_fast(&x.plant)) { /* beyond what its steps cover: end, named */
+      snprintf(err, errlen,
+               "mechanics: at t = %.6g s the rotor turns at %.4g rpm: beyond what the plant "
+               "integrates at this PWM period (%.4g rpm: %d steps of %g electrical rad per "
+               "period); a load (mechanics.load_torque) or an inertia (mechanics.j) that lets "
+               "the rotor run away",
+               t, x.plant.omega_m * 30.0 / SIL_PI,
+               plant_speed_limit_e(&x.plant) / sc->plant.machine.pole_pairs * 30.0 / SIL_PI,
+               PLANT_STEPS_SPEED_MAX, PLANT_HW_MAX);
+      return -1;
+    }
   }
   res->wall_time = wall_now() - t_start;
   plant_get_state(&x.plant, &st);

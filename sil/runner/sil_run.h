@@ -43,7 +43,8 @@
  * posted for the next ISR, and the transport sends what the drive queued,
  * stamped with t_k. The scenario's
  * references and enable/disable times are not applied: the CAN client
- * commands. With sil_opts_t.realtime the loop sleeps at each slow period
+ * commands; its injections (trip_at, cm_scale_*: sil_main_injections) are,
+ * after the protocol's poll. With sil_opts_t.realtime the loop sleeps at each slow period
  * until the wall clock has caught up with the simulated time.
  */
 #ifndef FD_SIL_RUN_H
@@ -133,6 +134,9 @@ typedef struct {
   sil_enc_state_t enc_faults;  /* the encoder faults' memory */
   bool isr_late;               /* ISR k overran: its pattern misses t_{k+1} */
   hal_pwm_t pwm_before;        /* then: the pattern written before it */
+  bool trip_posted;            /* inject.trip_at done (once per run, resets included) */
+  bool cm_written;             /* inject.cm_scale_*: a value written, cm_last holds it */
+  float cm_last[2];
 } sil_ctx_t;
 
 /* Plant, HAL and drive from the scenario; 0 or -1 with the message. */
@@ -141,8 +145,12 @@ int sil_setup(sil_ctx_t *x, const scenario_t *sc, char *err, size_t errlen);
 void sil_sample(sil_ctx_t *x, const scenario_t *sc, double t);
 /* Step 4: the plant over [t, t + Ts) with the preloaded pattern. */
 void sil_advance(sil_ctx_t *x, const scenario_t *sc, double t);
-/* The scenario's references at t, posted through drive_cmd_*. */
+/* The scenario's references at t, posted through drive_cmd_* (not with CAN). */
 void sil_command_references(drive_t *drv, const scenario_t *sc, double t);
+/* The main loop's injections at t (inject.trip_at, inject.cm_scale_*), with
+ * or without CAN: the fault posted once, the parameters written when their
+ * profile changes. */
+void sil_main_injections(sil_ctx_t *x, const scenario_t *sc, double t);
 
 /* Runs the scenario. obs (may be NULL) is called every period. Returns 0,
  * or -1 with a message in err (plant or drive rejected the parameters). */

@@ -129,6 +129,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   }
   /* one main-loop period: references, background, slow_div ISRs, plant */
   sil_command_references(&x.drv, &sc, 0.0);
+  sil_main_injections(&x, &sc, 0.0);
   drive_background(&x.drv);
   for (uint32_t k = 0; k < sc.drive.slow_div; ++k) {
     const double t = (double)k * sc.plant.ts;

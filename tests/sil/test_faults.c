@@ -210,12 +210,48 @@ static void current_sensor_gain(void **state) {
   }
 }
 
+/* inject.trip_at: the main loop posts the fault at its first period at or
+ * after trip_at (a main-loop period every slow_div ISRs, 1 ms), the ISR of
+ * that period takes it. Any trip_at fires: a denormal one (1e-320) or one
+ * inside the first period at the second period (t = 1 ms: t = 0 is before
+ * it), one on a period exactly at that period. */
+static void trip_at_fires_at_the_first_main_loop_period_after_it(void **state) {
+  (void)state;
+  static const double at[] = {1e-320, 1e-4, 1e-3, 2.5e-3, 7e-3};
+  for (size_t r = 0; r < sizeof at / sizeof at[0]; ++r) {
+    char json[512];
+    snprintf(json, sizeof json,
+             "{\"duration\": 0.01, " BASE "\"inject\": {\"trip_at\": %.17g, "
+             "\"trip_cause\": \"control\"}}",
+             at[r]);
+    scenario_t sc;
+    trace_t tr;
+    sil_result_t res;
+    run_json(json, &sc, &tr, &res);
+    unsigned m = 0u; /* the main loop's first t = m slow_div Ts >= trip_at */
+    while ((double)(m * sc.drive.slow_div) * sc.plant.ts < at[r] && m < 100u) {
+      ++m;
+    }
+    const double want = (double)(m * sc.drive.slow_div) * sc.plant.ts;
+    const size_t k = first_fault(&tr);
+    printf("trip_at %.3g s: fault 0x%x at %.6f s (the first main-loop period at or after it: "
+           "%.6f s)\n",
+           at[r], k < tr.n ? tr.faults[k] : 0u, k < tr.n ? tr.t[k] : -1.0, want);
+    assert_true(k < tr.n);
+    assert_int_equal(tr.faults[k], DRIVE_FAULT_CONTROL);
+    assert_true(fabs(tr.t[k] - want) < 0.5 * sc.plant.ts);
+    trace_free(&tr);
+  }
+}
+
 int main(void) {
-  const struct CMUnitTest tests[] = {cmocka_unit_test(overvoltage),
-                                     cmocka_unit_test(undervoltage),
-                                     cmocka_unit_test(overspeed),
-                                     cmocka_unit_test(overcurrent),
-                                     cmocka_unit_test(hardware_overcurrent),
-                                     cmocka_unit_test(current_sensor_gain)};
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(overvoltage),
+      cmocka_unit_test(undervoltage),
+      cmocka_unit_test(overspeed),
+      cmocka_unit_test(overcurrent),
+      cmocka_unit_test(hardware_overcurrent),
+      cmocka_unit_test(current_sensor_gain),
+      cmocka_unit_test(trip_at_fires_at_the_first_main_loop_period_after_it)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -203,10 +203,53 @@ static void bad_plant_faults_name_the_field(void **state) {
   }
 }
 
+/* Issue 22 point 10: a load far beyond the machine's (1000 N m, 50 x rated)
+ * on a free rotor: the drive trips (position) and lets go, the load drives
+ * the rotor backwards at T_L / J; the plant raises its steps with the speed
+ * (plant.h) and stays finite: at 0.3 s -136,400 rpm (1000 / 0.021 x 0.3
+ * rad/s, less the machine's drag), the current that of the diodes or the
+ * short, below twice psi / L. On an inertia of 1e-6 kg m^2 the same load
+ * passes in one period what the plant integrates at 16 kHz: the run ends
+ * with an error naming the load and the inertia. */
+static void extreme_load_integrated_or_named(void **state) {
+  (void)state;
+  static const char *const fmt =
+      "{\"duration\": 0.3, \"machine\": {\"preset\": \"rubino2020_spm\"}, \"controller\": "
+      "{\"law\": \"foc\", \"mode\": \"torque\"}, \"references\": {\"torque\": 5}, "
+      "\"mechanics\": {\"mode\": \"free\", \"load_torque\": 1000%s}}";
+  char js[512];
+  snprintf(js, sizeof js, fmt, "");
+  scenario_t sc;
+  trace_t tr;
+  sil_result_t res;
+  run_json(js, &sc, &tr, &res);
+  const double w_free = -1000.0 / sc.plant.mech.j * 0.3;
+  const double i_bound = 2.0 * sc.plant.machine.lambda_m / sc.plant.machine.ld;
+  printf("load 1000 N m: %.1f rpm at 0.3 s (T_L t / J: %.1f rpm), peak current %.4f A (2 psi/L "
+         "%.3f A), faults 0x%x\n",
+         res.final_speed * 30.0 / 3.14159265358979, w_free * 30.0 / 3.14159265358979,
+         res.max_phase_current, i_bound, res.faults);
+  assert_true(isfinite(res.final_speed) && isfinite(res.max_phase_current) &&
+              isfinite(res.v_dc_max) && isfinite(res.final_torque));
+  assert_true(res.final_speed < 0.99 * w_free && res.final_speed > 1.01 * w_free);
+  assert_true(res.max_phase_current < i_bound);
+  trace_free(&tr);
+  snprintf(js, sizeof js, fmt, ", \"j\": 1e-6");
+  char err[512];
+  assert_int_equal(scenario_parse(js, "test", &sc, err, sizeof err), 0);
+  const int r = sil_run(&sc, NULL, NULL, &res, err, sizeof err);
+  printf("load 1000 N m on 1e-6 kg m^2: %s\n", r != 0 ? err : "ran");
+  assert_int_equal(r, -1);
+  assert_non_null(strstr(err, "mechanics.load_torque"));
+  assert_non_null(strstr(err, "mechanics.j"));
+}
+
 int main(void) {
-  const struct CMUnitTest tests[] = {
-      cmocka_unit_test(bad_plant_faults_name_the_field), cmocka_unit_test(demagnetisation),
-      cmocka_unit_test(winding_temperature), cmocka_unit_test(passive_load),
-      cmocka_unit_test(capacitor_loss)};
+  const struct CMUnitTest tests[] = {cmocka_unit_test(bad_plant_faults_name_the_field),
+                                     cmocka_unit_test(demagnetisation),
+                                     cmocka_unit_test(winding_temperature),
+                                     cmocka_unit_test(passive_load),
+                                     cmocka_unit_test(capacitor_loss),
+                                     cmocka_unit_test(extreme_load_integrated_or_named)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -273,6 +273,102 @@ static void presets_below_the_rectifier_speed_go_all_off(void **state) {
   }
 }
 
+/* Issue 22 point 11: what the board must bound. Rubino's SPM on the
+ * dynamometer at 1200 rpm (its top speed) and 1485 rpm (just below
+ * speed_trip, 1500 rpm), the same 310 V diode-rectifier link of 200 uF.
+ * (i) A trip: the active short circuit holds the link at the source. (ii)
+ * The gate driver's nFAULT (a desaturation, its supply's undervoltage):
+ * every switch off in hardware, no short possible (the break input clears
+ * MOE): the diodes rectify the line back-EMF (peak sqrt(3) psi w_e) into
+ * the link. Printed: the peak, the energy the capacitor took,
+ * C (v_max^2 - v_0^2) / 2, and the power it took while passing v_dc_max
+ * (C (v_2^2 - v_1^2) / 2 / (t_2 - t_1) between 0.95 and 1.05 v_dc_max):
+ * what a chopper must burn to hold the link at v_dc_max, or a TVS /
+ * the capacitor and switches must take. */
+#define GATE_DRIVER                                                                                \
+  "\"inject\": {\"gate_driver\": [{\"type\": \"step\", \"t\": 0.5, \"value\": 1}]}"
+static void link_bound_short_vs_gate_driver(void **state) {
+  (void)state;
+  static const struct {
+    double rpm;
+    const char *inject;
+  } runs[] = {
+      {1200.0, TRIP},
+      {1485.0, TRIP},
+      {1485.0, GATE_DRIVER},
+      {1485.0, GATE_DRIVER}, /* with the chopper the third run sizes */
+  };
+  double p_pass = 0.0;
+  for (size_t r = 0; r < sizeof runs / sizeof runs[0]; ++r) {
+    char json[1024];
+    snprintf(json, sizeof json,
+             RUBINO("0.9", "\"mechanics\": {\"mode\": \"imposed\", \"speed\": {\"unit\": "
+                           "\"rpm\", \"terms\": [{\"type\": \"ramp\", \"t0\": 0.05, \"t1\": "
+                           "0.35, \"value\": %.1f}]}}, %s"),
+             runs[r].rpm, runs[r].inject);
+    if (r == 3) { /* the chopper: on at 0.95 v_dc_max, off at 0.9 (403 V: the preset's) */
+      char *at = strstr(json, "\"c\": 200e-6");
+      assert_non_null(at);
+      char tail[1024];
+      snprintf(tail, sizeof tail, "%s", at + strlen("\"c\": 200e-6"));
+      snprintf(at, sizeof json - (size_t)(at - json),
+               "\"c\": 200e-6, \"chopper_r\": %.3f, \"chopper_on\": 382.85, \"chopper_off\": "
+               "362.7%s",
+               pow(0.9 * 403.0, 2) / p_pass, tail);
+    }
+    scenario_t sc;
+    trace_t tr;
+    sil_result_t res;
+    run_json(json, &sc, &tr, &res);
+    const plant_machine_t *m = &sc.plant.machine;
+    const size_t k = first_fault(&tr);
+    assert_true(k < tr.n);
+    const double w_e = runs[r].rpm * PI / 30.0 * m->pole_pairs;
+    const double emf = sqrt(3.0) * m->lambda_m * w_e;
+    const double c = sc.plant.dclink.c, v0 = sc.plant.dclink.v_source;
+    const double vmax_drive = (double)sc.drive.v_dc_max;
+    const double v_max = trace_max(tr.v_dc, k, tr.n);
+    const double energy = 0.5 * c * (v_max * v_max - v0 * v0);
+    const bool all_off = r >= 2;
+    if (r == 3) {
+      printf("with a chopper of %.1f Ohm on at %.1f V, off at %.1f V: ", sc.plant.dclink.r_chop,
+             sc.plant.dclink.v_chop_on, sc.plant.dclink.v_chop_off);
+    }
+    printf("%s at %.0f rpm (line back-EMF peak %.1f V = %.2f x the %.0f V link), %.0f uF: faults "
+           "0x%x, short %s; v_dc max %.1f V (v_dc_max %.1f V), the capacitor took %.2f J",
+           all_off ? "gate driver nFAULT (all off)" : "trip (active short circuit)", runs[r].rpm,
+           emf, emf / v0, v0, c * 1e6, tr.faults[k], tr.asc[k] ? "on" : "off", v_max, vmax_drive,
+           energy);
+    if (r == 2) {
+      const size_t k1 = first_above(tr.v_dc, tr.n, 0.95 * vmax_drive);
+      const size_t k2 = first_above(tr.v_dc, tr.n, 1.05 * vmax_drive);
+      assert_true(k1 < k2 && k2 < tr.n);
+      const double v1 = tr.v_dc[k1], v2 = tr.v_dc[k2];
+      const double p = 0.5 * c * (v2 * v2 - v1 * v1) / (tr.t[k2] - tr.t[k1]);
+      p_pass = p;
+      printf(", %.0f W passing v_dc_max (%.2f ms from %.0f to %.0f V): a chopper of %.1f Ohm "
+             "burns it at 0.9 v_dc_max",
+             p, (tr.t[k2] - tr.t[k1]) * 1e3, v1, v2, pow(0.9 * vmax_drive, 2) / p);
+      assert_true((tr.faults[k] & DRIVE_FAULT_GATE_DRIVER) != 0u);
+      for (size_t j = k; j < tr.n; ++j) {
+        assert_int_equal(tr.asc[j], 0);
+        assert_int_equal(tr.gates[j], 0);
+      }
+      /* pumped towards the back-EMF's peak, never beyond it */
+      assert_true(v_max > 0.9 * emf && v_max < emf);
+      assert_true(p > 0.0);
+    } else if (r == 3) { /* the same with that chopper: bounded below v_dc_max */
+      assert_true((tr.faults[k] & DRIVE_FAULT_GATE_DRIVER) != 0u);
+      assert_true(v_max < vmax_drive && v_max > 0.9 * vmax_drive);
+    } else {
+      assert_int_equal(tr.asc[k], 1);
+      assert_true(v_max <= v0 + 1.0);
+    }
+    printf("\n");
+    trace_free(&tr);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(rubino_short_at_top_speed),
@@ -280,6 +376,7 @@ int main(void) {
       cmocka_unit_test(short_ends_below_the_rectifier_speed),
       cmocka_unit_test(active_load_after_a_trip_at_standstill),
       cmocka_unit_test(presets_below_the_rectifier_speed_go_all_off),
+      cmocka_unit_test(link_bound_short_vs_gate_driver),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

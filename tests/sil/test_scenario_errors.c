@@ -65,6 +65,11 @@ static const bad_case_t cases[] = {
      "controller.law: DFVC of Rubino 2020 needs an isotropic (SPM) machine"},
     {"{\"duration\": 1, \"machine\": {\"ld\": 50}}", "machine.ld: must be in [1e-07, 10]"},
     {"{\"duration\": 1, \"mechanics\": {\"j\": 1e4}}", "mechanics.j: must be in"},
+    /* issue 22: w_em = p psi sqrt(1.5 / (L J)) = 6.47e5 rad/s, 40.5 rad per
+     * period at 16 kHz: 81 steps of 0.5 rad */
+    {"{\"duration\": 1, \"mechanics\": {\"j\": 1e-9}}",
+     "mechanics.j: the plant cannot integrate this inertia at this PWM period: the rotor against "
+     "the PM flux (and the friction) needs 81 integration steps per period, at most 64"},
     {"{\"duration\": 1, \"controller\": {\"pos_source\": \"hall\"}}",
      "controller.pos_source: must be one of: encoder"},
     {"{\"duration\": 1, \"controller\": {\"slow_div\": 2.5}}",

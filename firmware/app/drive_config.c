@@ -163,6 +163,9 @@ void drive_config_default(drive_config_t *cfg) {
   }
 }
 
+/* rad: largest phase shift of the 2theta term at the current limit */
+#define DRIVE_DFC_PHI_I_MAX 0.1f
+
 #define RULE(cond, name, why)                                                                      \
   do {                                                                                             \
     if (!(cond)) {                                                                                 \
@@ -198,6 +201,25 @@ int drive_config_check(const drive_config_t *cfg, drive_config_err_t *err) {
        "must be positive when align_time > 0");
   RULE(cfg->align_current <= cfg->i_max, "align_current", "must be at most i_max");
   RULE(cfg->dfc_t_meas < cfg->dfc_tw, "dfc_t_meas", "must be shorter than dfc_tw");
+  /* the star point settles only after the switches have: a sample within the
+   * dead time reads the old vector */
+  RULE(cfg->dfc_t_meas > cfg->dead_time, "dfc_t_meas",
+       "must be longer than dead_time (the star-point sample after the edge must come after the "
+       "dead time)");
+  /* an alignment shorter than one period is none (a denormal never ends it) */
+  RULE(!(cfg->align_time > 0.0f) || cfg->align_time >= c, "align_time",
+       "must be 0 (no alignment) or at least one PWM period ts");
+  /* the Full IVD's phase shifts at the current limit: a turn of the 2theta term
+   * by more than 0.1 rad at i_max (an angle error of 0.05 rad if the machine
+   * has none) trips the star-point presets' Kalman filter (ebike 0.15 rad:
+   * overspeed at 0.28 s; fig33 0.2 rad: the speed 23 % off); phi_b = 2 phi_a
+   * for a turned saliency axis (docs/faults.md) */
+  RULE(fabsf(cfg->dfc_phi_a) * cfg->i_max <= DRIVE_DFC_PHI_I_MAX, "dfc_phi_a",
+       "|dfc_phi_a| i_max must be at most 0.1 rad (the 2theta term's phase shift at the current "
+       "limit)");
+  RULE(fabsf(cfg->dfc_phi_b) * cfg->i_max <= 2.0f * DRIVE_DFC_PHI_I_MAX, "dfc_phi_b",
+       "|dfc_phi_b| i_max must be at most 0.2 rad (the 4theta term's phase shift at the current "
+       "limit)");
   RULE(cfg->overrun_k <= cfg->overrun_n, "overrun_k", "must be at most overrun_n");
   RULE(cfg->dfc_t0 + cfg->dfc_tw <= 0.25f * c, "dfc_tw",
        "the DFC window dfc_t0 + dfc_tw must end within the first quarter of the period ts");

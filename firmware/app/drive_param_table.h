@@ -137,7 +137,7 @@
   X(39, enc_cpr,        U32,  "",       4096.0f,     0.0f,    16777216.0f, IDLE, "sensors.encoder_cpr",    \
     "encoder counts per mechanical revolution (0: not quantised)")                                          \
   X(44, align_time,     F32,  "s",      0.0f,        0.0f,    10.0f,    IDLE, "controller.align_time",     \
-    "alignment before run: d current along the assumed axis for this long (0: no alignment)")               \
+    "alignment before run: d current along the assumed axis for this long (0: no alignment, else >= ts)")               \
   X(45, align_current,  F32,  "A",      1.0f,        0.0f,    1e4f,     IDLE, "controller.align_current",  \
     "d current of the alignment")                                                                           \
   X(46, pos_err_max,    F32,  "rad",    0.5f,        0.01f,   3.2f,     LIVE, "controller.pos_err_max",    \
@@ -150,25 +150,32 @@
   X(27, dfc_iter,       U16,  "",       1.0f,        0.0f,    8.0f,     LIVE, "controller.dfc_iter",       \
     "IVD: iterations of (3.76) / (3.100)")                                                                  \
   X(28, dfc_phi_a,      F32,  "rad/A",  0.0f,        -1.0f,   1.0f,     LIVE, "controller.dfc_phi_a",      \
-    "Full IVD: phase shift phi_a of the 2theta term per A of i_q (3.97)")                                  \
+    "Full IVD: phase shift phi_a of the 2theta term per A of i_q (3.97); |phi_a| i_max <= 0.1 rad")                                  \
   X(29, dfc_phi_b,      F32,  "rad/A",  0.0f,        -1.0f,   1.0f,     LIVE, "controller.dfc_phi_b",      \
-    "Full IVD: phase shift phi_b of the 4theta term per A of i_q (3.97)")                                  \
+    "Full IVD: phase shift phi_b of the 4theta term per A of i_q (3.97); |phi_b| i_max <= 0.2 rad")                                  \
   X(47, dfc_t0,         F32,  "s",      1.5e-6f,     2e-7f,   2e-5f,    IDLE, "controller.dfc_t0",         \
     "DFC window: test vector start after the period start (the star point is sampled at t0/2 before it)") \
   X(48, dfc_tw,         F32,  "s",      3e-6f,       5e-7f,   3e-5f,    IDLE, "controller.dfc_tw",         \
     "DFC window: test vector length")                                                                       \
   X(49, dfc_t_meas,     F32,  "s",      2.5e-6f,     1e-7f,   3e-5f,    IDLE, "controller.dfc_t_meas",     \
-    "DFC window: star-point sample after the test-vector edge (dead time plus settling, < dfc_tw)")        \
+    "DFC window: star-point sample after the test-vector edge (dead time plus settling: > dead_time, < dfc_tw)")        \
   /* Kalman filter, EKF and RLS on the star-point position (Fabbri 2022 ch. 4; docs/dfc.md) */         \
   X(96, friction,       F32,  "N m s/rad", 0.0f,     0.0f,    1e4f,     IDLE, "mechanics.b",               \
     "viscous friction B, for the Kalman filter's model (4.46)")                                            \
-  X(97, kf_q_omega,     F32,  "(rad/s)^2", 1.0f,     0.0f,    1e8f,     LIVE, "controller.kf_q_omega",     \
+  /* kf_q_omega, kf_q_load, dfc_sigma: ranges found on the star-point presets (fabbri2022_t51,     \
+   * _fig33, _ebike; dfc+kf, ivd+kf, ekf, ivd+kf+rls; start, 500 / 50 rpm, load step; docs/faults.md):\
+   * Q_11 100 (rad/s)^2: overspeed at 0.58 s (dfc+kf, ebike), 1e3: 18 ms after the start (fig33,     \
+   * ebike), the filter follows the noise; Q_33 0.1 (N m)^2: overspeed at 0.19 s (ekf, fig33), 1:    \
+   * 23 ms (t51); sigma_v 2e-5: the RLS trips overspeed at 0.38 s (t51), 4e-6: the KF at 21 ms        \
+   * (ebike); sigma_v 0.3 (six times the presets' a): position at 0.12 s (ekf). 5e-5 is below a       \
+   * 12-bit star channel's step over the link (2.4e-4 / sqrt 12), 0.1 twice the presets' a. */      \
+  X(97, kf_q_omega,     F32,  "(rad/s)^2", 1.0f,     0.0f,    10.0f,    LIVE, "controller.kf_q_omega",     \
     "KF/EKF: process noise of the electrical speed, Q_11 (5.1)")                                           \
   X(98, kf_q_theta,     F32,  "rad^2",  0.0f,        0.0f,    10.0f,    LIVE, "controller.kf_q_theta",     \
     "KF/EKF: process noise of the electrical angle, Q_22 (5.1)")                                           \
-  X(99, kf_q_load,      F32,  "(N m)^2", 1e-6f,      0.0f,    1e6f,     LIVE, "controller.kf_q_load",      \
+  X(99, kf_q_load,      F32,  "(N m)^2", 1e-6f,      0.0f,    0.01f,    LIVE, "controller.kf_q_load",      \
     "KF/EKF: process noise of the load torque, Q_33 (5.1)")                                                \
-  X(100, dfc_sigma,     F32,  "",       2e-4f,       1e-7f,   0.5f,     LIVE, "controller.dfc_sigma",      \
+  X(100, dfc_sigma,     F32,  "",       2e-4f,       5e-5f,   0.1f,     LIVE, "controller.dfc_sigma",      \
     "KF/EKF/RLS: standard deviation sigma_v of each DFC signal (Gamma / v_dc) (4.29), (4.38), (4.53)")     \
   X(101, kf_r_scale,    F32,  "",       1.0f,        0.01f,   1e4f,     LIVE, "controller.kf_r_scale",     \
     "KF/EKF: R_k = kf_r_scale times (4.29) / (4.38) (Table 5.2: 1 and 5)")                                  \

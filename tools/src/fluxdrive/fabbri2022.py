@@ -272,7 +272,10 @@ def _shift_sc(root, source: str, phi_a: float = 0.0, phi_b: float = 0.0) -> dict
                            {"type": "ramp", "t0": 0.03, "t1": 0.08,
                             "value": PAPER.rpm_shift}]}}
     sc["controller"].update({"pos_source": source, "dfc_phi_a": phi_a, "dfc_phi_b": phi_b,
-                             "align_time": 0.02, "align_current": 0.5})
+                             "align_time": 0.02, "align_current": 0.5,
+                             # the steps reach 1.5 A: the limit there keeps the fitted
+                             # shift within |phi_a| i_max <= 0.1 rad (drive_config_check)
+                             "i_max": PAPER.iq_steps[-1]})
     t0 = 0.1
     sc["references"] = {"id": 0, "iq": {"terms": [
         {"type": "step", "t": t0 + i * SHIFT_STEP, "value": PAPER.iq_steps[i] - (

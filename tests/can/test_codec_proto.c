@@ -630,6 +630,19 @@ static void test_enable_clear_keep_over_can(void **state) {
   status_ticks(40);
   assert_int_equal(g_state, DRIVE_STATE_IDLE);
   assert_int_equal(g_cmd_enabled, 0);
+  /* a trip, then {enable 0, clear 1}: idle, not enabled; enable = 1 starts */
+  push_state(1, 0, CAN_KEEP, CAN_KEEP);
+  status_ticks(40);
+  assert_int_equal(g_state, DRIVE_STATE_RUN);
+  drive_request_fault(&rig.drv, DRIVE_FAULT_CONTROL);
+  status_ticks(2);
+  push_state(0, 1, CAN_KEEP, CAN_KEEP);
+  status_ticks(10);
+  assert_int_equal(g_state, DRIVE_STATE_IDLE);
+  assert_int_equal(g_cmd_enabled, 0);
+  push_state(1, 0, CAN_KEEP, CAN_KEEP);
+  status_ticks(40);
+  assert_int_equal(g_state, DRIVE_STATE_RUN);
   /* enable = 0: idle; {0, clear} in idle: nothing; keep: nothing */
   push_state(0, 1, CAN_KEEP, CAN_KEEP);
   push_state(CAN_KEEP, 0, CAN_KEEP, CAN_KEEP);

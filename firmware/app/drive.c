@@ -786,7 +786,9 @@ void drive_isr(drive_t *drv) {
 
   switch (drv->state) {
   case DRIVE_STATE_IDLE:
-    if (drv->cmd.law != drv->ctrl.law && drv->cmd.law != drv->law_refused) {
+    /* a pending set first: it initialises the commanded law itself (the
+     * switch was validated against that set, not the one in force) */
+    if (drv->cmd.law != drv->ctrl.law && drv->cmd.law != drv->law_refused && !drv->cfg_pending) {
       drive_select_law(drv);
     }
     if (enable && !drv->safe.asc) { /* the short first ends (drive_safe.c) */

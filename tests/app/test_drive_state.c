@@ -484,6 +484,38 @@ static void law_change_waits_for_gates_off(void **state) {
   assert_int_equal(drv.ctrl.law, DRIVE_LAW_PI_DFVC);
 }
 
+/* A law switch validated against a set that waits (written in a fault or
+ * under the short) is made with that set, not the one in force: it is never
+ * refused later (issue 22, point 4). */
+static void law_switch_waits_for_the_pending_set(void **state) {
+  (void)state;
+  drive_config_t cfg;
+  drive_config_default(&cfg);
+  cfg.law = DRIVE_LAW_FOC;
+  cfg.vsd_max = 0.0f; /* FOC runs it; the DFVC laws refuse it */
+  setup_with(&cfg);
+  sample(0.0f, 0.0f, 0.0f, 310.0f);
+  run_isrs(2);
+  drive_request_fault(&drv, DRIVE_FAULT_CONTROL);
+  run_isrs(2);
+  assert_int_equal(drive_params_set(&drv, drive_params_by_name("vsd_max")->id, 60.0f, NULL),
+                   DRIVE_PARAM_OK);
+  assert_null(drive_cmd_set_law(&drv, DRIVE_LAW_DB_DFVC)); /* valid with the set requested */
+  drv.safe.asc = true; /* the short still holds after the clear (a spinning rotor) */
+  drive_cmd_clear_fault(&drv);
+  drive_isr(&drv);
+  assert_int_equal(drv.state, DRIVE_STATE_IDLE);
+  assert_true(drv.cfg_pending);
+  assert_int_equal(drv.faults, 0u);
+  assert_int_equal(drv.ctrl.law, DRIVE_LAW_FOC); /* waits with the set */
+  drv.safe.asc = false;                          /* the short ends */
+  run_isrs(2);
+  assert_int_equal(drv.faults, 0u);
+  assert_false(drv.cfg_pending);
+  assert_int_equal(drv.ctrl.law, DRIVE_LAW_DB_DFVC);
+  assert_float_equal(drv.cfg.vsd_max, 60.0f, 0.0f);
+}
+
 /* Posts a law in the command block without the main loop's validation
  * (what a torn or unvalidated path would hand the ISR). */
 static void post_law_unchecked(drive_law_t law) {
@@ -783,6 +815,7 @@ int main(void) {
                                      cmocka_unit_test(protections_must_fit_the_adc_ranges),
                                      cmocka_unit_test(law_change_waits_for_gates_off),
                                      cmocka_unit_test(refused_law_switch_leaves_the_law_as_it_was),
+                                     cmocka_unit_test(law_switch_waits_for_the_pending_set),
                                      cmocka_unit_test(syr_machine_runs_foc_only),
                                      cmocka_unit_test(parameter_requests_are_applied_by_the_isr),
                                      cmocka_unit_test(watchdog_needs_both_contexts),

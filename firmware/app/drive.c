@@ -744,7 +744,8 @@ static void drive_publish(drive_t *drv, const hal_sample_t *s, const float i[3])
   tm->pos_health = drv->pos.out.health;
   tm->load_est = drv->pos.out.load;
   tm->cmd_seq = drv->cmd.seq;
-  tm->cmd_enabled = (drv->cmd.enable != 0u && drv->armed) ? 1u : 0u;
+  tm->cmd_enabled =
+      (drv->cmd.enable != 0u && drv->armed && drv->state != DRIVE_STATE_FAULT) ? 1u : 0u;
   if (drv->state != DRIVE_STATE_RUN) {
     tm->theta_e = drv->pos.out.theta;
   }

@@ -87,8 +87,9 @@ typedef struct {
   float load_est;        /* position source's load torque estimate (Kalman filter) [N m] */
   uint32_t lc_cause;     /* DRIVE_LC_* that tripped lost_control */
   uint32_t cmd_seq;      /* last command block taken (drive_cmd_t.seq) */
-  uint32_t cmd_enabled;  /* 1: the enable in force (commanded, and armed: posted after the
-                            last trip and the last clear that cleared a fault) */
+  uint32_t cmd_enabled;  /* 1: the enable in force (commanded, armed: posted after the
+                            last trip and the last clear that cleared a fault, and no
+                            fault latched) */
   ctrl_telemetry_t law_tm;
   uint32_t isr_count_end; /* ... and last: equal to isr_count in a consistent copy */
 } drive_telemetry_t;

@@ -11,6 +11,7 @@
 
 #include <cmocka.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -578,77 +579,52 @@ static void status_ticks(unsigned n) {
 }
 
 /* The enable / clear / keep state machine over CAN (docs/can.md, "Enable
- * and clear"; issue 22, point 6), with STATUS as the host sees it. */
+ * and clear"; issue 22, point 6), every transition of its table in one
+ * sequence, with STATUS (state, cmd_enabled) as the host sees it. */
 static void test_enable_clear_keep_over_can(void **state) {
   (void)state;
+  enum { K = CAN_KEEP, RUN = DRIVE_STATE_RUN, IDLE = DRIVE_STATE_IDLE, FLT = DRIVE_STATE_FAULT };
+  static const struct {
+    bool trip;          /* the main loop posts a fault first */
+    unsigned en, clear; /* the CMD_STATE frame (en K and clear 0: none) */
+    int state, enabled; /* STATUS 40 slow periods later */
+  } steps[] = {
+      {false, 1, 0, RUN, 1},  /* idle, armed + enable: runs */
+      {false, K, 1, RUN, 1},  /* running + {keep, clear}: nothing changes */
+      {false, 1, 1, RUN, 1},  /* running + {1, clear}: nothing changes */
+      {true, K, 0, FLT, 0},   /* a trip: the enable is no longer in force */
+      {false, 1, 1, RUN, 1},  /* fault + {1, clear}: restarts (the enable after the clear) */
+      {true, K, 1, IDLE, 0},  /* fault + {keep, clear}: idle, not armed, and stays so */
+      {false, 1, 0, RUN, 1},  /* ... until an enable = 1 (no enable = 0 needed) */
+      {true, 1, 0, FLT, 0},   /* fault + enable without a clear: still the fault */
+      {false, K, 1, IDLE, 0}, /* ... and that enable does not count after the clear */
+      {false, 1, 0, RUN, 1},  {true, 0, 1, IDLE, 0},  /* fault + {0, clear}: idle, not armed */
+      {false, 1, 0, RUN, 1},  {false, 0, 0, IDLE, 0}, /* running + enable = 0: idle */
+      {false, 0, 1, IDLE, 0},                         /* idle + {0, clear}: nothing */
+      {false, K, 0, IDLE, 0},                         /* keep: nothing */
+  };
   rig_init();
   rig.p.cfg.period_ms[CAN_PERIOD_STATUS] = 1u;
-  g_cmd_enabled = g_state = -1;
-  push_state(1, 0, CAN_KEEP, CAN_KEEP);
-  status_ticks(40);
-  assert_int_equal(g_state, DRIVE_STATE_RUN);
-  assert_int_equal(g_cmd_enabled, 1);
-  /* running + {keep, clear}: still running (it disabled the drive) */
-  push_state(CAN_KEEP, 1, CAN_KEEP, CAN_KEEP);
-  status_ticks(5);
-  assert_int_equal(g_state, DRIVE_STATE_RUN);
-  assert_int_equal(g_cmd_enabled, 1);
-  assert_true(rig.hal.gates_on);
-  /* a trip, then {enable 1, clear 1}: answered ok and it restarts */
-  drive_request_fault(&rig.drv, DRIVE_FAULT_CONTROL);
-  status_ticks(2);
-  assert_int_equal(g_state, DRIVE_STATE_FAULT);
-  assert_int_equal(g_cmd_enabled, 0);
-  push_state(1, 1, CAN_KEEP, CAN_KEEP);
-  slow_tick();
-  reply_t r[64];
-  assert_int_equal(pop_replies(r, 64, NULL), 1);
-  assert_int_equal(r[0].result, CAN_RESULT_OK);
-  status_ticks(40);
-  assert_int_equal(g_state, DRIVE_STATE_RUN);
-  assert_int_equal(g_cmd_enabled, 1);
-  /* a trip, then {keep, clear}: idle, not enabled, and it stays so */
-  drive_request_fault(&rig.drv, DRIVE_FAULT_CONTROL);
-  status_ticks(2);
-  push_state(CAN_KEEP, 1, CAN_KEEP, CAN_KEEP);
-  status_ticks(40);
-  assert_int_equal(g_state, DRIVE_STATE_IDLE);
-  assert_int_equal(g_cmd_enabled, 0);
-  assert_false(rig.hal.gates_on);
-  /* then enable = 1 alone starts it (no enable = 0 needed) */
-  push_state(1, 0, CAN_KEEP, CAN_KEEP);
-  status_ticks(40);
-  assert_int_equal(g_state, DRIVE_STATE_RUN);
-  /* a trip, enable = 1 without a clear: still the fault; a clear alone then
-   * leaves it idle (that enable came before the clear) */
-  drive_request_fault(&rig.drv, DRIVE_FAULT_CONTROL);
-  status_ticks(2);
-  push_state(1, 0, CAN_KEEP, CAN_KEEP);
-  status_ticks(10);
-  assert_int_equal(g_state, DRIVE_STATE_FAULT);
-  push_state(CAN_KEEP, 1, CAN_KEEP, CAN_KEEP);
-  status_ticks(40);
-  assert_int_equal(g_state, DRIVE_STATE_IDLE);
-  assert_int_equal(g_cmd_enabled, 0);
-  /* a trip, then {enable 0, clear 1}: idle, not enabled; enable = 1 starts */
-  push_state(1, 0, CAN_KEEP, CAN_KEEP);
-  status_ticks(40);
-  assert_int_equal(g_state, DRIVE_STATE_RUN);
-  drive_request_fault(&rig.drv, DRIVE_FAULT_CONTROL);
-  status_ticks(2);
-  push_state(0, 1, CAN_KEEP, CAN_KEEP);
-  status_ticks(10);
-  assert_int_equal(g_state, DRIVE_STATE_IDLE);
-  assert_int_equal(g_cmd_enabled, 0);
-  push_state(1, 0, CAN_KEEP, CAN_KEEP);
-  status_ticks(40);
-  assert_int_equal(g_state, DRIVE_STATE_RUN);
-  /* enable = 0: idle; {0, clear} in idle: nothing; keep: nothing */
-  push_state(0, 1, CAN_KEEP, CAN_KEEP);
-  push_state(CAN_KEEP, 0, CAN_KEEP, CAN_KEEP);
-  status_ticks(10);
-  assert_int_equal(g_state, DRIVE_STATE_IDLE);
-  assert_int_equal(g_cmd_enabled, 0);
+  for (size_t n = 0; n < sizeof steps / sizeof steps[0]; ++n) {
+    if (steps[n].trip) {
+      drive_request_fault(&rig.drv, DRIVE_FAULT_CONTROL);
+      status_ticks(2);
+      assert_int_equal(g_state, FLT);
+    }
+    if (steps[n].en != K || steps[n].clear != 0u) {
+      push_state(steps[n].en, steps[n].clear, K, K);
+      slow_tick();
+      reply_t r[64];
+      assert_int_equal(pop_replies(r, 64, NULL), 1);
+      assert_int_equal(r[0].result, CAN_RESULT_OK);
+    }
+    g_cmd_enabled = g_state = -1;
+    status_ticks(40);
+    printf("step %zu: state %d, cmd_enabled %d\n", n, g_state, g_cmd_enabled);
+    assert_int_equal(g_state, steps[n].state);
+    assert_int_equal(g_cmd_enabled, steps[n].enabled);
+    assert_true(rig.hal.gates_on == (steps[n].state == RUN));
+  }
 }
 
 /* Every main-loop fault request survives a clear frame in the same slow

@@ -402,7 +402,8 @@ static void send_periodic(can_proto_t *p, can_period_t which, const drive_t *drv
     can_codec_set(CAN_SIG_V_DC, f.data, tm->v_dc);
     can_codec_set_raw(CAN_SIG_TIMEOUT_RAMP, f.data, p->ramp ? 1u : 0u);
     /* the enable in force as the ISR holds it (armed), not the level posted */
-    can_codec_set_raw(CAN_SIG_CMD_ENABLED, f.data, tm->cmd_enabled);
+    can_codec_set_raw(CAN_SIG_CMD_ENABLED, f.data,
+                      drive_enable_in_force(tm, drive_commands(drv)) ? 1u : 0u);
     can_codec_set_raw(CAN_SIG_ERR_COUNT, f.data, p->stats.rx_errors & 0xFFu);
     p->st_state = tm->state;
     p->st_faults = tm->faults;

@@ -48,6 +48,7 @@ static FD_NOINLINE void drive_trip(drive_t *drv, uint32_t bits) {
    * clear: only one posted after this trip does (docs/can.md, "Enable and
    * clear") */
   drv->armed = false;
+  drv->tm.armed = 0u;
   drv->arm_mark = drv->cmd.enable_count;
 }
 
@@ -277,6 +278,7 @@ FD_COLD int drive_init(drive_t *drv, const drive_config_t *cfg, drive_config_err
   drv->cmd.law = cfg->law;
   drv->cmd.mode = cfg->mode;
   drv->armed = true;
+  drv->tm.armed = 1u;
   drv->req.cmd = drv->cmd;
   drv->creq.cfg = *cfg;
   if (hal_reset_by_watchdog()) {
@@ -365,6 +367,7 @@ static void take_commands(drive_t *drv) {
       drv->faults = 0u;
       drv->state = DRIVE_STATE_IDLE;
       drv->armed = false; /* an enable posted after the clear is needed */
+      drv->tm.armed = 0u;
       drv->arm_mark = drv->cmd.clear_enable_mark;
     }
   }
@@ -744,8 +747,6 @@ static void drive_publish(drive_t *drv, const hal_sample_t *s, const float i[3])
   tm->pos_health = drv->pos.out.health;
   tm->load_est = drv->pos.out.load;
   tm->cmd_seq = drv->cmd.seq;
-  tm->cmd_enabled =
-      (drv->cmd.enable != 0u && drv->armed && drv->state != DRIVE_STATE_FAULT) ? 1u : 0u;
   if (drv->state != DRIVE_STATE_RUN) {
     tm->theta_e = drv->pos.out.theta;
   }
@@ -780,8 +781,9 @@ void drive_isr(drive_t *drv) {
   if (f != 0u) {
     drive_trip(drv, f);
   }
-  if (drv->cmd.enable_count != drv->arm_mark) {
+  if (!drv->armed && drv->cmd.enable_count != drv->arm_mark) {
     drv->armed = true; /* an enable command since the last disarm */
+    drv->tm.armed = 1u;
   }
   const bool enable = drv->cmd.enable && drv->armed;
 

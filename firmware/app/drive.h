@@ -87,9 +87,8 @@ typedef struct {
   float load_est;        /* position source's load torque estimate (Kalman filter) [N m] */
   uint32_t lc_cause;     /* DRIVE_LC_* that tripped lost_control */
   uint32_t cmd_seq;      /* last command block taken (drive_cmd_t.seq) */
-  uint32_t cmd_enabled;  /* 1: the enable in force (commanded, armed: posted after the
-                            last trip and the last clear that cleared a fault, and no
-                            fault latched) */
+  uint32_t armed;        /* drive_t.armed, written where it changes (a trip, a clear that
+                            cleared a fault, an enable command after them) */
   ctrl_telemetry_t law_tm;
   uint32_t isr_count_end; /* ... and last: equal to isr_count in a consistent copy */
 } drive_telemetry_t;
@@ -260,6 +259,13 @@ void drive_machine_copy(machine_t *dm, flux_map_t *dmap, const machine_t *m, con
  * period. */
 static inline bool drive_state_enabled(drive_state_t s) {
   return s == DRIVE_STATE_OFFSET_CAL || s == DRIVE_STATE_RUN || s == DRIVE_STATE_ALIGN;
+}
+
+/* The enable in force as the main loop sees it (STATUS.cmd_enabled): an
+ * enable command posted after the last trip and after the last clear that
+ * cleared a fault (tm->armed), and no fault latched. */
+static inline bool drive_enable_in_force(const drive_telemetry_t *tm, const drive_cmd_t *c) {
+  return c->enable != 0u && tm->armed != 0u && tm->state != DRIVE_STATE_FAULT;
 }
 
 /* The PWM-period interrupt body. Bounded time, never blocks. */

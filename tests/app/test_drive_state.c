@@ -160,6 +160,11 @@ static void clear_racing_a_trip_stays_safe(void **state) {
   assert_int_equal(drv.state, DRIVE_STATE_FAULT);
 }
 
+/* STATUS.cmd_enabled as the main loop would send it now. */
+static int enabled_in_force(void) {
+  return drive_enable_in_force(&drv.tm, &drv.cmd) ? 1 : 0;
+}
+
 /* A clear clears only the faults latched before it: a request the ISR has
  * not seen latches, whether posted before or after the clear in the same
  * period (issue 22, point 3: a flood of clears swallowed the main loop's
@@ -212,23 +217,23 @@ static void enable_clear_keep_transitions(void **state) {
   run_isrs(5);
   assert_int_equal(drv.state, DRIVE_STATE_RUN);
   assert_true(hal.gates_on);
-  assert_int_equal(drv.tm.cmd_enabled, 1);
+  assert_int_equal(enabled_in_force(), 1);
   /* trip: the enable level stays 1 but is no longer in force */
   drive_request_fault(&drv, DRIVE_FAULT_CONTROL);
   drive_isr(&drv);
   assert_int_equal(drv.state, DRIVE_STATE_FAULT);
-  assert_int_equal(drv.tm.cmd_enabled, 0);
+  assert_int_equal(enabled_in_force(), 0);
   /* clear alone: idle, and it stays idle (the enable was posted before) */
   drive_cmd_clear_fault(&drv);
   run_isrs(100);
   assert_int_equal(drv.state, DRIVE_STATE_IDLE);
-  assert_int_equal(drv.tm.cmd_enabled, 0);
+  assert_int_equal(enabled_in_force(), 0);
   assert_false(hal.gates_on);
   /* a later enable = 1 (without a 0 first) starts it */
   drive_cmd_enable(&drv, true);
   run_isrs(drv.cfg.offset_samples + 2);
   assert_int_equal(drv.state, DRIVE_STATE_RUN);
-  assert_int_equal(drv.tm.cmd_enabled, 1);
+  assert_int_equal(enabled_in_force(), 1);
   /* trip, then clear and enable in one step (one CMD_STATE frame): restarts */
   drive_request_fault(&drv, DRIVE_FAULT_CONTROL);
   drive_isr(&drv);
@@ -252,7 +257,7 @@ static void enable_clear_keep_transitions(void **state) {
   drive_cmd_enable(&drv, false);
   run_isrs(3);
   assert_int_equal(drv.state, DRIVE_STATE_IDLE);
-  assert_int_equal(drv.tm.cmd_enabled, 0);
+  assert_int_equal(enabled_in_force(), 0);
   drive_cmd_enable(&drv, true);
   run_isrs(drv.cfg.offset_samples + 2);
   assert_int_equal(drv.state, DRIVE_STATE_RUN);

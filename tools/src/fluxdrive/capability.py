@@ -137,11 +137,13 @@ def corner_speeds(cap: Capability, m: Machine, lim: Limits) -> dict:
 
 def _map_table(cfg: dict, rpm: np.ndarray) -> int:
     """The capability of a flux-map machine (fluxmap/capability.py)."""
+    from argparse import Namespace
+
     from .fluxmap.cli import _load
     from .fluxmap.capability import map_capability
 
     m, c = cfg["machine"], cfg["controller"]
-    fm = _load(None, m["map"])
+    fm = _load(Namespace(i_max=c["i_max"]), m["map"])  # the map's current unit against i_max
     rows = map_capability(fm, m["rs"], c["i_max"], cfg["v_dc"], c["v_margin"], c["torque_max"],
                           rpm * np.pi / 30.0)
     print(f"flux map {m['map']} ({fm.pole_pairs} pole pairs), i_max {c['i_max']:.3f} A, "

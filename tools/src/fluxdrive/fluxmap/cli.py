@@ -29,7 +29,9 @@ def _load(args, file: str):
         return FluxMap(b["i_d"], b["i_q"], b["psi_d"].astype(float), b["psi_q"].astype(float),
                        int(b["pole_pairs"]), Path(file).stem, ["read from a .fdmap blob"])
     return io.load(file, getattr(args, "convention", None), getattr(args, "mirror", False),
-                   getattr(args, "pole_pairs", None))
+                   getattr(args, "pole_pairs", None), getattr(args, "flux_unit", None),
+                   getattr(args, "current_unit", None), getattr(args, "i_max", None),
+                   getattr(args, "v_dc", None), getattr(args, "speed", None))
 
 
 def cmd_check(args) -> int:
@@ -81,12 +83,23 @@ def add_parser(sub) -> None:
     p = sub.add_parser("map", help="flux maps of saturated machines (docs/flux-maps.md)")
     ms = p.add_subparsers(dest="map_cmd", required=True)
 
-    def load_opts(q):
+    def load_opts(q, plot=False):
         q.add_argument("--convention", choices=("fluxdrive", "syr"),
                        help="axis convention of the file (default: the file's, else fluxdrive)")
         q.add_argument("--mirror", action="store_true",
                        help="complete a map of i_q >= 0 (fluxdrive frame) by symmetry")
         q.add_argument("--pole-pairs", type=int, help="pole pairs (default: the file's)")
+        q.add_argument("--flux-unit", choices=("Vs", "mVs"),
+                       help="unit of the file's flux linkages (default: the file's, else Vs)")
+        q.add_argument("--current-unit", choices=("A", "mA"),
+                       help="unit of the file's currents (default: the file's, else A)")
+        q.add_argument("--i-max", type=float, metavar="A",
+                       help="the machine's current limit (peak): checks the map's current unit")
+        q.add_argument("--speed", type=float, metavar="RPM",
+                       help="rated (or top) speed: with --v-dc checks the flux unit")
+        if not plot:
+            q.add_argument("--v-dc", type=float, metavar="V",
+                           help="DC link: with --speed checks the flux unit")
 
     q = ms.add_parser("check", help="validate and summarise a map")
     q.add_argument("file", metavar="FILE")
@@ -112,7 +125,7 @@ def add_parser(sub) -> None:
     q.add_argument("file", metavar="FILE")
     q.add_argument("-o", "--output", required=True, metavar="DIR")
     q.add_argument("--v-dc", type=float, help="DC link for the voltage-limit curves [V]")
-    load_opts(q)
+    load_opts(q, plot=True)
     q.set_defaults(func=_guard(cmd_plot))
     q = ms.add_parser("doc", help="the generated part of docs/flux-maps.md")
     q.add_argument("--file", default=str(REPO / "docs" / "flux-maps.md"))

@@ -44,16 +44,24 @@ class Tables:
     # the MTPV trajectory (plots): the current of the largest torque at each flux
     mtpv_id: np.ndarray | None = None
     mtpv_iq: np.ndarray | None = None
+    # the MTPA at the grid's i_d edge with the torque still rising beyond it:
+    # (amplitude, relative slope per rad, edge i_d), else None (validate.check_tables)
+    edge: tuple | None = None
 
 
-def _best_angles(m: FluxMap, amp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _best_angles(m: FluxMap, amp: np.ndarray,
+                 th_min: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Angle theta (i = a (cos, sin), sin >= 0) of the largest torque at each
-    amplitude: a dense sweep, then golden-section refinement (vectorised)."""
+    amplitude over theta >= th_min (the angles inside the grid's i_d):
+    a dense sweep, then golden-section refinement (vectorised)."""
+    if th_min is None:
+        th_min = np.zeros_like(amp)
     th = np.linspace(0.0, np.pi, 721)
     A, TH = np.meshgrid(amp, th, indexing="ij")
-    t = m.torque_smooth(A * np.cos(TH), A * np.sin(TH))
+    t = np.where(TH >= th_min[:, None], m.torque_smooth(A * np.cos(TH), A * np.sin(TH)), -np.inf)
     k = np.argmax(t, axis=1)
-    lo, hi = th[np.maximum(k - 1, 0)], th[np.minimum(k + 1, len(th) - 1)]
+    lo = np.maximum(th[np.maximum(k - 1, 0)], th_min)
+    hi = np.maximum(th[np.minimum(k + 1, len(th) - 1)], th_min)
     g = 0.5 * (np.sqrt(5.0) - 1.0)
     for _ in range(40):
         x1, x2 = hi - g * (hi - lo), lo + g * (hi - lo)
@@ -66,15 +74,45 @@ def _best_angles(m: FluxMap, amp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def mtpa_amp_max(m: FluxMap) -> float:
-    """The largest amplitude whose half circle i_q >= 0 lies in the grid."""
-    return float(min(-m.i_d[0], m.i_d[-1], m.i_q[-1]))
+    """The largest amplitude whose quarter circle i_d <= 0, i_q >= 0 lies in
+    the grid (the MTPA of a machine with the PM on +d and L_q >= L_d; a
+    grid of i_d <= 0 only is enough; 0 when the grid has no i_d <= 0)."""
+    return float(max(0.0, min(-m.i_d[0], m.i_q[-1]))) if m.i_d[-1] >= -1e-9 * m.did else 0.0
+
+
+def _edge(m: FluxMap, amp, ang, th_min, tor):
+    """Where the optimum sits on the i_d edge (th_min > 0) with the torque
+    still rising beyond it by more than EDGE_SLOPE per rad: the worst
+    (amplitude, relative slope, edge i_d), else None."""
+    from .validate import EDGE_SLOPE
+
+    h = 1e-3
+    on = (th_min > 0) & (ang - th_min < np.pi / 720) & (tor > 0)
+    if not np.any(on):
+        return None
+    a, t0 = amp[on], th_min[on]
+    g0 = m.torque_smooth(a * np.cos(t0), a * np.sin(t0))
+    g1 = m.torque_smooth(a * np.cos(t0 + h), a * np.sin(t0 + h))
+    rise = (g0 - g1) / h / np.maximum(np.abs(g0), 1e-300)  # towards smaller theta (larger i_d)
+    k = int(np.argmax(rise))
+    return (float(a[k]), float(rise[k]), float(m.i_d[-1])) if rise[k] > EDGE_SLOPE else None
 
 
 def tables(m: FluxMap, n: int = N_LUT) -> Tables:
+    key = ("tables", n)
+    if key not in m.cache:
+        m.cache[key] = _tables(m, n)
+    return m.cache[key]
+
+
+def _tables(m: FluxMap, n: int) -> Tables:
     amax = mtpa_amp_max(m)
     amp = np.linspace(0.0, amax, 161)
-    ang, tor = _best_angles(m, amp)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        th_min = np.arccos(np.clip(np.where(amp > 0, m.i_d[-1] / amp, 1.0), -1.0, 1.0))
+    ang, tor = _best_angles(m, amp, th_min)
     ang[0], tor[0] = ang[1], 0.0
+    edge = _edge(m, amp, ang, th_min, tor)
     tor = np.maximum.accumulate(tor)
     ad, aq = amp * np.cos(ang), amp * np.sin(ang)
     t_max = float(tor[-1])
@@ -101,7 +139,7 @@ def tables(m: FluxMap, n: int = N_LUT) -> Tables:
     rows = np.arange(n)
     v_id, v_iq = i_d[rows, best], i_q[rows, best]
     tv = np.maximum.accumulate(np.maximum(tq.max(axis=1), 0.0))
-    return Tables(t_max, m_id, m_iq, m_flux, l_max, tv, amp, ad, aq, tor, v_id, v_iq)
+    return Tables(t_max, m_id, m_iq, m_flux, l_max, tv, amp, ad, aq, tor, v_id, v_iq, edge)
 
 
 def current_smooth(m: FluxMap, ld, lq, iters: int = 16):

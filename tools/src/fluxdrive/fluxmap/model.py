@@ -19,6 +19,7 @@ class FluxMap:
     pole_pairs: int
     name: str = "map"
     notes: list[str] = field(default_factory=list)  # what was done on load (mirror, ...)
+    cache: dict = field(default_factory=dict, repr=False, compare=False)  # tables (luts)
 
     @property
     def nd(self) -> int:

@@ -86,7 +86,8 @@ def add_parser(sub) -> None:
                        help="axis convention of the file (default: the file's, else fluxdrive)")
         q.add_argument("--mirror", action="store_true",
                        help="complete a map of i_q >= 0 (fluxdrive frame) by symmetry")
-        q.add_argument("--pole-pairs", type=int, help="pole pairs (default: the file's)")
+        q.add_argument("--pole-pairs", type=int,
+                       help="pole pairs, for a file without them (a file's own must agree)")
 
     q = ms.add_parser("check", help="validate and summarise a map")
     q.add_argument("file", metavar="FILE")

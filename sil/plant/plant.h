@@ -38,6 +38,10 @@ typedef struct {
   double m0, m2; /* [H] */
   double phi_iq; /* [rad/A] */
   double amp_iq; /* [1/A] */
+  /* the range of the load scale 1 + amp_iq |i_q| the plant uses (clamped
+   * to it) and plant_aniso_ok checks; 0: 0.5 .. 2 (the scenario parser
+   * sets it from the current the plant may carry, controller.i_trip) */
+  double k_min, k_max;
 } plant_aniso_t;
 
 typedef struct {

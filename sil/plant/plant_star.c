@@ -46,21 +46,34 @@ static void star_matrix_of(double l0, double l2, double m0, double m2, double x,
   }
 }
 
+/* The load scale's range: the machine's (plant_aniso_t), else the default. */
+static void star_k_range(const plant_aniso_t *an, double *lo, double *hi) {
+  *lo = an->k_min > 0.0 ? an->k_min : STAR_K_MIN;
+  *hi = an->k_max > 0.0 ? an->k_max : STAR_K_MAX;
+}
+
 /* at x = 2 theta_e + phi_iq i_q, the 2theta terms scaled by the load */
 static void star_matrix(const plant_t *pl, double x, double i_q, double L[3][3], double dL[3][3]) {
   const plant_aniso_t *an = &pl->p.machine.aniso;
-  double k = 1.0 + an->amp_iq * fabs(i_q);
-  k = k < STAR_K_MIN ? STAR_K_MIN : (k > STAR_K_MAX ? STAR_K_MAX : k);
+  double k = 1.0 + an->amp_iq * fabs(i_q), lo, hi;
+  star_k_range(an, &lo, &hi);
+  k = k < lo ? lo : (k > hi ? hi : k);
   star_matrix_of(pl->aux.l0, k * pl->aux.l2, an->m0, k * an->m2, x, L, dL);
 }
 
 /* The matrix from (ld, lq, m0, m2) must be an inductance matrix: positive
  * definite at every angle (leading minors, checked every degree of 2
- * theta_e), and carry the position (L2 != M2, first condition of (3.7)). */
+ * theta_e), and carry the position (L2 != M2, first condition of (3.7)).
+ * With a load scale, at both ends of its range (the matrix is linear in
+ * the scale: positive definite at both ends is positive definite
+ * between). */
 int plant_aniso_ok(const plant_machine_t *m) {
   const double m0 = m->aniso.m0, m2 = m->aniso.m2;
+  double k_lo, k_hi;
+  star_k_range(&m->aniso, &k_lo, &k_hi);
   if (!(isfinite(m0) && isfinite(m2) && fabs(m->aniso.phi_iq) < 10.0 && m->aniso.amp_iq >= -0.5 &&
-        m->aniso.amp_iq <= 1.0)) {
+        m->aniso.amp_iq <= 1.0 && k_lo >= STAR_K_MIN && k_lo <= 1.0 && k_hi >= 1.0 &&
+        k_hi <= STAR_K_MAX)) {
     return 0;
   }
   const double l0 = 0.5 * (m->ld + m->lq) + m0, l2 = (m->ld - m->lq) - 2.0 * m2;
@@ -68,7 +81,7 @@ int plant_aniso_ok(const plant_machine_t *m) {
     return 0;
   }
   for (int k = 0; k < 3 * 360; k++) {
-    const double sc = (k / 360 == 0) ? 1.0 : (k / 360 == 1 ? STAR_K_MIN : STAR_K_MAX);
+    const double sc = (k / 360 == 0) ? 1.0 : (k / 360 == 1 ? k_lo : k_hi);
     if (sc != 1.0 && !(fabs(m->aniso.amp_iq) > 0.0)) {
       break; /* no load scaling */
     }

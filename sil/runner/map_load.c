@@ -58,7 +58,8 @@ static const char *python(void) {
 
 /* .npz / .csv -> a temporary .fdmap through the map tool; the tool's own
  * message (file, check, cell) on failure. */
-static int convert(const char *src, char *tmp, size_t tmpn, char *err, size_t errlen) {
+static int convert(const char *src, int pole_pairs, char *tmp, size_t tmpn, char *err,
+                   size_t errlen) {
   if (strchr(src, '\'') != NULL) {
     snprintf(err, errlen, "%s: a map path may not contain a quote", src);
     return -1;
@@ -70,8 +71,12 @@ static int convert(const char *src, char *tmp, size_t tmpn, char *err, size_t er
     return -1;
   }
   close(fd);
-  char cmd[2048];
-  snprintf(cmd, sizeof cmd, "'%s' -m fluxdrive map convert '%s' -o '%s' 2>&1", python(), src, tmp);
+  char cmd[2048], pp[32] = "";
+  if (pole_pairs > 0) {
+    snprintf(pp, sizeof pp, " --pole-pairs %d", pole_pairs);
+  }
+  snprintf(cmd, sizeof cmd, "'%s' -m fluxdrive map convert '%s' -o '%s'%s 2>&1", python(), src, tmp,
+           pp);
   FILE *p = popen(cmd, "r");
   char out[512] = "";
   size_t got = 0;
@@ -208,7 +213,8 @@ void map_load_release(map_load_t *e) {
   memset(e, 0, sizeof *e);
 }
 
-const map_load_t *map_load(const char *file, const char *origin, char *err, size_t errlen) {
+const map_load_t *map_load(const char *file, const char *origin, int pole_pairs, char *err,
+                           size_t errlen) {
   char path[512];
   if (resolve(file, origin, path, sizeof path) != 0) {
     snprintf(err, errlen,
@@ -217,8 +223,10 @@ const map_load_t *map_load(const char *file, const char *origin, char *err, size
              file);
     return NULL;
   }
+  const int tool = ends_with(path, ".npz") || ends_with(path, ".csv");
+  const int pp_asked = tool && pole_pairs > 0 ? pole_pairs : 0; /* a blob has its own */
   for (int k = 0; k < n_loaded; ++k) {
-    if (strcmp(loaded[k].path, path) == 0) {
+    if (strcmp(loaded[k].path, path) == 0 && loaded[k].pole_pairs_asked == pp_asked) {
       return &loaded[k];
     }
   }
@@ -226,13 +234,12 @@ const map_load_t *map_load(const char *file, const char *origin, char *err, size
     snprintf(err, errlen, "%s: more than %d map files in one process", file, MAP_LOAD_MAX);
     return NULL;
   }
-  const int tool = ends_with(path, ".npz") || ends_with(path, ".csv");
   if (!tool && !ends_with(path, ".fdmap")) {
     snprintf(err, errlen, "%s: unknown map format (.fdmap, .npz, .csv)", file);
     return NULL;
   }
   char tmp[64] = "";
-  if (tool && convert(path, tmp, sizeof tmp, err, errlen) != 0) {
+  if (tool && convert(path, pp_asked, tmp, sizeof tmp, err, errlen) != 0) {
     return NULL;
   }
   map_load_t *e = &loaded[n_loaded];
@@ -249,6 +256,7 @@ const map_load_t *map_load(const char *file, const char *origin, char *err, size
     return NULL;
   }
   snprintf(e->path, sizeof e->path, "%s", path);
+  e->pole_pairs_asked = pp_asked;
   n_loaded++;
   return e;
 }

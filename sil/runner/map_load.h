@@ -30,14 +30,19 @@ typedef struct {
   char path[512];         /* the file as resolved */
   const uint32_t *words;  /* the blob (the drive's machine_map) */
   uint32_t size;          /* its bytes */
+  int pole_pairs_asked;   /* the pole pairs given the map tool (0: the file's) */
   flux_map_t map;         /* parsed (for the runner's own use) */
   plant_fluxmap_t *plant; /* the plant's map */
 } map_load_t;
 
 /* Loads (or finds loaded) the map `file` of a scenario read from `origin`
- * (a path, or a name without folder). NULL with a message in err (naming
- * the file, the check and the grid cell) on failure. */
-const map_load_t *map_load(const char *file, const char *origin, char *err, size_t errlen);
+ * (a path, or a name without folder). pole_pairs > 0: the scenario's, given
+ * the map tool for a .npz / .csv (`--pole-pairs`: a file without them takes
+ * them, a file with others is refused naming both); a .fdmap has its own
+ * (the caller compares). NULL with a message in err (naming the file, the
+ * check and the grid cell) on failure. */
+const map_load_t *map_load(const char *file, const char *origin, int pole_pairs, char *err,
+                           size_t errlen);
 
 /* The same checks, parse and plant map for a file's contents in memory (n
  * bytes), into *e without the cache (e->path empty); 0, or -1 with a

@@ -21,6 +21,9 @@
 #include "presets.h"
 
 #define PI 3.14159265358979323846
+/* star_tau at most this share of the sample's settling time (dfc_t_meas -
+ * dead time): measured on the fabbri2022 presets, docs/dfc.md */
+#define STAR_TAU_SHARE 0.2
 
 typedef struct {
   char *err;
@@ -28,6 +31,9 @@ typedef struct {
   const char *origin;
   int failed;
   int ls_given; /* machine.ls set both inductances (for the error's key) */
+  /* the machine key that set the star point's p = b/a (3.7) the drive's
+   * dfc_b follows, when controller.dfc_b is not given ("" otherwise) */
+  char p_key[32];
 } ctx_t;
 
 static void utf8_clean(char *s);
@@ -39,7 +45,7 @@ static int fail(ctx_t *c, const char *path, const char *fmt, ...) {
     return -1;
   }
   c->failed = 1;
-  char reason[256];
+  char reason[400];
   va_list ap;
   va_start(ap, fmt);
   /* the analyzer misses va_start on this path (LLVM 14) */
@@ -306,18 +312,41 @@ static int get_profile(ctx_t *c, const cJSON *obj, const char *path, const char 
 
 /* ---- sections ---------------------------------------------------------- */
 
-/* A flux map into plant and drive: the pole pairs are the map's. */
-static int use_map(ctx_t *c, const char *key, const char *file, scenario_t *sc) {
+/* A flux map into plant and drive: the pole pairs are the map's; pp > 0,
+ * the scenario's machine.pole_pairs: a map file without them takes them,
+ * one with others is refused naming both. */
+static int use_map(ctx_t *c, const char *key, const char *file, int pp, scenario_t *sc) {
   char why[640];
-  const map_load_t *e = map_load(file, c->origin, why, sizeof why);
+  const map_load_t *e = map_load(file, c->origin, pp, why, sizeof why);
   if (e == NULL) {
+    if (strstr(why, ": pole pairs: ") != NULL) { /* the map tool's check (fluxmap/io.py) */
+      return pp > 0 ? fail(c, "machine.pole_pairs", "%d: %s", pp, why)
+                    : fail(c, "machine.pole_pairs", "required: %s", why);
+    }
     return fail(c, key, "%s", why);
+  }
+  if (pp > 0 && e->map.pole_pairs != (float)pp) {
+    return fail(c, "machine.pole_pairs", "%d, but the map file %s has %g", pp, file,
+                (double)e->map.pole_pairs);
   }
   sc->plant.machine.map = e->plant;
   snprintf(sc->map_file, sizeof sc->map_file, "%s", e->path);
   sc->plant.machine.pole_pairs = (int)e->map.pole_pairs;
   sc->drive.machine_map = e->words;
   return 0;
+}
+
+/* The first star-point key the machine section gives ("machine.star_p",
+ * ...), NULL for none. */
+static const char *star_key_given(const cJSON *m) {
+  static const char *const keys[] = {"machine.star_p", "machine.star_m2", "machine.star_m0",
+                                     "machine.star_amp_iq", "machine.star_phi_iq"};
+  for (size_t k = 0; m != NULL && k < sizeof keys / sizeof keys[0]; ++k) {
+    if (cJSON_GetObjectItemCaseSensitive(m, keys[k] + 8) != NULL) {
+      return keys[k];
+    }
+  }
+  return NULL;
 }
 
 static int parse_machine(ctx_t *c, const cJSON *m, scenario_t *sc) {
@@ -327,6 +356,14 @@ static int parse_machine(ctx_t *c, const cJSON *m, scenario_t *sc) {
   if (check_keys(c, m, "machine", keys) != 0) {
     return -1;
   }
+  /* the scenario's pole pairs first: a map file may need them */
+  double pp_given = 0.0;
+  if (get_param_num(c, m, "machine", "pole_pairs", "pole_pairs", &pp_given) != 0) {
+    return -1;
+  }
+  if (floor(pp_given) != pp_given) {
+    return fail(c, "machine.pole_pairs", "must be an integer (got %g)", pp_given);
+  }
   const cJSON *pre = cJSON_GetObjectItemCaseSensitive(m, "preset");
   if (pre != NULL) {
     const machine_preset_t *p = cJSON_IsString(pre) ? preset_find(pre->valuestring) : NULL;
@@ -334,7 +371,7 @@ static int parse_machine(ctx_t *c, const cJSON *m, scenario_t *sc) {
       return fail(c, "machine.preset", "unknown preset (known: %s)", preset_names());
     }
     preset_apply(p, &sc->plant, &sc->drive);
-    if (p->map != NULL && use_map(c, "machine.preset", p->map, sc) != 0) {
+    if (p->map != NULL && use_map(c, "machine.preset", p->map, (int)pp_given, sc) != 0) {
       return -1;
     }
   }
@@ -343,7 +380,7 @@ static int parse_machine(ctx_t *c, const cJSON *m, scenario_t *sc) {
     if (!cJSON_IsString(map) || map->valuestring[0] == '\0') {
       return fail(c, "machine.map", "must be a file name (.fdmap, .npz, .csv)");
     }
-    if (use_map(c, "machine.map", map->valuestring, sc) != 0) {
+    if (use_map(c, "machine.map", map->valuestring, (int)pp_given, sc) != 0) {
       return -1;
     }
   }
@@ -378,13 +415,9 @@ static int parse_machine(ctx_t *c, const cJSON *m, scenario_t *sc) {
     c->ls_given = 1;
   }
   /* the star point's inductance matrix (3.3), plant.h */
-  const int star = cJSON_GetObjectItemCaseSensitive(m, "star_m0") != NULL ||
-                   cJSON_GetObjectItemCaseSensitive(m, "star_m2") != NULL ||
-                   cJSON_GetObjectItemCaseSensitive(m, "star_phi_iq") != NULL ||
-                   cJSON_GetObjectItemCaseSensitive(m, "star_amp_iq") != NULL ||
-                   cJSON_GetObjectItemCaseSensitive(m, "star_p") != NULL;
-  if (star && sc->plant.machine.map != NULL) {
-    return fail(c, "machine.star_m0", "the star-point model needs a linear machine (no map)");
+  const char *star = star_key_given(m);
+  if (star != NULL && sc->plant.machine.map != NULL) {
+    return fail(c, star, "the star-point model needs a linear machine (no map)");
   }
   if (get_num(c, m, M, "star_m0", -1.0, 1.0, &pm->aniso.m0) ||
       get_num(c, m, M, "star_m2", -1.0, 1.0, &pm->aniso.m2) ||
@@ -410,13 +443,8 @@ static int parse_machine(ctx_t *c, const cJSON *m, scenario_t *sc) {
     pm->lq = g0 - g2;
     pm->aniso.m2 = g2 - 0.5 * l2;
   }
-  if (star) {
-    pm->aniso.enabled = 1;
-    if (!plant_aniso_ok(pm)) {
-      return fail(c, "machine.star_m0",
-                  "with ld, lq and star_m2 the (3.3) matrix is not a positive definite inductance "
-                  "matrix carrying the position (L2 != M2)");
-    }
+  if (star != NULL) {
+    pm->aniso.enabled = 1; /* checked with the whole scenario known (check_star) */
   }
   if (pm->aniso.enabled) { /* the controller's DFC model (3.7), unless set */
     double a, b;
@@ -1116,8 +1144,183 @@ static int resolve_substeps(ctx_t *c, scenario_t *sc) {
   return 0;
 }
 
+/* ---- the star point, with the whole scenario known --------------------- */
+
+/* The key that set the machine's star-point split (Fabbri 2022 (3.3)): the
+ * first of `keys` the machine section gives, else its preset. */
+static const char *machine_key(const cJSON *m, const char *const *keys) {
+  static char out[32];
+  for (int k = 0; keys[k] != NULL; ++k) {
+    if (m != NULL && cJSON_GetObjectItemCaseSensitive(m, keys[k]) != NULL) {
+      snprintf(out, sizeof out, "machine.%s", keys[k]);
+      return out;
+    }
+  }
+  return "machine.preset";
+}
+
+/* star_p's range with L0, M0, L2 kept: the matrix is linear in M2 = p
+ * (L0 - M0) - L2/2, so positive definite on an interval of p (bisection
+ * from p = 0 to either side); 0 when p = 0 itself is not. */
+static int star_p_range(const plant_machine_t *pm, double l2, double *lo, double *hi) {
+  plant_machine_t q = *pm;
+  q.aniso.amp_iq = 0.0;
+  const double g0 = 0.5 * (pm->ld + pm->lq);
+  double ends[2];
+  for (int side = 0; side < 2; ++side) {
+    double ok = 0.0, bad = side == 0 ? -1.0 : 1.0;
+    for (int i = 0; i < 40; ++i) {
+      const double p = 0.5 * (ok + bad);
+      q.ld = g0 * (1.0 + p);
+      q.lq = g0 * (1.0 - p);
+      q.aniso.m2 = p * g0 - 0.5 * l2;
+      if (i == 0) { /* p = 0 first */
+        q.ld = q.lq = g0;
+        q.aniso.m2 = -0.5 * l2;
+        if (!plant_aniso_ok(&q)) {
+          return 0;
+        }
+        q.ld = g0 * (1.0 + p);
+        q.lq = g0 * (1.0 - p);
+        q.aniso.m2 = p * g0 - 0.5 * l2;
+      }
+      if (plant_aniso_ok(&q)) {
+        ok = p;
+      } else {
+        bad = p;
+      }
+    }
+    ends[side] = ok;
+  }
+  *lo = ends[0];
+  *hi = ends[1];
+  return 1;
+}
+
+/* The star point's matrix (3.3) and the drive's model of it: errors name
+ * the key the scenario wrote and the condition (docs/dfc.md). The load
+ * scale is checked up to controller.i_trip, the largest current the plant
+ * carries before the drive trips, and held there (plant_aniso_t.k_max). */
+static int check_star(ctx_t *c, const cJSON *root, scenario_t *sc) {
+  const cJSON *m = cJSON_GetObjectItemCaseSensitive(root, "machine");
+  const cJSON *ctl = cJSON_GetObjectItemCaseSensitive(root, "controller");
+  plant_machine_t *pm = &sc->plant.machine;
+  if (!pm->aniso.enabled) {
+    return 0;
+  }
+  const double g0 = 0.5 * (pm->ld + pm->lq), m0 = pm->aniso.m0, m2 = pm->aniso.m2;
+  const double l0 = g0 + m0, l2 = (pm->ld - pm->lq) - 2.0 * m2, lz = g0 + 3.0 * m0;
+  const int star_p = m != NULL && cJSON_GetObjectItemCaseSensitive(m, "star_p") != NULL;
+  /* the zero-sequence inductance L0 + 2 M0: a star winding's zero-sequence
+   * currents make no fundamental field (leakage and triplen harmonics):
+   * positive, and at most twice (L_d + L_q)/2 (M0 <= (L_d + L_q)/6; Fig.
+   * 3.3's machine: 1.15) */
+  if (!(lz > 0.0 && lz <= 2.0 * g0)) {
+    static const char *const k0[] = {"star_m0", NULL};
+    return fail(c, machine_key(m, k0),
+                "%g H gives the zero-sequence inductance L0 + 2 M0 = (ld + lq)/2 + 3 M0 = %.4g H, "
+                "%.3g times (ld + lq)/2 (%.4g H): a star winding's is leakage and harmonics only, "
+                "in (0, 2] times (M0 in (%.4g, %.4g] H; a unit error?)",
+                m0, lz, lz / g0, g0, -g0 / 3.0, g0 / 3.0);
+  }
+  plant_machine_t q = *pm;
+  q.aniso.amp_iq = 0.0;
+  if (!(fabs(l2 - m2) > 1e-9 * l0)) {
+    static const char *const k2[] = {"star_p", "star_m2", "ld", "lq", NULL};
+    return fail(c, machine_key(m, k2),
+                "the (3.3) matrix carries no position: L2 = M2 (%.4g H) makes a = b = 0 in (3.7)",
+                m2);
+  }
+  if (!plant_aniso_ok(&q)) {
+    double lo, hi;
+    if (star_p && star_p_range(pm, l2, &lo, &hi)) {
+      return fail(c, "machine.star_p",
+                  "%.3g: with L0 %.4g, M0 %.4g, L2 %.4g H kept (Fig. 3.3's split) the (3.3) matrix "
+                  "is not positive definite at every angle (no inductance matrix): star_p in "
+                  "(%.3f, %.3f) with these",
+                  (pm->ld - pm->lq) / (pm->ld + pm->lq), l0, m0, l2, lo, hi);
+    }
+    static const char *const km[] = {"star_p", "star_m2", "star_m0", "ld", "lq", "ls", NULL};
+    return fail(
+        c, machine_key(m, km),
+        "the (3.3) matrix of ld %.4g, lq %.4g, star_m0 %.4g, star_m2 %.4g H is not positive "
+        "definite at every angle (no inductance matrix)",
+        pm->ld, pm->lq, m0, m2);
+  }
+  /* the load scale 1 + amp_iq |i_q| up to i_trip */
+  const double amp = pm->aniso.amp_iq, i_lim = (double)sc->drive.i_trip;
+  double k_end = 1.0 + amp * i_lim;
+  k_end = k_end < 0.5 ? 0.5 : (k_end > 2.0 ? 2.0 : k_end);
+  pm->aniso.k_min = k_end < 1.0 ? k_end : 1.0;
+  pm->aniso.k_max = k_end > 1.0 ? k_end : 1.0;
+  if (!plant_aniso_ok(pm)) {
+    double ok = 0.0, bad = i_lim; /* the current where it stops being one */
+    for (int i = 0; i < 40; ++i) {
+      const double i_q = 0.5 * (ok + bad), k = 1.0 + amp * i_q;
+      q.aniso.amp_iq = amp;
+      q.aniso.k_min = k < 1.0 ? k : 1.0;
+      q.aniso.k_max = k > 1.0 ? k : 1.0;
+      if (plant_aniso_ok(&q)) {
+        ok = i_q;
+      } else {
+        bad = i_q;
+      }
+    }
+    return fail(c, "machine.star_amp_iq",
+                "%g 1/A scales L2 and M2 by 1 + %g |i_q|: the (3.3) matrix stops being positive "
+                "definite at |i_q| = %.3g A, below controller.i_trip (%g A), the current the plant "
+                "may carry before the drive trips: lower star_amp_iq or i_trip",
+                amp, amp, ok, i_lim);
+  }
+  /* the drive's a against the matrix's: a's sign is L2 - M2's (3.7); the
+   * other sign turns the DFC angle 2 theta_e by pi, theta_e by 90 degrees,
+   * and nothing detects it */
+  double a, b;
+  plant_aniso_ab(pm, &a, &b);
+  const double da = (double)sc->drive.dfc_a;
+  if (ctl != NULL && cJSON_GetObjectItemCaseSensitive(ctl, "dfc_a") != NULL && da * a <= 0.0) {
+    return fail(c, "controller.dfc_a",
+                "%g has the opposite sign of the machine's star-point a = %.4g ((3.7): the sign of "
+                "L2 - M2 = %.4g H): the angle would be 90 degrees (electrical) off with no fault",
+                da, a, l2 - m2);
+  }
+  if (ctl == NULL || cJSON_GetObjectItemCaseSensitive(ctl, "dfc_b") == NULL) {
+    static const char *const kp[] = {"star_p", "star_m2", "ld", "lq", "star_m0", NULL};
+    snprintf(c->p_key, sizeof c->p_key, "%s", machine_key(m, kp));
+  }
+  return 0;
+}
+
+/* The drive's current limit within the map's grid (issue 23): beyond it
+ * the plant and the drive's tables extrapolate a saturation curve nobody
+ * measured. The drive works at i_d <= 0 (MTPA, field weakening; either
+ * sign of torque), so the grid must hold i_d from -i_max to 0 and i_q from
+ * -i_max to i_max. */
+static int check_map_range(ctx_t *c, const scenario_t *sc, const char *map_key) {
+  if (sc->drive.machine_map == NULL) {
+    return 0;
+  }
+  flux_map_t fm;
+  flux_map_status_t st;
+  if (flux_map_parse(&fm, sc->drive.machine_map, sc->drive.machine_map[2], &st) != 0) {
+    return 0; /* parsed once by map_load: cannot fail */
+  }
+  const double i_max = (double)sc->drive.i_max, tol = 1e-5 * i_max;
+  const double id_lo = (double)fm.id0, id_hi = (double)fm.id0 + (double)fm.did * (fm.nd - 1u);
+  const double iq_lo = (double)fm.iq0, iq_hi = (double)fm.iq0 + (double)fm.diq * (fm.nq - 1u);
+  if (id_lo > -i_max + tol || id_hi < -tol || iq_lo > -i_max + tol || iq_hi < i_max - tol) {
+    return fail(c, "controller.i_max",
+                "%g A reaches beyond the flux map %s (i_d %g .. %g A, i_q %g .. %g A): the drive "
+                "needs i_d from -i_max to 0 and i_q from -i_max to i_max inside it (the tables "
+                "would be extrapolated): at most %g A with this map%s",
+                i_max, map_key, id_lo, id_hi, iq_lo, iq_hi, fmin(fmin(-id_lo, -iq_lo), iq_hi),
+                id_hi < -tol ? " (and the map must reach i_d = 0)" : "");
+  }
+  return 0;
+}
+
 int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *err, size_t errlen) {
-  ctx_t c = {err, errlen, origin, 0, 0};
+  ctx_t c = {err, errlen, origin, 0, 0, ""};
   scenario_defaults(sc);
   /* the whole text is the one object: nothing but white space after it */
   cJSON *root = cJSON_ParseWithOpts(json, NULL, 1);
@@ -1175,6 +1378,8 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
       r = sections[i].fn(&c, o, sc);
     }
   }
+  r = r ? r : check_star(&c, root, sc);
+  r = r ? r : check_map_range(&c, sc, sc->map_file);
   if (r == 0 && cJSON_GetObjectItemCaseSensitive(root, "board") == NULL) {
     sil_board_apply(sil_board_find(DEFAULT_BOARD), sc->plant.ts, sc->plant.inverter.dead_time,
                     &sc->board);
@@ -1201,6 +1406,20 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
   }
   if (ps != NULL && (ps->caps & POS_CAP_GATED) != 0u && !sc->board.asym_edges) {
     return fail(&c, "board", "a star-point position source needs a board with asymmetric edges");
+  }
+  /* the star-point circuit settles within the sample's delay after the
+   * edge (issue 23: the fabbri2022 presets trip `position` from a settling
+   * time of 4 time constants on, docs/dfc.md) */
+  const double settle = (double)sc->drive.dfc_t_meas - sc->plant.inverter.dead_time;
+  if (ps != NULL && (ps->caps & POS_CAP_GATED) != 0u &&
+      sc->plant.sensors.star_tau > STAR_TAU_SHARE * settle * (1.0 + 1e-6)) {
+    return fail(&c, "sensors.star_tau",
+                "%g s: the star-point sample at controller.dfc_t_meas (%g s) after the edge, less "
+                "the dead time (%g s), leaves the circuit %.2g time constants to settle: at "
+                "least %g (star_tau <= %g s; the position trips from 4 on)",
+                sc->plant.sensors.star_tau, (double)sc->drive.dfc_t_meas,
+                sc->plant.inverter.dead_time, settle / sc->plant.sensors.star_tau,
+                1.0 / STAR_TAU_SHARE, STAR_TAU_SHARE * settle);
   }
   if (resolve_substeps(&c, sc) != 0) {
     return -1;
@@ -1232,6 +1451,11 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
   if (drive_config_usable(&sc->drive, sc->drive.law, &m, &map, &e) != 0) {
     const drive_param_t *p = drive_params_by_name(e.field);
     const char *key = p != NULL ? p->scenario : e.field;
+    if (strcmp(e.field, "dfc_b") == 0 && c.p_key[0] != '\0') {
+      /* the drive's b follows the machine's star point: name what set it */
+      return fail(&c, c.p_key, "the star point's p = b/a = %.3g (3.7), the drive's dfc_b: %s",
+                  (double)(sc->drive.dfc_b / sc->drive.dfc_a), e.reason);
+    }
     if (p != NULL && strcmp(e.reason, "outside its range") == 0) {
       return fail(&c, key, "must be in [%g, %g] (got %g)", (double)p->min, (double)p->max,
                   (double)drive_param_get(&sc->drive, p));

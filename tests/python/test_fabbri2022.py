@@ -58,10 +58,12 @@ def test_the_convergence_floor_is_the_resistive_drop(res):
 
 
 def test_theorem1_refuses_p_at_or_above_one_half(res):
-    """Acceptance 1: |p| >= 1/2 with the IVD is refused, naming the
-    parameter and the reason."""
+    """Acceptance 1: |p| >= 1/2 with the IVD is refused, naming the key the
+    scenario wrote (machine.star_p, not the dfc_b derived from it; issue
+    23, point 8) and the reason."""
     for p, msg in res.refusals.items():
-        assert "controller.dfc_b" in msg and "1/2" in msg, (p, msg)
+        assert f"machine.star_p: the star point's p = b/a = {p:g} (3.7)" in msg, (p, msg)
+        assert "1/2 (Theorem 1" in msg, (p, msg)
 
 
 def test_fourth_harmonic_cut(res):

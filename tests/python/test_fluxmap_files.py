@@ -5,6 +5,8 @@ convention, giving identical blobs."""
 
 from __future__ import annotations
 
+import json
+import os
 import subprocess
 import sys
 import zlib
@@ -213,3 +215,60 @@ def test_board_table_is_the_sil_blob(tmp_path):
              if w.startswith("0x") and w.endswith("u,")]
     blob_bytes = (tmp_path / "m.fdmap").read_bytes()
     assert b"".join(w.to_bytes(4, "little") for w in words) == blob_bytes
+
+
+def _sil_parse(tmp_path, machine, controller=None):
+    """The real runner's verdict on a scenario (--print-config): (rc, text)."""
+    from conftest import REAL_SIL
+
+    if not REAL_SIL.is_file():
+        pytest.skip(f"real runner not built ({REAL_SIL} missing)")
+    sc = {"duration": 0.01, "machine": machine, "controller": controller or {}}
+    p = tmp_path / "sc.json"
+    p.write_text(json.dumps(sc))
+    env = {**os.environ, "FLUXDRIVE_PYTHON": sys.executable,
+           "PYTHONPATH": str(REPO / "tools" / "src")}
+    r = subprocess.run([str(REAL_SIL), str(p), "--print-config"], capture_output=True, text=True,
+                       timeout=120, env=env)
+    return r.returncode, r.stdout + r.stderr
+
+
+@pytest.mark.real_sil
+def test_scenario_gives_the_pole_pairs(tmp_path):
+    """Issue 23, point 13: a map file without pole_pairs takes the
+    scenario's machine.pole_pairs; a file with others is refused naming
+    both; without either the scenario key is named."""
+    i_d, i_q, pd, pq = small()
+    nopp = npz(tmp_path, "nopp.npz", i_d=i_d, i_q=i_q, psi_d=pd, psi_q=pq)
+    rc, out = _sil_parse(tmp_path, {"map": str(nopp), "pole_pairs": 4}, {"i_max": 3})
+    assert rc == 0, out
+    assert '"pole_pairs":\t4' in out, out
+    rc, out = _sil_parse(tmp_path, {"map": str(nopp)}, {"i_max": 3})
+    assert rc != 0 and "machine.pole_pairs: required" in out and "nopp.npz" in out, out
+    pp2 = npz(tmp_path, "pp2.npz", i_d=i_d, i_q=i_q, psi_d=pd, psi_q=pq, pole_pairs=2)
+    rc, out = _sil_parse(tmp_path, {"map": str(pp2), "pole_pairs": 3}, {"i_max": 3})
+    assert rc != 0 and "machine.pole_pairs: 3" in out and "the file has 2, 3 given" in out, out
+    rc, out = _sil_parse(tmp_path, {"map": str(pp2), "pole_pairs": 2}, {"i_max": 3})
+    assert rc == 0, out
+    # the map tool itself: --pole-pairs fills a gap, never overrides
+    assert io.load(nopp, pole_pairs=4).pole_pairs == 4
+    refused(pp2, "pole pairs", "the file has 2, 3 given", pole_pairs=3)
+
+
+@pytest.mark.real_sil
+def test_i_max_within_the_map(tmp_path):
+    """Issue 23, point 14: the drive's current limit beyond the map's grid
+    (small(): +-4 A) is refused naming i_max and the grid; within, accepted."""
+    i_d, i_q, pd, pq = small()
+    p = npz(tmp_path, "m.npz", i_d=i_d, i_q=i_q, psi_d=pd, psi_q=pq, pole_pairs=2)
+    rc, out = _sil_parse(tmp_path, {"map": str(p)}, {"i_max": 4.0, "i_trip": 6})
+    assert rc == 0, out
+    rc, out = _sil_parse(tmp_path, {"map": str(p)}, {"i_max": 4.5, "i_trip": 6})
+    assert rc != 0, out
+    assert "controller.i_max: 4.5 A reaches beyond the flux map" in out, out
+    assert "(i_d -4 .. 4 A, i_q -4 .. 4 A)" in out and "at most 4 A" in out, out
+    # a half-range map (i_d <= 0) holds all the drive needs
+    h = npz(tmp_path, "h.npz", i_d=i_d[:5], i_q=i_q, psi_d=pd[:, :5], psi_q=pq[:, :5],
+            pole_pairs=2)
+    rc, out = _sil_parse(tmp_path, {"map": str(h)}, {"i_max": 4.0, "i_trip": 6})
+    assert "controller.i_max" not in out, out

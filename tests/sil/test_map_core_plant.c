@@ -21,7 +21,7 @@
 
 static const map_load_t *syr(void) {
   char err[512];
-  const map_load_t *e = map_load("maps/syr_1k1.fdmap", "test", err, sizeof err);
+  const map_load_t *e = map_load("maps/syr_1k1.fdmap", "test", 0, err, sizeof err);
   if (e == NULL) {
     fail_msg("%s", err);
   }

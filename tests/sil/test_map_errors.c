@@ -130,11 +130,49 @@ static void refused_maps(void **state) {
                                       "maps.json", &sc, err, sizeof err),
                        0);
   printf("%s\n", err);
-  assert_non_null(strstr(err, "machine.pole_pairs: must equal the flux map's pole pairs"));
+  /* issue 23, point 13: both counts named */
+  assert_non_null(strstr(err, "machine.pole_pairs: 3, but the map file map_ok2.fdmap has 2"));
+  /* the map's own count given again: accepted */
+  assert_int_equal(scenario_parse("{\"duration\": 0.01, \"machine\": {\"map\": "
+                                  "\"map_ok2.fdmap\", \"pole_pairs\": 2}}",
+                                  "maps.json", &sc, err, sizeof err),
+                   0);
+}
+
+/* issue 23, point 14: the drive's current limit inside the map's grid
+ * (the fixture's: i_d, i_q in [-FX_I, FX_I] = [-6, 6] A) */
+static void i_max_within_the_map(void **state) {
+  (void)state;
+  const uint32_t n = fx_build(&FX_PM, blob);
+  write_file("map_range.fdmap", blob, n);
+  static scenario_t sc;
+  char err[1024] = "", json[512];
+  const double ok = FX_I, bad = FX_I * 1.05;
+  snprintf(json, sizeof json,
+           "{\"duration\": 0.01, \"machine\": {\"map\": \"map_range.fdmap\"}, \"controller\": "
+           "{\"i_max\": %g, \"i_trip\": 9}, \"sensors\": {\"i_full_scale\": 20}}",
+           ok);
+  if (scenario_parse(json, "maps.json", &sc, err, sizeof err) != 0) {
+    fail_msg("i_max %g A on a +-%g A grid refused: %s", ok, FX_I, err);
+  }
+  snprintf(json, sizeof json,
+           "{\"duration\": 0.01, \"machine\": {\"map\": \"map_range.fdmap\"}, \"controller\": "
+           "{\"i_max\": %g, \"i_trip\": 9}, \"sensors\": {\"i_full_scale\": 20}}",
+           bad);
+  assert_int_not_equal(scenario_parse(json, "maps.json", &sc, err, sizeof err), 0);
+  printf("%s\n", err);
+  char want[160];
+  snprintf(want, sizeof want, "controller.i_max: %g A reaches beyond the flux map", bad);
+  assert_non_null(strstr(err, want));
+  snprintf(want, sizeof want, "(i_d %g .. %g A, i_q %g .. %g A)", -FX_I, FX_I, -FX_I, FX_I);
+  assert_non_null(strstr(err, want));
+  assert_non_null(strstr(err, "map_range.fdmap"));
+  snprintf(want, sizeof want, "at most %g A with this map", FX_I);
+  assert_non_null(strstr(err, want));
 }
 
 int main(void) {
-  const struct CMUnitTest tests[] = {cmocka_unit_test(accepted_map),
-                                     cmocka_unit_test(refused_maps)};
+  const struct CMUnitTest tests[] = {cmocka_unit_test(accepted_map), cmocka_unit_test(refused_maps),
+                                     cmocka_unit_test(i_max_within_the_map)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -88,7 +88,8 @@ def add_parser(sub) -> None:
                        help="axis convention of the file (default: the file's, else fluxdrive)")
         q.add_argument("--mirror", action="store_true",
                        help="complete a map of i_q >= 0 (fluxdrive frame) by symmetry")
-        q.add_argument("--pole-pairs", type=int, help="pole pairs (default: the file's)")
+        q.add_argument("--pole-pairs", type=int,
+                       help="pole pairs, for a file without them (a file's own must agree)")
         q.add_argument("--flux-unit", choices=("Vs", "mVs"),
                        help="unit of the file's flux linkages (default: the file's, else Vs)")
         q.add_argument("--current-unit", choices=("A", "mA"),

@@ -241,9 +241,16 @@ def load(path: str | Path, convention: str | None = None, mirror: bool = False,
     if mirror:
         i_d, i_q, psi_d, psi_q = mirror_iq(file, i_d, i_q, psi_d, psi_q)
         notes.append("mirrored to i_q < 0 by symmetry (--mirror)")
-    pp = pole_pairs if pole_pairs is not None else meta.get("pole_pairs")
+    pp = meta.get("pole_pairs")
+    if pole_pairs is not None and pp is not None and float(pp) != float(pole_pairs):
+        # the file's own count against the one given (--pole-pairs, a
+        # scenario's machine.pole_pairs): neither wins silently
+        raise FluxMapError(file, "pole pairs", f"the file has {pp:g}, {pole_pairs} given "
+                           "(--pole-pairs or a scenario's machine.pole_pairs)")
+    pp = pole_pairs if pole_pairs is not None else pp
     if pp is None:
-        raise FluxMapError(file, "pole pairs", "not in the file: give --pole-pairs")
+        raise FluxMapError(file, "pole pairs", "not in the file: give --pole-pairs (a scenario: "
+                           "machine.pole_pairs)")
     m = FluxMap(i_d, i_q, psi_d, psi_q, int(pp) if float(pp).is_integer() else pp, p.stem, notes)
     check_map(file, m)
     check_units(file, m, i_max=i_max, v_dc=v_dc, speed_rpm=speed_rpm)

@@ -1316,6 +1316,16 @@ static int check_map_range(ctx_t *c, const scenario_t *sc, const char *map_key) 
                 i_max, map_key, id_lo, id_hi, iq_lo, iq_hi, fmin(fmin(-id_lo, -iq_lo), iq_hi),
                 id_hi < -tol ? " (and the map must reach i_d = 0)" : "");
   }
+  /* the unit check of `fluxdrive map check --i-max` (docs/flux-maps.md): a
+   * grid a hundred times beyond the current limit is a unit error (mA) */
+  const double i_grid = fmax(fmax(-id_lo, id_hi), fmax(-iq_lo, iq_hi));
+  if (i_grid > 100.0 * i_max) {
+    return fail(c, map_key,
+                "currents implausible (unit?): the grid reaches %g A, %g times controller.i_max "
+                "(%g A): currents in mA? state current_unit \"mA\" in the file (or convert it "
+                "with fluxdrive map convert --current-unit mA)",
+                i_grid, i_grid / i_max, i_max);
+  }
   return 0;
 }
 

@@ -265,3 +265,28 @@ def test_half_range_map_runs_in_the_sil(tmp_path):
         assert s["faults"] == [] and s["final_state"] == "run"
         assert abs(s["final_torque"] / 30.0 - 1) < 0.01
     assert abs(out["half"]["final_torque"] - out["full"]["final_torque"]) < 0.003 * 30
+
+
+@pytest.mark.skipif(not REAL_SIL.exists(), reason="fluxdrive-sil not built")
+def test_map_in_ma_is_refused_by_the_sil(tmp_path):
+    """The published map with its currents in mA, run by a scenario with
+    i_max 20 A: refused at set-up naming the unit (the SIL checks the grid
+    against controller.i_max like `map check --i-max`); the same map with
+    current_unit "mA" stated in the file runs."""
+    published(tmp_path, "ma.npz", cur=1000.0)
+    published(tmp_path, "ma_stated.npz", cur=1000.0, current_unit=np.array("mA"))
+    for name, ok in (("ma", False), ("ma_stated", True)):
+        sc = {"name": name, "duration": 0.05, "machine": {"map": f"{name}.npz", "rs": 0.5},
+              "sensors": {"i_full_scale": 40, "v_full_scale": 1000}, "dc_link": {"voltage": 540},
+              "controller": {"law": "foc", "mode": "torque", "i_max": 20, "i_trip": 30,
+                             "torque_max": 40, "v_dc_max": 700, "v_dc_min": 300}}
+        (tmp_path / f"{name}.json").write_text(json.dumps(sc))
+        r = subprocess.run([str(REAL_SIL), str(tmp_path / f"{name}.json")], capture_output=True,
+                           text=True, timeout=300,
+                           env={**os.environ, "FLUXDRIVE_PYTHON": sys.executable})
+        print(name, r.returncode, r.stderr.strip()[:300])
+        if ok:
+            assert r.returncode == 0, r.stderr
+        else:
+            assert r.returncode == 2, r.stderr
+            assert "currents implausible (unit?)" in r.stderr and "mA" in r.stderr

@@ -1421,7 +1421,9 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
    * edge (issue 23: the fabbri2022 presets trip `position` from a settling
    * time of 4 time constants on, docs/dfc.md) */
   const double settle = (double)sc->drive.dfc_t_meas - sc->plant.inverter.dead_time;
-  if (ps != NULL && (ps->caps & POS_CAP_GATED) != 0u &&
+  /* a sample at or before the dead time's end is the drive's own refusal
+   * (controller.dfc_t_meas: drive_config_check), named there */
+  if (ps != NULL && (ps->caps & POS_CAP_GATED) != 0u && settle > 0.0 &&
       sc->plant.sensors.star_tau > STAR_TAU_SHARE * settle * (1.0 + 1e-6)) {
     return fail(&c, "sensors.star_tau",
                 "%g s: the star-point sample at controller.dfc_t_meas (%g s) after the edge, less "

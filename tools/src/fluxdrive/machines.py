@@ -47,8 +47,12 @@ Star-point machines (`star`, Fabbri 2022): anisotropy p = (L_d - L_q) /
 (L_d + L_q) of either sign with 0.1 <= |p| <= 0.45 (Theorem 1 needs |p| < 1/2;
 below 0.1 the 2theta term vanishes in the noise), (L_d + L_q)/2 in
 [100, 1000] uH, the zero-sequence mutual M0 in [0, 0.15] (L_d + L_q)
-(docs/dfc.md: (-1/6, 1/6]), the star point's mutual M2 = k (L_d - L_q),
-k in [0.2, 0.6] (Table 5.1: 0.6), R_s 0.1 .. 3 Ohm, pole pairs 2 .. 12, star
+(docs/dfc.md: (-1/6, 1/6]), the split of the 2theta terms by the DFC
+signal's amplitude |L2 - M2| in [0.1, 0.3] L0 of either sign (Table 5.1:
+-0.14, Fig. 3.3: +0.21; L2 + 2 M2 = L_d - L_q fixes the rest; near 0 the
+star point carries no position: a first version drew M2 = k (L_d - L_q),
+which crosses it at k = 1/3, and the IVD of such a draw stalled at 113 mrad),
+R_s 0.1 .. 3 Ohm, pole pairs 2 .. 12, star
 noise 0 .. 0.06 V (the range of issue 23's start-up grid), 24 V.
 """
 
@@ -210,7 +214,12 @@ def _star(g):
     pa = g.uniform(0.1, 0.45) * (1 if g.uniform() < 0.5 else -1)
     ld, lq = lm * (1 + pa), lm * (1 - pa)
     m0 = g.uniform(0.0, 0.15) * (ld + lq)
-    m2 = g.uniform(0.2, 0.6) * (ld - lq)
+    # the split of the 2theta terms between self (L2) and mutual (M2):
+    # L2 + 2 M2 = L_d - L_q is fixed, L2 - M2 sets the DFC signal's amplitude
+    # (docs/dfc.md; 0 carries no position): |L2 - M2| in [0.1, 0.3] L0
+    l0 = 0.5 * (ld + lq) + m0
+    sig = g.uniform(0.1, 0.3) * l0 * (1 if g.uniform() < 0.5 else -1)
+    m2 = (ld - lq - sig) / 3.0
     rs = _logu(g, 0.1, 3.0)
     p = int(g.integers(2, 13))
     v_dc = 24.0

@@ -49,6 +49,12 @@ def make_log(n: int = 2000, dt: float = 1.0 / 16000.0, names: list[str] | None =
     return log
 
 
+def pytest_addoption(parser: pytest.Parser) -> None:
+    # test_random_machines.py: draw more machines (docs/machines.md)
+    parser.addoption("--seed", action="append", type=int, default=[],
+                     help="seed of a random machine (repeatable; test_random_machines.py)")
+
+
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line(
         "markers", "real_sil: runs the real fluxdrive-sil binary (skipped when it is not built)"

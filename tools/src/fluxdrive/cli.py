@@ -289,6 +289,9 @@ def build_parser() -> argparse.ArgumentParser:
     from fluxdrive.fluxmap.cli import add_parser as add_map_parser  # fluxdrive map ...
 
     add_map_parser(sub)
+    from fluxdrive.machines import add_parser as add_machines_parser  # fluxdrive machines ...
+
+    add_machines_parser(sub)
 
     add_can_parser(sub)
     return parser

@@ -149,3 +149,85 @@ def test_v_max_as_the_drive():
     # the window: lo = max(0, 0.5 - 0.024) = 0.476, hi = min(0.95, 1 - 0.024 - 0.048) = 0.928
     assert v == pytest.approx(0.95 * (0.928 - 0.476) * 650.0 / np.sqrt(3.0), rel=1e-9)
     assert "DFC window" in how
+
+
+def truncated_map() -> FluxMap:
+    """The linear IPM on a grid cut at i_d = -25 A: its MTPV, from
+    -lambda_m / L_d = -20 A at zero flux, leaves the grid as the flux grows."""
+    i_d = np.linspace(-25.0, 15.0, 161)
+    i_q = np.linspace(0.0, 60.0, 241)
+    D, Q = np.meshgrid(i_d, i_q)
+    return FluxMap(i_d, i_q, LD * D + LM, LQ * Q, P, "linear_ipm_cut")
+
+
+def exact_mtpv_row(m: FluxMap, lam: float) -> tuple[float, bool, float]:
+    """The largest torque at flux amplitude lam over the currents inside the
+    grid, closed-form: the stationary points over the load angle (the MTPV)
+    and the ends of the arcs inside the grid (the flux circle crossing the
+    grid's edges). Returns the torque, whether an edge gives it, its i_d."""
+    def cur(d):
+        return (lam * np.cos(d) - LM) / LD, lam * np.sin(d) / LQ
+
+    def inside(i_d, i_q):
+        e = 1e-9
+        return m.i_d[0] - e <= i_d <= m.i_d[-1] + e and -e <= i_q <= m.i_q[-1] + e
+
+    cand = []
+    a, b = lam * (1 / LQ - 1 / LD), LM / LD  # d/dd sin d (a cos d + b) = 0
+    for c in np.roots([2 * a, b, -a]):
+        if abs(c.imag) < 1e-12 and abs(c.real) <= 1:
+            cand.append((*cur(np.arccos(c.real)), False))
+    for i_d in (m.i_d[0], m.i_d[-1]):  # lambda_q = +sqrt(lam^2 - lambda_d^2)
+        r = lam ** 2 - (LD * i_d + LM) ** 2
+        if r >= 0:
+            cand.append((i_d, np.sqrt(r) / LQ, True))
+    for i_q in (m.i_q[-1],):
+        r = lam ** 2 - (LQ * i_q) ** 2
+        if r >= 0:
+            for s in (-1, 1):
+                cand.append(((s * np.sqrt(r) - LM) / LD, i_q, True))
+    best = (0.0, False, 0.0)
+    for i_d, i_q, edge in cand:
+        t = 1.5 * P * (LM * i_q + (LD - LQ) * i_d * i_q)
+        if inside(i_d, i_q) and t > best[0]:
+            best = (t, edge, i_d)
+    return best
+
+
+def test_mtpv_edge_refined_and_labelled():
+    """Issue 23 point 15: where the true MTPV lies beyond the grid the table
+    is the map-edge limit, on the edge itself (not up to 0.8 A inside it),
+    and labelled so (tables, map check's summary)."""
+    from fluxdrive.fluxmap.luts import edge_ranges, tables
+    from fluxdrive.fluxmap.summary import describe
+
+    m = truncated_map()
+    t = tables(m)
+    ll = np.linspace(0.0, t.mtpv_flux_max, len(t.mtpv_torque))
+    rows = [exact_mtpv_row(m, x) for x in ll]
+    # the table is the largest torque at a flux not above lambda (monotone):
+    # its rows where the circle's own maximum is not that (the grid's far
+    # corner, where the circle leaves the grid) hold the running maximum
+    run = np.maximum.accumulate([r[0] for r in rows])
+    worst_t, worst_id, n_edge, n_in = 0.0, 0.0, 0, 0
+    for k in range(1, len(ll)):
+        ref, edge, i_d = rows[k]
+        if ref < run[k] or ref <= 0:
+            assert t.mtpv_torque[k] == pytest.approx(run[k], rel=1e-3, abs=1e-9)
+            continue
+        assert bool(t.mtpv_edge[k]) == edge, (k, ll[k])
+        worst_t = max(worst_t, abs(t.mtpv_torque[k] / ref - 1))
+        if edge:
+            n_edge += 1
+            worst_id = max(worst_id, abs(t.mtpv_id[k] - i_d))
+        else:
+            n_in += 1
+    print(f"truncated linear IPM: {n_edge} MTPV rows on the grid's edge, {n_in} inside, "
+          f"worst |i_d - edge| {worst_id:.2e} A, worst torque error {100 * worst_t:.4f} %; "
+          f"edge ranges {edge_ranges(t)}")
+    assert n_edge >= 20 and n_in >= 5  # both kinds of rows are exercised
+    assert worst_id < 1e-3  # on the edge (was 0.01-0.8 A inside)
+    assert worst_t < 1e-3  # exact at the edge; the interpolant's edge cells elsewhere
+    text = describe(m)
+    print(text)
+    assert "map-edge limit" in text and "true MTPV lies outside the grid" in text

@@ -15,6 +15,8 @@ from fluxdrive.fluxmap.capability import map_capability, v_max_of
 from fluxdrive.fluxmap.model import FluxMap, syr_to_fluxdrive
 from fluxdrive.fluxmap.presets import model
 
+from conftest import REAL_SIL, REPO_ROOT
+
 # linear IPM: p, L_d, L_q, lambda_m; i_max; v_max (characteristic current
 # lambda_m / L_d = 20 A < i_max: the MTPV is reached, the speed range unbounded)
 P, LD, LQ, LM = 4, 0.2e-3, 0.5e-3, 0.004
@@ -231,3 +233,30 @@ def test_mtpv_edge_refined_and_labelled():
     text = describe(m)
     print(text)
     assert "map-edge limit" in text and "true MTPV lies outside the grid" in text
+
+
+@pytest.mark.skipif(not REAL_SIL.exists(), reason="fluxdrive-sil not built")
+def test_capability_command_on_the_scenario(capsys):
+    """`fluxdrive capability` on the flux-map scenario takes the drive's
+    voltage limit from the scenario (board duty 0 .. 0.95, v_margin 0.95,
+    650 V: 338.69 V) and agrees with a dense solve at that limit."""
+    from argparse import Namespace
+
+    from fluxdrive.capability import main_capability
+
+    scen = str(REPO_ROOT / "sil" / "scenarios" / "syr_1k1_speed_load.json")
+    rc = main_capability(Namespace(sil=str(REAL_SIL), scenario=scen, min_rpm=2000, max_rpm=6000,
+                                   points=3))
+    out = capsys.readouterr().out
+    print(out)
+    assert rc == 0
+    v = 0.95 * 0.95 * 650.0 / np.sqrt(3.0)
+    assert f"v_max {v:.2f} V" in out and "board duty 0 .. 0.95" in out
+    got = [float(line.split()[1]) for line in out.splitlines()[3:6]]
+    hk, p = model("syr_1k1")
+    for rpm, t in zip((2000, 4000, 6000), got):
+        ref = dense_reference(hk, p, 6.8, 1.5 * 2.3 * np.sqrt(2), v, rpm * np.pi / 30 * p)
+        # the committed map's 0.5 A grid against the model itself
+        print(f"  {rpm} rpm: command {t:.3f} N m, dense solve on the model {ref:.4f} N m, "
+              f"{100 * (t / ref - 1):+.2f} %")
+        assert t == pytest.approx(ref, rel=0.005), rpm

@@ -140,14 +140,16 @@ def _map_table(cfg: dict, rpm: np.ndarray) -> int:
     from argparse import Namespace
 
     from .fluxmap.cli import _load
-    from .fluxmap.capability import map_capability
+    from .fluxmap.capability import map_capability, v_max_of
 
     m, c = cfg["machine"], cfg["controller"]
     fm = _load(Namespace(i_max=c["i_max"]), m["map"])  # the map's current unit against i_max
+    v_max, how = v_max_of(cfg)  # the drive's voltage limit: v_margin and the board's duty range
     rows = map_capability(fm, m["rs"], c["i_max"], cfg["v_dc"], c["v_margin"], c["torque_max"],
-                          rpm * np.pi / 30.0)
+                          rpm * np.pi / 30.0, v_max=v_max)
     print(f"flux map {m['map']} ({fm.pole_pairs} pole pairs), i_max {c['i_max']:.3f} A, "
           f"v_dc {cfg['v_dc']:g} V, v_margin {c['v_margin']:g}")
+    print(how)
     print(f"{'speed rpm':>10} {'torque N m':>11} {'power W':>9} {'i_d A':>7} {'i_q A':>7}  limit")
     for r, (t, d, q, l) in zip(rpm, rows):
         print(f"{r:10.0f} {t:11.3f} {t * r * np.pi / 30:9.1f} {d:7.3f} {q:7.3f}  {l}")

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from . import io
-from .luts import tables
+from .luts import mtpv_label, tables
 from .plots import plot_all
 from .presets import MODELS, SYR_C, SYR_K, SYR_R
 from .summary import rated_point
@@ -49,7 +49,8 @@ def _section(repo: Path, name: str, src: str, v_dc: float, i_n: float, figs: boo
            f"| there: l_dd, l_qq, l_dq | {lr[0] * 1e3:.1f}, {lr[3] * 1e3:.1f}, "
            f"{lr[1] * 1e3:.2f} mH (l_qq at {lr[3] / l0[3]:.2f} of unsaturated) |",
            f"| MTPA table / MTPV table | 0 .. {t.mtpa_t_max:.2f} N m / 0 .. "
-           f"{t.mtpv_flux_max:.3f} Vs, {len(t.mtpa_id)} points each |", ""]
+           f"{t.mtpv_flux_max:.3f} Vs, {len(t.mtpa_id)} points each |",
+           f"| the MTPV table is | {mtpv_label(t)} |", ""]
     if name == "syr_1k1":
         out += [f"Fit (`tools/src/fluxdrive/fluxmap/presets.py`): the Hinkkanen model's 5.5 kW "
                 f"example parameters scaled by k = {SYR_K:g} in current and c = {SYR_C:g} in "

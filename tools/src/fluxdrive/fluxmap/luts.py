@@ -47,6 +47,9 @@ class Tables:
     # the MTPA at the grid's i_d edge with the torque still rising beyond it:
     # (amplitude, relative slope per rad, edge i_d), else None (validate.check_tables)
     edge: tuple | None = None
+    # per MTPV row: True where the largest torque at that flux sits on the
+    # grid's edge (the map-edge limit; the true MTPV lies outside the grid)
+    mtpv_edge: np.ndarray | None = None
 
 
 def _best_angles(m: FluxMap, amp: np.ndarray,
@@ -135,23 +138,117 @@ def _tables(m: FluxMap, n: int) -> Tables:
     inside = ((i_d >= m.i_d[0]) & (i_d <= m.i_d[-1]) & (i_q >= 0.0) & (i_q <= m.i_q[-1])
               & np.isfinite(i_d) & np.isfinite(i_q))
     tq = np.where(inside, 1.5 * m.pole_pairs * (ld * i_q - lq * i_d), 0.0)
-    best = tq.argmax(axis=1)
+    t_row, v_id, v_iq, v_edge = _refine_mtpv(m, ll, delta, tq, inside, i_d, i_q)
+    tv = np.maximum.accumulate(np.maximum(t_row, 0.0))
+    return Tables(t_max, m_id, m_iq, m_flux, l_max, tv, amp, ad, aq, tor, v_id, v_iq, edge,
+                  v_edge)
+
+
+def _inside(m: FluxMap, i_d, i_q):
+    return ((i_d >= m.i_d[0]) & (i_d <= m.i_d[-1]) & (i_q >= 0.0) & (i_q <= m.i_q[-1])
+            & np.isfinite(i_d) & np.isfinite(i_q))
+
+
+def _refine_mtpv(m: FluxMap, ll, delta, tq, inside, i_d, i_q):
+    """The MTPV rows refined from the load-angle samples: where a neighbour
+    of the best sample lies outside the grid, the grid's edge along the load
+    angle by bisection; then golden section on the torque over the bracket
+    (clipped to the edge). A row whose optimum is that edge is the map-edge
+    limit, not the MTPV (the torque still grows beyond the grid): flagged.
+    Returns the torque, i_d, i_q and the flag per row."""
+    n, nd = tq.shape
     rows = np.arange(n)
-    v_id, v_iq = i_d[rows, best], i_q[rows, best]
-    tv = np.maximum.accumulate(np.maximum(tq.max(axis=1), 0.0))
-    return Tables(t_max, m_id, m_iq, m_flux, l_max, tv, amp, ad, aq, tor, v_id, v_iq, edge)
+    b = tq.argmax(axis=1)
+    t0 = tq[rows, b]
+    g_d, g_q = np.nan_to_num(i_d[rows, b]), np.nan_to_num(i_q[rows, b])
+    ok_row = (t0 > 0) & inside[rows, b]
+    l2, gd2, gq2 = np.tile(ll, 2), np.tile(g_d, 2), np.tile(g_q, 2)
+
+    def at(dl, lam=ll, gd=g_d, gq=g_q):
+        """Currents and torque at load angle dl on each row's flux circle;
+        -inf outside the grid (Newton warm-started at gd, gq)."""
+        fd, fq = lam * np.cos(dl), lam * np.sin(dl)
+        cd, cq = current_smooth(m, fd, fq, iters=4, guess=(gd, gq))
+        t = np.where(_inside(m, cd, cq), 1.5 * m.pole_pairs * (fd * cq - fq * cd), -np.inf)
+        return t, cd, cq
+
+    # the bracket's ends: the neighbour sample, or the grid's edge by bisection
+    j = np.concatenate([b - 1, b + 1])
+    inb = (j >= 0) & (j < nd)
+    jc = np.clip(j, 0, nd - 1)
+    out = ~inb | ~inside[np.tile(rows, 2), jc]
+    step = np.concatenate([-np.ones(n), np.ones(n)]) * (delta[1] - delta[0])
+    lo = np.tile(delta[b], 2)
+    hi = np.clip(np.where(inb, delta[jc], lo + step), 0.0, np.pi)
+    for _ in range(24):  # lo inside, hi outside
+        mid = 0.5 * (lo + hi)
+        good = np.isfinite(at(mid, l2, gd2, gq2)[0])
+        lo, hi = np.where(good, mid, lo), np.where(good, hi, mid)
+    e = np.where(out, lo, hi)
+    a, c, a_edge, c_edge = e[:n], e[n:], out[:n], out[n:]
+    ends = [(a.copy(), a_edge), (c.copy(), c_edge)]
+    g = 0.5 * (np.sqrt(5.0) - 1.0)
+    for _ in range(30):
+        x1, x2 = c - g * (c - a), a + g * (c - a)
+        f = at(np.concatenate([x1, x2]), l2, gd2, gq2)[0]
+        first = f[:n] > f[n:]
+        c, a = np.where(first, x2, c), np.where(first, a, x1)
+    tol = 1e-6
+    for e, flag in ends:  # the edge itself if it is better (the torque rising to it)
+        te = at(e)[0]
+        x = 0.5 * (a + c)
+        tx = at(x)[0]
+        use = flag & (te >= tx)
+        a, c = np.where(use, e, a), np.where(use, e, c)
+    x = 0.5 * (a + c)
+    t, cd, cq = at(x)
+    better = ok_row & np.isfinite(t) & (t >= t0)
+    t = np.where(better, t, np.where(ok_row, t0, tq.max(axis=1)))
+    cd, cq = np.where(better, cd, g_d), np.where(better, cq, g_q)
+    on_edge = better & ((a_edge & (np.abs(x - ends[0][0]) < tol))
+                        | (c_edge & (np.abs(x - ends[1][0]) < tol)))
+    on_edge |= ok_row & ~better & (a_edge | c_edge)
+    return t, cd, cq, on_edge
 
 
-def current_smooth(m: FluxMap, ld, lq, iters: int = 16):
+def edge_ranges(t: Tables) -> list[tuple[float, float]]:
+    """The flux ranges [Vs] where the MTPV table is the map-edge limit."""
+    if t.mtpv_edge is None or not np.any(t.mtpv_edge):
+        return []
+    ll = np.linspace(0.0, t.mtpv_flux_max, len(t.mtpv_torque))
+    out, start = [], None
+    for k, e in enumerate(t.mtpv_edge):
+        if e and start is None:
+            start = k
+        if start is not None and (not e or k == len(ll) - 1):
+            out.append((float(ll[start]), float(ll[k if e else k - 1])))
+            start = None
+    return out
+
+
+def mtpv_label(t: Tables) -> str:
+    """Which the MTPV table is: the MTPV, or where the map's edge limits it."""
+    r = edge_ranges(t)
+    if not r:
+        return "the MTPV inside the grid at every flux"
+    return ("the map-edge limit (the true MTPV lies outside the grid) at flux "
+            + ", ".join(f"{a:.3f} .. {b:.3f} Vs" for a, b in r) + "; the MTPV elsewhere")
+
+
+def current_smooth(m: FluxMap, ld, lq, iters: int = 16, guess=None):
     """i(lambda) on the bicubic interpolant: Newton from the zero-current
-    linearisation, Jacobian by central differences (vectorised)."""
+    linearisation (or from guess = (i_d, i_q)), Jacobian by central
+    differences (vectorised)."""
     h = 1e-4 * max(m.did, m.diq)
-    l0 = m.inductance(0.0, 0.0)
-    f0 = m.flux_smooth(0.0, 0.0)
-    det0 = l0[0] * l0[3] - l0[1] * l0[2]
-    rd, rq = ld - f0[0], lq - f0[1]
-    i_d = (l0[3] * rd - l0[1] * rq) / det0
-    i_q = (l0[0] * rq - l0[2] * rd) / det0
+    if guess is None:
+        l0 = m.inductance(0.0, 0.0)
+        f0 = m.flux_smooth(0.0, 0.0)
+        det0 = l0[0] * l0[3] - l0[1] * l0[2]
+        rd, rq = ld - f0[0], lq - f0[1]
+        i_d = (l0[3] * rd - l0[1] * rq) / det0
+        i_q = (l0[0] * rq - l0[2] * rd) / det0
+    else:
+        i_d, i_q = (np.array(np.broadcast_to(x, np.shape(ld)), float) for x in guess)
     for _ in range(iters):
         i_d = np.clip(i_d, 2 * m.i_d[0], 2 * m.i_d[-1])
         i_q = np.clip(i_q, 2 * m.i_q[0], 2 * m.i_q[-1])

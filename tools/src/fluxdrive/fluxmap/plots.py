@@ -56,8 +56,14 @@ def _plane(m: FluxMap, path: Path, v_dc: float | None, i_limit: float | None) ->
     c = ax.contour(D, Q, m.torque_smooth(D, Q), 12, cmap="viridis", linewidths=0.8)
     ax.clabel(c, fontsize=7, fmt="%.1f N m")
     ax.plot(t.amp_id, t.amp_iq, "r", lw=2, label="MTPA")
-    ok = np.isfinite(t.mtpv_id) & (t.mtpv_iq > 0) & (t.mtpv_id > m.i_d[0] + m.did)
-    ax.plot(t.mtpv_id[ok], t.mtpv_iq[ok], "m--", lw=2, label="MTPV (in the grid)")
+    ok = np.isfinite(t.mtpv_id) & (t.mtpv_iq > 0)
+    e = t.mtpv_edge if t.mtpv_edge is not None else np.zeros_like(ok)
+    if np.any(ok & ~e):
+        ax.plot(np.where(ok & ~e, t.mtpv_id, np.nan), np.where(ok & ~e, t.mtpv_iq, np.nan), "m--",
+                lw=2, label="MTPV")
+    if np.any(ok & e):  # the table where the map's edge limits it (the true MTPV is outside)
+        ax.plot(t.mtpv_id[ok & e], t.mtpv_iq[ok & e], "mx", ms=4,
+                label="MTPV table: the map-edge limit (true MTPV outside the grid)")
     g = np.linspace(0, np.pi, 200)
     for a in [x for x in (i_limit, 1.5 * i_limit if i_limit else None) if x]:
         ax.plot(a * np.cos(g), a * np.sin(g), "k:", lw=1)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .luts import tables
+from .luts import mtpv_label, tables
 from .model import FluxMap
 
 
@@ -26,6 +26,7 @@ def describe(m: FluxMap) -> str:
            f"incremental inductances at zero current: l_dd {l0[0] * 1e3:.2f} mH, "
            f"l_qq {l0[3] * 1e3:.2f} mH, l_dq {l0[1] * 1e3:.3f} mH",
            f"MTPA table: 0 .. {t.mtpa_t_max:.3f} N m (current amplitude up to "
-           f"{t.amp[-1]:.2f} A); MTPV table: flux 0 .. {t.mtpv_flux_max:.3f} Vs"]
+           f"{t.amp[-1]:.2f} A); MTPV table: flux 0 .. {t.mtpv_flux_max:.3f} Vs",
+           f"MTPV table: {mtpv_label(t)}"]
     out += [f"note: {n}" for n in m.notes]
     return "\n".join(out)

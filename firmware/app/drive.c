@@ -591,12 +591,14 @@ static FD_NOINLINE void drive_pos_check_step(drive_t *drv) {
  * period: the speed is off the (ramped) reference by more than
  * DRIVE_RA_MARGIN |w_ref| + DRIVE_RA_FLOOR speed_max, and the loop's torque
  * pushes it back (torque x error < 0). Held for DRIVE_RA_TIME without a
- * break, it trips lost_control (lc_cause DRIVE_LC_RUNAWAY) if the error has
- * grown meanwhile by DRIVE_RA_FLOOR speed_max: the rotor went further away
- * against the torque (a wrong polarity or angle turns the torque against
- * the loop); an error that shrinks (a healthy drive braking back to its
- * reference, a reversal, a load step) starts the window again. Once per
- * speed-loop period (1 kHz), not in the PWM ISR's own path. */
+ * break, it trips lost_control (lc_cause DRIVE_LC_RUNAWAY) if the speed
+ * itself has moved meanwhile by DRIVE_RA_FLOOR speed_max further from the
+ * reference: the rotor went away against the torque (a wrong polarity or
+ * angle turns the torque against the loop). A speed that moves back (a
+ * healthy drive braking to its reference, a reversal, a load step the loop
+ * catches) or that the reference outruns (a ramp faster than the torque
+ * the voltage allows) starts the window again. Once per
+ * speed-loop period (1 kHz: the ISR of every slow_div-th period), a few flops. */
 #define DRIVE_RA_MARGIN 0.2f  /* of |w_ref| */
 #define DRIVE_RA_FLOOR  0.02f /* of speed_max: the margin's floor, and the growth */
 #define DRIVE_RA_TIME   0.02f /* s */
@@ -610,10 +612,11 @@ static void drive_runaway_check(drive_t *drv, float w, float w_ref, float torque
     return;
   }
   if (drv->ra_n++ == 0u) {
-    drv->ra_e0 = ae;
+    drv->ra_w0 = w;
   }
   if ((float)drv->ra_n * (float)c->slow_div * c->ts >= DRIVE_RA_TIME) {
-    if (ae > drv->ra_e0 + floor) {
+    const float away = e > 0.0f ? w - drv->ra_w0 : drv->ra_w0 - w;
+    if (away > floor) {
       drv->tm.lc_cause = DRIVE_LC_RUNAWAY;
       drive_trip(drv, DRIVE_FAULT_LOST_CONTROL);
     }
@@ -733,7 +736,7 @@ static void drive_start(drive_t *drv) {
   drv->speed_torque = 0.0f;
   memset(drv->lc_n, 0, sizeof drv->lc_n);
   drv->ra_n = 0u;
-  drv->ra_e0 = 0.0f;
+  drv->ra_w0 = 0.0f;
   drv->tm.lc_cause = 0u;
   drv->v_applied = (ab_t){0.0f, 0.0f};
   const bool align = drv->cfg.align_time > 0.0f && (drv->pos_src->caps & POS_CAP_ALIGN) != 0u;

@@ -162,7 +162,7 @@ typedef struct drive_s {
   float torque_min_avail, torque_max_avail; /* what the law can deliver now */
   uint32_t lc_n[DRIVE_LC_COUNT];            /* periods each condition has held */
   uint32_t ra_n;                            /* speed-loop periods the run-away condition held */
-  float ra_e0;                              /* |speed error| when it began [rad/s] */
+  float ra_w0;                              /* the speed when its window began [rad/s] */
   float torque_scale, flux_scale;           /* torque and flux amplitude on MTPA at i_max */
   float lc_n_fast, lc_n_track;              /* lc_time, lc_track_time in periods */
   float inv_pole_pairs;

@@ -6,7 +6,8 @@ rotor runs away from the reference while the loop asks for the opposite
 torque. The drive's speed loop checks it (firmware/app/drive.c,
 drive_runaway_check): the speed off the ramped reference by more than
 RA_MARGIN |w_ref| + RA_FLOOR speed_max with the loop's torque pushing back,
-held for RA_TIME with the error grown by RA_FLOOR speed_max, trips
+held for RA_TIME with the speed itself moved RA_FLOOR speed_max further
+away from the reference (against the torque), trips
 lost_control (lc_cause 32). The wrong position is forced on the plant's side
 on every star-point source, on fabbri2022_t51 at the calibrated star noise:
 - wrong polarity: the rotor held (Coulomb friction 0.5 N m, the alignment's

@@ -13,7 +13,7 @@ the rotor runs away, issue 23 point 2); right when within pos_err_max
 
 Each run lasts only as long as the decision takes (offset calibration
 0.016 s, alignment 0.1 s, then 6 ms of run). The full grid (19,845 runs,
-about 45 min on 2 cores) runs with FD_POLARITY_FULL=1; CI runs a seeded
+about 75 min on 2 cores) runs with FD_POLARITY_FULL=1; CI runs a seeded
 subset: every source from the +-0.3 rad band around the alignment angle on
 fabbri2022_t51 at 0.0368 V (where the measured-angle evidence failed for
 every seed), plus 200 cases drawn from the whole grid (random.Random(23)).

@@ -585,6 +585,45 @@ static FD_NOINLINE void drive_pos_check_step(drive_t *drv) {
   }
 }
 
+/* Run-away (issue 23, point 2; docs/faults.md): whatever the position
+ * source says, the rotor must not run away from the speed reference
+ * against the torque the speed loop asks. The condition, each speed-loop
+ * period: the speed is off the (ramped) reference by more than
+ * DRIVE_RA_MARGIN |w_ref| + DRIVE_RA_FLOOR speed_max, and the loop's torque
+ * pushes it back (torque x error < 0). Held for DRIVE_RA_TIME without a
+ * break, it trips lost_control (lc_cause DRIVE_LC_RUNAWAY) if the speed
+ * itself has moved meanwhile by DRIVE_RA_FLOOR speed_max further from the
+ * reference: the rotor went away against the torque (a wrong polarity or
+ * angle turns the torque against the loop). A speed that moves back (a
+ * healthy drive braking to its reference, a reversal, a load step the loop
+ * catches) or that the reference outruns (a ramp faster than the torque
+ * the voltage allows) starts the window again. Once per
+ * speed-loop period (1 kHz: the ISR of every slow_div-th period), a few flops. */
+#define DRIVE_RA_MARGIN 0.2f  /* of |w_ref| */
+#define DRIVE_RA_FLOOR  0.02f /* of speed_max: the margin's floor, and the growth */
+#define DRIVE_RA_TIME   0.02f /* s */
+static void drive_runaway_check(drive_t *drv, float w, float w_ref, float torque) {
+  const drive_config_t *c = &drv->cfg;
+  const float e = w - w_ref;
+  const float floor = DRIVE_RA_FLOOR * c->speed_max;
+  const float ae = fabsf(e);
+  if (!(ae > DRIVE_RA_MARGIN * fabsf(w_ref) + floor && torque * e < 0.0f)) {
+    drv->ra_n = 0u;
+    return;
+  }
+  if (drv->ra_n++ == 0u) {
+    drv->ra_w0 = w;
+  }
+  if ((float)drv->ra_n * (float)c->slow_div * c->ts >= DRIVE_RA_TIME) {
+    const float away = e > 0.0f ? w - drv->ra_w0 : drv->ra_w0 - w;
+    if (away > floor) {
+      drv->tm.lc_cause = DRIVE_LC_RUNAWAY;
+      drive_trip(drv, DRIVE_FAULT_LOST_CONTROL);
+    }
+    drv->ra_n = 0u; /* a new window */
+  }
+}
+
 /* The speed loop, every slow_div ISRs, on the angle rate averaged over that
  * period (no lag under acceleration), with the slow-rate checks. */
 static void drive_speed_loop(drive_t *drv) {
@@ -613,6 +652,7 @@ static void drive_speed_loop(drive_t *drv) {
     const float w_ref = fd_clampf(drv->cmd.speed, -c->speed_max, c->speed_max);
     drv->speed_torque =
         speed_ctrl_update(&drv->speed, w_ref, w, drv->torque_min_avail, drv->torque_max_avail);
+    drive_runaway_check(drv, w, drv->speed.w_ref_ramped, drv->speed_torque);
   } else if (drv->speed_active) { /* reset once, when the loop stops */
     speed_ctrl_reset(&drv->speed, drv->omega_m, 0.0f);
     drv->speed_active = false;
@@ -695,6 +735,8 @@ static void drive_start(drive_t *drv) {
   drv->speed_active = false;
   drv->speed_torque = 0.0f;
   memset(drv->lc_n, 0, sizeof drv->lc_n);
+  drv->ra_n = 0u;
+  drv->ra_w0 = 0.0f;
   drv->tm.lc_cause = 0u;
   drv->v_applied = (ab_t){0.0f, 0.0f};
   const bool align = drv->cfg.align_time > 0.0f && (drv->pos_src->caps & POS_CAP_ALIGN) != 0u;

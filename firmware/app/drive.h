@@ -51,13 +51,14 @@
 
 /* Loss-of-control conditions (drive_telemetry_t.lc_cause). */
 enum {
-  DRIVE_LC_CURRENT = 1u << 0, /* |i| above lc_current * i_max */
-  DRIVE_LC_DELTA = 1u << 1,   /* |load angle| beyond delta_max + lc_delta */
-  DRIVE_LC_TORQUE = 1u << 2,  /* torque off its (deliverable) reference */
-  DRIVE_LC_FLUX = 1u << 3,    /* flux off its reference */
-  DRIVE_LC_OBSERVER = 1u << 4 /* observer flux off the current model */
+  DRIVE_LC_CURRENT = 1u << 0,  /* |i| above lc_current * i_max */
+  DRIVE_LC_DELTA = 1u << 1,    /* |load angle| beyond delta_max + lc_delta */
+  DRIVE_LC_TORQUE = 1u << 2,   /* torque off its (deliverable) reference */
+  DRIVE_LC_FLUX = 1u << 3,     /* flux off its reference */
+  DRIVE_LC_OBSERVER = 1u << 4, /* observer flux off the current model */
+  DRIVE_LC_RUNAWAY = 1u << 5   /* speed running away against the speed loop's torque */
 };
-#define DRIVE_LC_COUNT 5
+#define DRIVE_LC_COUNT 5 /* the ISR's own conditions; the run-away is the speed loop's */
 
 /* Low-pass of the applied voltage for the main loop's voltage balance
  * (drive_telemetry_t.v_ab_filt): the share of each ISR's voltage. */
@@ -160,6 +161,8 @@ typedef struct drive_s {
   float speed_torque;                       /* torque reference from the speed loop [N m] */
   float torque_min_avail, torque_max_avail; /* what the law can deliver now */
   uint32_t lc_n[DRIVE_LC_COUNT];            /* periods each condition has held */
+  uint32_t ra_n;                            /* speed-loop periods the run-away condition held */
+  float ra_w0;                              /* the speed when its window began [rad/s] */
   float torque_scale, flux_scale;           /* torque and flux amplitude on MTPA at i_max */
   float lc_n_fast, lc_n_track;              /* lc_time, lc_track_time in periods */
   float inv_pole_pairs;

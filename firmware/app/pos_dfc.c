@@ -269,8 +269,9 @@ static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sam
     trk_reset(s, theta0, 0.0f); /* polarity: the alignment decides */
     s->dfc.started = true;
   }
-  const float th = nearest_branch(theta0, trk_theta(s));
-  out->health = fabsf(frames_wrap_pi(th - trk_theta(s))); /* measured - predicted */
+  const float pred = trk_theta(s); /* the prediction, before this period's measurement */
+  const float th = nearest_branch(theta0, pred);
+  out->health = fabsf(frames_wrap_pi(th - pred)); /* measured - predicted */
   if (!kalman) {
     angle_pll_update(pll, th);
     out->theta = th;
@@ -290,9 +291,13 @@ static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sam
     out->rate = kf->x[0];
     out->load = kf->x[2];
   }
-  /* the polarity evidence, until the alignment has used it */
+  /* the polarity evidence, until the alignment has used it: on the
+   * predicted angle, which this period's measurement noise has not reached
+   * (on the measured one, the noise that moves the speed update also moves
+   * the sine: a bias towards theta + pi that wins where the rotor hardly
+   * moves, near the alignment angle; docs/dfc.md) */
   if (!s->dfc.aligned) {
-    s->dfc.pol_acc -= (out->omega - s->dfc.w_prev) * frames_sincos(th).s;
+    s->dfc.pol_acc -= (out->omega - s->dfc.w_prev) * frames_sincos(pred).s;
     s->dfc.w_prev = out->omega;
   }
 }

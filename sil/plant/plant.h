@@ -42,6 +42,8 @@ typedef struct {
    * to it) and plant_aniso_ok checks; 0: 0.5 .. 2 (the scenario parser
    * sets it from the current the plant may carry, controller.i_trip) */
   double k_min, k_max;
+  double shift; /* [rad electrical]: the star point's saliency axis turned by this, 2 theta_e ->
+                   2 (theta_e + shift): the position it shows is off by it (inject.star_shift) */
 } plant_aniso_t;
 
 typedef struct {
@@ -122,6 +124,7 @@ typedef struct {
   profile_t rs_scale;       /* R_s times this (winding temperature) */
   profile_t lambda_m_scale; /* PM flux linkage times this (demagnetisation; linear machines) */
   profile_t c_scale;        /* DC-link capacitance times this (capacitor loss; RC link) */
+  profile_t star_shift; /* [rad electrical] the star point's axis turned (plant_aniso_t.shift) */
   /* passive load (FREE mechanics): a friction that always opposes motion
    * and never drives the rotor: Coulomb torque [N m] (at standstill it
    * holds the rotor against a net torque up to its value) and viscous
@@ -294,6 +297,7 @@ int plant_check(const plant_params_t *p, const char **field);
 #define PLANT_RS_SCALE_MAX       4.0
 #define PLANT_LAMBDA_M_SCALE_MAX 2.0
 #define PLANT_C_SCALE_MAX        10.0
+#define PLANT_STAR_SHIFT_MAX     7.0 /* [rad electrical]: inject.star_shift within +-this */
 /* The electromechanical mode (the rotor's inertia against the PM flux's
  * stiffness, w_em = p psi_m sqrt(1.5 / (L_min J)), psi_m the PM flux at its
  * largest scale) and the friction's pole (b / J, the passive load's viscous

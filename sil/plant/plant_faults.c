@@ -50,6 +50,8 @@ int plant_faults_check(const plant_params_t *p, const char **field) {
       check_one(&f->lambda_m_scale, 0.0, 0, PLANT_LAMBDA_M_SCALE_MAX, "faults.lambda_m_scale",
                 field) ||
       check_one(&f->c_scale, 0.0, 1, PLANT_C_SCALE_MAX, "faults.c_scale", field) ||
+      check_one(&f->star_shift, -PLANT_STAR_SHIFT_MAX, 0, PLANT_STAR_SHIFT_MAX, "faults.star_shift",
+                field) ||
       check_one(&f->coulomb, 0.0, 0, 1e6, "faults.coulomb", field) ||
       check_one(&f->viscous, 0.0, 0, 1e6, "faults.viscous", field)) {
     return -1;
@@ -73,7 +75,7 @@ void plant_faults_init(plant_t *pl) {
   const plant_faults_t *f = &pl->p.faults;
   plant_aux_t *a = &pl->aux;
   a->faults_on = f->rs_scale.n > 0 || f->lambda_m_scale.n > 0 || f->c_scale.n > 0 ||
-                 f->coulomb.n > 0 || f->viscous.n > 0;
+                 f->coulomb.n > 0 || f->viscous.n > 0 || f->star_shift.n > 0;
   a->rs0 = pl->p.machine.rs;
   a->lambda_m0 = a->mag.lambda_m;
   a->inv_c0 = a->inv_c;
@@ -102,6 +104,9 @@ void plant_faults_period_start(plant_t *pl) {
   }
   if (f->c_scale.n > 0) {
     a->inv_c = a->inv_c0 / profile_eval(&f->c_scale, t);
+  }
+  if (f->star_shift.n > 0) {
+    pl->p.machine.aniso.shift = profile_eval(&f->star_shift, t);
   }
   if (f->viscous.n > 0) {
     pl->p.mech.b = a->b0 + profile_eval(&f->viscous, t);

@@ -123,7 +123,8 @@ void plant_star_gain(const plant_t *pl, double theta_e, double i_q, double g[3])
     return;
   }
   double L[3][3], dL[3][3];
-  star_matrix(pl, 2.0 * theta_e + pl->p.machine.aniso.phi_iq * i_q, i_q, L, dL);
+  star_matrix(pl, 2.0 * (theta_e + pl->p.machine.aniso.shift) + pl->p.machine.aniso.phi_iq * i_q,
+              i_q, L, dL);
   star_divider(L, g);
 }
 
@@ -133,7 +134,8 @@ double plant_star_vn(const plant_t *pl, const double v[3], const double i[3], do
     return (v[0] + v[1] + v[2]) * (1.0 / 3.0);
   }
   double L[3][3], dL[3][3], g[3];
-  star_matrix(pl, 2.0 * th_e + pl->p.machine.aniso.phi_iq * i_q, i_q, L, dL);
+  star_matrix(pl, 2.0 * (th_e + pl->p.machine.aniso.shift) + pl->p.machine.aniso.phi_iq * i_q, i_q,
+              L, dL);
   star_divider(L, g);
   double vn = 0.0;
   for (int k = 0; k < 3; k++) {

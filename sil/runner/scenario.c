@@ -890,12 +890,11 @@ static int parse_power_fault(ctx_t *c, const cJSON *o, const char *key, int kind
 #define FAULT_NAME(E, n, d) #n,
 static int parse_inject(ctx_t *c, const cJSON *o, scenario_t *sc) {
   static const char *const keys[] = {
-      "encoder_error",  "encoder_invalid", "main_stall",    "isr_stall",
-      "cm_scale_d",     "cm_scale_q",      "current",       "rs_scale",
-      "lambda_m_scale", "c_scale",         "passive_load",  "trip_at",
-      "trip_cause",     "encoder",         "can",           "isr_overrun",
-      "gate_driver",    "switch_open",     "switch_closed", "phase_lost",
-      "phase_open",     "phase_short",     "ground_short",  NULL};
+      "encoder_error", "encoder_invalid", "main_stall",   "isr_stall",      "cm_scale_d",
+      "cm_scale_q",    "current",         "rs_scale",     "lambda_m_scale", "c_scale",
+      "passive_load",  "trip_at",         "trip_cause",   "encoder",        "can",
+      "isr_overrun",   "gate_driver",     "switch_open",  "switch_closed",  "phase_lost",
+      "phase_open",    "phase_short",     "ground_short", "star_shift",     NULL};
   static const char *const faults[] = {DRIVE_FAULT_LIST(FAULT_NAME) NULL};
   const char *P = "inject";
   plant_faults_t *pf = &sc->plant.faults;
@@ -920,6 +919,8 @@ static int parse_inject(ctx_t *c, const cJSON *o, scenario_t *sc) {
       get_bounded_profile(c, o, P, "lambda_m_scale", 0.0, 0, PLANT_LAMBDA_M_SCALE_MAX,
                           &pf->lambda_m_scale) ||
       get_bounded_profile(c, o, P, "c_scale", 0.0, 1, PLANT_C_SCALE_MAX, &pf->c_scale) ||
+      get_bounded_profile(c, o, P, "star_shift", -PLANT_STAR_SHIFT_MAX, 0, PLANT_STAR_SHIFT_MAX,
+                          &pf->star_shift) ||
       get_profile(c, o, P, "gate_driver", &sc->gate_driver) ||
       parse_power_fault(c, o, "switch_open", PF_SWITCH, &sc->switch_open.target,
                         &sc->switch_open.active) ||
@@ -984,6 +985,10 @@ static int parse_inject(ctx_t *c, const cJSON *o, scenario_t *sc) {
     return fail(c, "inject.lambda_m_scale",
                 "a flux-map machine's PM flux is inside its map (saturated with the currents): "
                 "give the demagnetised machine as its own map (machine.map)");
+  }
+  if (pf->star_shift.n > 0 && !sc->plant.machine.aniso.enabled) {
+    return fail(c, "inject.star_shift",
+                "needs a star-point machine (machine.star_m0, star_m2 or a star-point preset)");
   }
   if (pf->c_scale.n > 0 && sc->plant.dclink.kind == PLANT_DC_IDEAL) {
     return fail(c, "inject.c_scale",
@@ -1079,6 +1084,7 @@ static const char *scenario_key_of(const char *plant_field) {
                                        {"faults.rs_scale", "inject.rs_scale"},
                                        {"faults.lambda_m_scale", "inject.lambda_m_scale"},
                                        {"faults.c_scale", "inject.c_scale"},
+                                       {"faults.star_shift", "inject.star_shift"},
                                        {"faults.coulomb", "inject.passive_load.coulomb"},
                                        {"faults.viscous", "inject.passive_load.viscous"}};
   for (size_t i = 0; i < sizeof map / sizeof map[0]; ++i) {

@@ -29,7 +29,7 @@ static plant_params_t star_params(double theta_e, double tau, double dead) {
   p.machine.ld = 394e-6;
   p.machine.lq = 475e-6;
   p.machine.lambda_m = 0.1186 / 8.0;
-  p.machine.aniso = (plant_aniso_t){1, 20e-6, -48.54e-6, 0.0, 0.0, 0.0, 0.0};
+  p.machine.aniso = (plant_aniso_t){1, 20e-6, -48.54e-6, 0.0, 0.0, 0.0, 0.0, 0.0};
   p.inverter.model = PLANT_INV_SWITCHING;
   p.inverter.dead_time = dead;
   p.sensors.adc_bits = 24;

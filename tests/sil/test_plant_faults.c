@@ -190,6 +190,9 @@ static void bad_plant_faults_name_the_field(void **state) {
       {"\"mechanics\": {\"mode\": \"imposed\", \"speed\": 1}, \"inject\": {\"passive_load\": "
        "{\"viscous\": 1}}",
        "inject.passive_load: needs mechanics.mode \"free\""},
+      {"\"inject\": {\"star_shift\": 1}", "inject.star_shift: needs a star-point machine"},
+      {"\"machine\": {\"preset\": \"fabbri2022_t51\"}, \"inject\": {\"star_shift\": 8}",
+       "inject.star_shift: must stay in [-7, 7]"},
   };
   static scenario_t sc;
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {

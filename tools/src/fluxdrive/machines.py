@@ -133,6 +133,20 @@ def _mtpa_linear(ld, lq, lam, i):
     return i_d, math.sqrt(max(i * i - i_d * i_d, 0.0))
 
 
+def _rated_point(g, p, ld, lq, lam, rs, i_n, w_e, vs, n_rpm):
+    """The rated point of a linear PM machine: the MTPA torque at i_n, the
+    voltage it needs (refused beyond 0.95 v_s: the reason) and an inertia
+    of 0.02 .. 0.5 t_n / w_m (a rated-torque start of 0.02 .. 0.5 s):
+    (t_n, w_m, j)."""
+    i_d, i_q = _mtpa_linear(ld, lq, lam, i_n)
+    t_n = 1.5 * p * (lam * i_q + (ld - lq) * i_d * i_q)
+    psi = math.hypot(lam + ld * i_d, lq * i_q)
+    if w_e * psi + rs * i_n > 0.95 * vs:
+        return "rated point beyond the voltage limit"
+    w_m = n_rpm * RPM
+    return t_n, w_m, g.uniform(0.02, 0.5) * t_n / w_m
+
+
 def _linear(kind, g):
     v_dc = float(g.choice([24.0, 48.0, 310.0, 540.0]))
     vs = v_s(v_dc)
@@ -152,13 +166,10 @@ def _linear(kind, g):
         lq = x * vs / (w_e * i_n)
         ld = lq / g.uniform(1.5, 3.0)
     rs = g.uniform(0.005, 0.08) * vs / i_n
-    i_d, i_q = _mtpa_linear(ld, lq, lam, i_n)
-    t_n = 1.5 * p * (lam * i_q + (ld - lq) * i_d * i_q)
-    psi = math.hypot(lam + ld * i_d, lq * i_q)
-    if w_e * psi + rs * i_n > 0.95 * vs:
-        return None, "rated point beyond the voltage limit"
-    w_m = n_rpm * RPM
-    j = g.uniform(0.02, 0.5) * t_n / w_m
+    rp = _rated_point(g, p, ld, lq, lam, rs, i_n, w_e, vs, n_rpm)
+    if isinstance(rp, str):
+        return None, rp
+    t_n, w_m, j = rp
     mach = {"preset": "rubino2020_spm", "pole_pairs": p, "rs": rs, "ld": ld, "lq": lq,
             "lambda_m": lam}
     if kind == "spm":
@@ -232,13 +243,10 @@ def _star(g):
     i_n = _logu(g, 1.0, 10.0)
     if rs * i_n > 0.3 * vs:
         return None, "R_s i_n above 0.3 v_s"
-    i_d, i_q = _mtpa_linear(ld, lq, lam, i_n)
-    t_n = 1.5 * p * (lam * i_q + (ld - lq) * i_d * i_q)
-    psi = math.hypot(lam + ld * i_d, lq * i_q)
-    if w_e * psi + rs * i_n > 0.95 * vs:
-        return None, "rated point beyond the voltage limit"
-    w_m = n_rpm * RPM
-    j = g.uniform(0.02, 0.5) * t_n / w_m
+    rp = _rated_point(g, p, ld, lq, lam, rs, i_n, w_e, vs, n_rpm)
+    if isinstance(rp, str):
+        return None, rp
+    t_n, w_m, j = rp
     noise = g.uniform(0.0, 0.06)
     mach = {"preset": "fabbri2022_t51", "pole_pairs": p, "rs": rs, "ld": ld, "lq": lq,
             "lambda_m": lam, "star_m0": m0, "star_m2": m2}

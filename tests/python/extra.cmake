@@ -2,36 +2,31 @@
 # uses this build's fluxdrive-sil.
 set(FD_PYTHON "" CACHE FILEPATH "Python of the tools venv (scripts/setup.sh)")
 if(FD_PYTHON)
+  # tests that run on their own (in parallel with the rest, found by -R),
+  # left out of python/pytest
+  set(alone param_ranges random_machines start_polarity)
+  set(ignore "")
+  foreach(name ${alone})
+    list(APPEND ignore --ignore=${CMAKE_CURRENT_SOURCE_DIR}/python/test_${name}.py)
+  endforeach()
   add_test(NAME python/pytest
-           COMMAND ${FD_PYTHON} -m pytest -q ${CMAKE_CURRENT_SOURCE_DIR}/python
-                   --ignore=${CMAKE_CURRENT_SOURCE_DIR}/python/test_param_ranges.py
-                   --ignore=${CMAKE_CURRENT_SOURCE_DIR}/python/test_random_machines.py
-                   --ignore=${CMAKE_CURRENT_SOURCE_DIR}/python/test_start_polarity.py
+           COMMAND ${FD_PYTHON} -m pytest -q ${CMAKE_CURRENT_SOURCE_DIR}/python ${ignore}
            WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   set_tests_properties(python/pytest PROPERTIES LABELS python TIMEOUT 900
     ENVIRONMENT "FLUXDRIVE_SIL=$<TARGET_FILE:fluxdrive-sil>")
-  # the star-point and Kalman ranges walked at their edges on the star-point
-  # presets (issue 22, point 9): on its own, so that -R finds it
-  add_test(NAME python/param_ranges
-           COMMAND ${FD_PYTHON} -m pytest -q ${CMAKE_CURRENT_SOURCE_DIR}/python/test_param_ranges.py
-           WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
-  set_tests_properties(python/param_ranges PROPERTIES LABELS python TIMEOUT 300
-    ENVIRONMENT "FLUXDRIVE_SIL=$<TARGET_FILE:fluxdrive-sil>")
-  # the acceptance tests on random machines (issue 23, point 19,
-  # docs/machines.md): on their own, in parallel with the rest
-  add_test(NAME python/random_machines
-           COMMAND ${FD_PYTHON} -m pytest -q ${CMAKE_CURRENT_SOURCE_DIR}/python/test_random_machines.py
-           WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
-  set_tests_properties(python/random_machines PROPERTIES LABELS python TIMEOUT 300
-    ENVIRONMENT "FLUXDRIVE_SIL=$<TARGET_FILE:fluxdrive-sil>")
-  # the star-point sources' polarity decision over start angles, noise,
-  # sources and presets (issue 23, point 1): a seeded subset, the full grid
-  # with FD_POLARITY_FULL=1
-  add_test(NAME python/start_polarity
-           COMMAND ${FD_PYTHON} -m pytest -q ${CMAKE_CURRENT_SOURCE_DIR}/python/test_start_polarity.py
-           WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
-  set_tests_properties(python/start_polarity PROPERTIES LABELS python TIMEOUT 300
-    ENVIRONMENT "FLUXDRIVE_SIL=$<TARGET_FILE:fluxdrive-sil>")
+  # param_ranges: the star-point and Kalman ranges walked at their edges on
+  # the star-point presets (issue 22, point 9); random_machines: the
+  # acceptance tests on random machines (issue 23, point 19,
+  # docs/machines.md); start_polarity: the star-point sources' polarity
+  # decision over start angles, noise, sources and presets (issue 23,
+  # point 1: a seeded subset, the full grid with FD_POLARITY_FULL=1)
+  foreach(name ${alone})
+    add_test(NAME python/${name}
+             COMMAND ${FD_PYTHON} -m pytest -q ${CMAKE_CURRENT_SOURCE_DIR}/python/test_${name}.py
+             WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+    set_tests_properties(python/${name} PROPERTIES LABELS python TIMEOUT 300
+      ENVIRONMENT "FLUXDRIVE_SIL=$<TARGET_FILE:fluxdrive-sil>")
+  endforeach()
   # the parameter table of the firmware against the DBC, the tools' table
   # and docs/parameters.md (fluxdrive params --check)
   add_test(NAME params/agreement

@@ -466,6 +466,42 @@ static void idle_ticks(unsigned n) {
   }
 }
 
+/* In idle, switches to `law` (accepted) and writes `name` = v, which that
+ * law refuses: answered inconsistent naming the parameter, and the reason
+ * names it too. */
+static void write_refused_under(drive_law_t law, const char *name, float v) {
+  reply_t r[8];
+  push_state(CAN_KEEP, 0, CAN_KEEP, law);
+  push_param(1, pid(name), v);
+  slow_tick();
+  assert_int_equal(pop_replies(r, 8, NULL), 2);
+  assert_int_equal(r[0].result, CAN_RESULT_OK);
+  assert_int_equal(rig.drv.ctrl.law, law);
+  assert_int_equal(r[1].result, CAN_RESULT_INCONSISTENT);
+  assert_int_equal(r[1].param, pid(name));
+  drive_config_err_t err;
+  assert_int_equal(drive_params_set(&rig.drv, pid(name), v, &err), DRIVE_PARAM_INCONSISTENT);
+  assert_non_null(strstr(err.reason, name));
+}
+
+/* In idle, `from` in force with `name` = v (both accepted), then a switch
+ * to `to`, which refuses that set: answered unavailable naming the law
+ * signal, and `from` stays in force and commanded. */
+static void switch_refused_after(drive_law_t from, const char *name, float v, drive_law_t to) {
+  reply_t r[8];
+  push_state(CAN_KEEP, 0, CAN_KEEP, from);
+  push_param(1, pid(name), v);
+  push_state(CAN_KEEP, 0, CAN_KEEP, to);
+  slow_tick();
+  assert_int_equal(pop_replies(r, 8, NULL), 3);
+  assert_int_equal(r[0].result, CAN_RESULT_OK);
+  assert_int_equal(r[1].result, CAN_RESULT_OK);
+  assert_int_equal(r[2].result, CAN_RESULT_UNAVAILABLE);
+  assert_int_equal(r[2].signal, CAN_SIG_LAW + 1);
+  assert_int_equal(rig.drv.ctrl.law, from);
+  assert_int_equal(drive_commands(&rig.drv)->law, from);
+}
+
 /* What is acknowledged is never refused later (issue 22, points 4 and 5),
  * on a board without the star-point window (this rig's, like the ESC1):
  * every write and law switch is answered with its verdict, the GET reports
@@ -492,55 +528,24 @@ static void test_acknowledged_writes_never_trip_later(void **state) {
   assert_non_null(strstr(err.reason, "star-point"));
   idle_ticks(20);
   push_param(1, pid("align_time"), 0.0f);
-  /* DB-DFVC: vsd_max = 0 refused (its deadbeat needs a d_s voltage limit) */
-  push_state(CAN_KEEP, 0, CAN_KEEP, DRIVE_LAW_DB_DFVC);
-  push_param(1, pid("vsd_max"), 0.0f);
   slow_tick();
-  assert_int_equal(pop_replies(r, 128, NULL), 3);
-  assert_int_equal(r[0].result, CAN_RESULT_OK); /* align_time = 0 */
-  assert_int_equal(r[1].result, CAN_RESULT_OK);
-  assert_int_equal(r[2].result, CAN_RESULT_INCONSISTENT);
-  assert_int_equal(r[2].param, pid("vsd_max"));
-  assert_int_equal(drive_params_set(&rig.drv, pid("vsd_max"), 0.0f, &err),
-                   DRIVE_PARAM_INCONSISTENT);
-  assert_non_null(strstr(err.reason, "vsd_max"));
-  /* the decoupled DFVC: flux_min = 5 Vs (beyond the flux at i_max) refused */
-  push_state(CAN_KEEP, 0, CAN_KEEP, DRIVE_LAW_DFVC_DECOUPLED);
-  push_param(1, pid("flux_min"), 5.0f);
-  slow_tick();
-  assert_int_equal(pop_replies(r, 128, NULL), 2);
+  assert_int_equal(pop_replies(r, 128, NULL), 1);
   assert_int_equal(r[0].result, CAN_RESULT_OK);
-  assert_int_equal(rig.drv.ctrl.law, DRIVE_LAW_DFVC_DECOUPLED);
-  assert_int_equal(r[1].result, CAN_RESULT_INCONSISTENT);
-  assert_int_equal(drive_params_set(&rig.drv, pid("flux_min"), 5.0f, &err),
-                   DRIVE_PARAM_INCONSISTENT);
-  assert_non_null(strstr(err.reason, "flux_min"));
+  /* DB-DFVC: vsd_max = 0 refused (its deadbeat needs a d_s voltage limit) */
+  write_refused_under(DRIVE_LAW_DB_DFVC, "vsd_max", 0.0f);
+  /* the decoupled DFVC: flux_min = 5 Vs (beyond the flux at i_max) refused */
+  write_refused_under(DRIVE_LAW_DFVC_DECOUPLED, "flux_min", 5.0f);
   /* ... and flux_min = 1.76 under DB-DFVC is fine there, but a switch to
    * the decoupled DFVC with it is unavailable (point 2's sequence) */
-  push_state(CAN_KEEP, 0, CAN_KEEP, DRIVE_LAW_DB_DFVC);
-  push_param(1, pid("flux_min"), 1.76f);
-  push_state(CAN_KEEP, 0, CAN_KEEP, DRIVE_LAW_DFVC_DECOUPLED);
-  slow_tick();
-  assert_int_equal(pop_replies(r, 128, NULL), 3);
-  assert_int_equal(r[1].result, CAN_RESULT_OK);
-  assert_int_equal(r[2].result, CAN_RESULT_UNAVAILABLE);
-  assert_int_equal(r[2].signal, CAN_SIG_LAW + 1);
-  assert_int_equal(rig.drv.ctrl.law, DRIVE_LAW_DB_DFVC);
+  switch_refused_after(DRIVE_LAW_DB_DFVC, "flux_min", 1.76f, DRIVE_LAW_DFVC_DECOUPLED);
   push_param(1, pid("flux_min"), 0.038f);
+  slow_tick();
+  assert_int_equal(pop_replies(r, 128, NULL), 1);
+  assert_int_equal(r[0].result, CAN_RESULT_OK);
   /* FOC: vsd_max = 0 is fine, the switch to DB-DFVC is unavailable and FOC
    * stays (point 5: it was answered ok, FOC stayed and the next write
    * tripped config) */
-  push_state(CAN_KEEP, 0, CAN_KEEP, DRIVE_LAW_FOC);
-  push_param(1, pid("vsd_max"), 0.0f);
-  push_state(CAN_KEEP, 0, CAN_KEEP, DRIVE_LAW_DB_DFVC);
-  slow_tick();
-  assert_int_equal(pop_replies(r, 128, NULL), 4);
-  assert_int_equal(r[0].result, CAN_RESULT_OK);
-  assert_int_equal(r[1].result, CAN_RESULT_OK);
-  assert_int_equal(r[2].result, CAN_RESULT_OK);
-  assert_int_equal(r[3].result, CAN_RESULT_UNAVAILABLE);
-  assert_int_equal(rig.drv.ctrl.law, DRIVE_LAW_FOC);
-  assert_int_equal(drive_commands(&rig.drv)->law, DRIVE_LAW_FOC);
+  switch_refused_after(DRIVE_LAW_FOC, "vsd_max", 0.0f, DRIVE_LAW_DB_DFVC);
   /* later writes and enable / disable cycles: nothing trips */
   push_param(1, pid("i_max"), 4.0f);
   idle_ticks(5);

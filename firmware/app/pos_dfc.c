@@ -171,24 +171,56 @@ static void trk_reset(pos_state_t *s, float theta, float omega) {
   }
 }
 
-/* The RLS of a, b (4.51)-(4.57) on this vector at the filter's predicted
- * angle, and the IVD's a, b from it, within the guards (header). One
- * update per refresh of the whole vector (when component a is the newest:
- * every third period, 5.3 kHz, the thesis's DFC rate): successive updates
- * then share no sample, as the RLS's independent noise assumes. */
+/* The RLS's regressor: the IVD (3.76) on this vector with the a, b in use,
+ * iterated DFC_ITER_MAX times from the filter's predicted angle (u: its
+ * 2theta as a unit vector). Not the filter's angle itself: that follows
+ * the IVD's angle of dfc_iter iterations, whose error contracts only by
+ * 2|p| per iteration (Theorem 1, (3.81)): one iteration leaves 2|p| of
+ * the raw error p sin 6theta (0.7 of it at p = 0.35), and that error, at
+ * the regressor, turns into a bias of the b column (the 6theta error
+ * times e^{j2theta} carries an e^{-j4theta} term: b - a eps / 2, eps the
+ * error's amplitude on 2theta; issue 23 point 5, docs/dfc.md). From the
+ * prediction (a priori, within the error above) and with |p| <= 0.45 the
+ * iterations contract to the angle at which this vector fits the model. */
+static void rls_regressor(const dfc_cfg_t *dc, const dfc_vec_t *v, sincos_t *u) {
+  static const float one[2] = {1.0f, 0.0f}; /* no phase shifts: (4.54) has none */
+  const float inv_a = 1.0f / dc->a;
+  const float zr = -v->al * inv_a, zi = v->be * inv_a, p = dc->b * inv_a;
+  float ur = u->c, ui = u->s;
+  for (uint32_t k = 0u; k < DFC_ITER_MAX; ++k) {
+    if (!dfc_ivd_step(zr, zi, p, v->k, one, one, &ur, &ui)) {
+      return; /* a zero vector: the prediction stays */
+    }
+  }
+  u->c = ur;
+  u->s = ui;
+}
+
 #define POS_DFC_P_MAX 0.45f /* |b/a| the IVD is given at most (Theorem 1: < 1/2) */
+/* The IVD's a, b: the RLS's within the guards (header). */
+static void rls_guarded(const rls_ab_t *r, const drive_config_t *cfg, dfc_cfg_t *dc) {
+  const float a0 = fabsf(cfg->dfc_a);
+  const float am = fd_clampf(fabsf(r->x[0]), 0.25f * a0, 4.0f * a0);
+  dc->a = cfg->dfc_a < 0.0f ? -am : am;
+  dc->b = fd_clampf(r->x[1], -POS_DFC_P_MAX * am, POS_DFC_P_MAX * am);
+}
+
+/* The RLS of a, b (4.51)-(4.57) on this vector at the converged IVD's
+ * angle (rls_regressor), and the IVD's a, b from it, within the guards
+ * (header). One update per refresh of the whole vector (when component a
+ * is the newest: every third period, 5.3 kHz, the thesis's DFC rate):
+ * successive updates then share no sample, as the RLS's independent noise
+ * assumes. */
 static void rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v, bool fresh) {
   rls_ab_t *r = &s->dfc.rls;
   r->cfg = rls_cfg_of(cfg); /* the live tuning */
+  rls_guarded(r, cfg, &s->dfc.dc);
   if (fresh && s->dfc.sig.last == 0u && s->dfc.aligned && fabsf(s->dfc.kf.x[0]) > cfg->rls_w_min) {
-    const sincos_t u = frames_sincos(2.0f * s->dfc.kf.x[1]);
+    sincos_t u = frames_sincos(2.0f * s->dfc.kf.x[1]);
+    rls_regressor(&s->dfc.dc, v, &u);
     (void)rls_ab_update(r, v->al, v->be, u.c, u.s, v->k);
+    rls_guarded(r, cfg, &s->dfc.dc);
   }
-  const float a0 = fabsf(cfg->dfc_a);
-  const float am = fd_clampf(fabsf(r->x[0]), 0.25f * a0, 4.0f * a0);
-  const float a = cfg->dfc_a < 0.0f ? -am : am;
-  s->dfc.dc.a = a;
-  s->dfc.dc.b = fd_clampf(r->x[1], -POS_DFC_P_MAX * am, POS_DFC_P_MAX * am);
 }
 
 /* The measurement variance of the angle (4.29)-(4.31) or of the signals

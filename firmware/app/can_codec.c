@@ -59,6 +59,7 @@ static const can_sig_desc_t sigs[CAN_SIG_COUNT] = {
   {"isr_overruns",     48, 16, false, false, 1.0f,    0.0f, 0.0f,      65535.0f, 0, 65535},
   {"load_torque_est",   0, 32, true,  false, 1e-4f,   0.0f, -214748.3648f, 214748.3647f, -2147483648, 2147483647},
   {"pos_err",          32, 16, false, false, 1e-4f,   0.0f, 0.0f,      6.5535f, 0, 65535},
+  {"rls_ok",           48,  1, false, false, 1.0f,    0.0f, 0.0f,      1.0f, 0, 1},
   {"hb_count",          0,  8, false, false, 1.0f,    0.0f, 0.0f,      255.0f, 0, 255},
   {"hb_state",          8,  8, false, false, 1.0f,    0.0f, 0.0f,      255.0f, 0, 255},
 };
@@ -80,7 +81,7 @@ static const can_msg_desc_t msgs[CAN_MSG_COUNT] = {
   {"TM_DQ",       0x330, 8, false, CAN_SIG_I_D,           4},
   {"TM_FLUX",     0x340, 8, false, CAN_SIG_FLUX,          4},
   {"TM_CPU",      0x350, 8, false, CAN_SIG_ISR_CYCLES_MEAN, 4},
-  {"TM_POSITION", 0x360, 6, false, CAN_SIG_LOAD_TORQUE_EST, 2},
+  {"TM_POSITION", 0x360, 7, false, CAN_SIG_LOAD_TORQUE_EST, 3},
   {"HEARTBEAT",   0x700, 2, false, CAN_SIG_HB_COUNT,      2},
 };
 /* clang-format on */

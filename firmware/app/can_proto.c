@@ -448,6 +448,7 @@ static void send_periodic(can_proto_t *p, can_period_t which, const drive_t *drv
     frame_init(&f, CAN_MSG_TM_POSITION, node);
     can_codec_set(CAN_SIG_LOAD_TORQUE_EST, f.data, tm->load_est);
     can_codec_set(CAN_SIG_POS_ERR, f.data, tm->pos_health);
+    can_codec_set(CAN_SIG_RLS_OK, f.data, tm->rls_ok ? 1.0f : 0.0f);
     break;
   case CAN_PERIOD_TM_CPU:
   default: {

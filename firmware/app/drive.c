@@ -198,7 +198,8 @@ FD_COLD static int drive_configure(drive_t *drv, const drive_config_t *cfg, driv
   }
   drv->pos_src = pos_source(cfg->pos_source);
   drv->pos_src->init(&drv->pos_st, cfg);
-  drv->pos.out.load = 0.0f; /* written by the sources that estimate it (pos_source.h) */
+  drv->pos.out.load = 0.0f;    /* written by the sources that estimate it (pos_source.h) */
+  drv->pos.out.rls_ok = false; /* the same: ivd+kf+rls */
   speed_ctrl_cfg_t scfg;
   speed_cfg_from(&scfg, cfg);
   speed_ctrl_init(&drv->speed, &scfg);
@@ -788,6 +789,7 @@ static void drive_publish(drive_t *drv, const hal_sample_t *s, const float i[3])
   tm->omega_m = drv->omega_m;
   tm->pos_health = drv->pos.out.health;
   tm->load_est = drv->pos.out.load;
+  tm->rls_ok = drv->pos.out.rls_ok;
   tm->cmd_seq = drv->cmd.seq;
   if (drv->state != DRIVE_STATE_RUN) {
     tm->theta_e = drv->pos.out.theta;

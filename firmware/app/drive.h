@@ -86,6 +86,7 @@ typedef struct {
   float torque_est;      /* [N m] */
   float pos_health;      /* position source: |measured - predicted| [rad] */
   float load_est;        /* position source's load torque estimate (Kalman filter) [N m] */
+  bool rls_ok;           /* ivd+kf+rls: the identified a, b have settled (docs/dfc.md) */
   uint32_t lc_cause;     /* DRIVE_LC_* that tripped lost_control */
   uint32_t cmd_seq;      /* last command block taken (drive_cmd_t.seq) */
   uint32_t armed;        /* drive_t.armed, written where it changes (a trip, a clear that

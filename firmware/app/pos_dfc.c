@@ -16,7 +16,9 @@
  *                       (4.51)-(4.57), the loop of Fig. 4.4: the IVD uses
  *                       the identified a, b (held in the IVD's convergence
  *                       region |b/a| <= 0.45 and within a factor 4 of
- *                       dfc_a); the RLS regressor is the filter's
+ *                       dfc_a) and iterates DFC_ITER_MAX times (not
+ *                       dfc_iter: its residual error biases b); the
+ *                       RLS regressor is the filter's
  *                       predicted angle (a priori: free of this period's
  *                       signal noise, which the IVD angle carries - no
  *                       errors-in-variables bias); it identifies only above
@@ -119,6 +121,8 @@ FD_COLD static void pdfc_init(pos_state_t *s, const drive_config_t *cfg) {
   const rls_ab_cfg_t rc = rls_cfg_of(cfg);
   (void)rls_ab_init(&s->dfc.rls, &rc);
   rls_ab_reset(&s->dfc.rls, cfg->dfc_a, cfg->dfc_b, cfg->rls_p_max);
+  s->dfc.rls_avg[0] = 0.0f; /* not settled before its updates (rls_health) */
+  s->dfc.rls_avg[1] = 0.0f;
   s->dfc.r = 0.0f;
   s->dfc.miss = 0u;
   s->dfc.dc = cfg_of(cfg);
@@ -171,31 +175,6 @@ static void trk_reset(pos_state_t *s, float theta, float omega) {
   }
 }
 
-/* The RLS's regressor: the IVD (3.76) on this vector with the a, b in use,
- * iterated DFC_ITER_MAX times from the filter's predicted angle (u: its
- * 2theta as a unit vector). Not the filter's angle itself: that follows
- * the IVD's angle of dfc_iter iterations, whose error contracts only by
- * 2|p| per iteration (Theorem 1, (3.81)): one iteration leaves 2|p| of
- * the raw error p sin 6theta (0.7 of it at p = 0.35), and that error, at
- * the regressor, turns into a bias of the b column (the 6theta error
- * times e^{j2theta} carries an e^{-j4theta} term: b - a eps / 2, eps the
- * error's amplitude on 2theta; issue 23 point 5, docs/dfc.md). From the
- * prediction (a priori, within the error above) and with |p| <= 0.45 the
- * iterations contract to the angle at which this vector fits the model. */
-static void rls_regressor(const dfc_cfg_t *dc, const dfc_vec_t *v, sincos_t *u) {
-  static const float one[2] = {1.0f, 0.0f}; /* no phase shifts: (4.54) has none */
-  const float inv_a = 1.0f / dc->a;
-  const float zr = -v->al * inv_a, zi = v->be * inv_a, p = dc->b * inv_a;
-  float ur = u->c, ui = u->s;
-  for (uint32_t k = 0u; k < DFC_ITER_MAX; ++k) {
-    if (!dfc_ivd_step(zr, zi, p, v->k, one, one, &ur, &ui)) {
-      return; /* a zero vector: the prediction stays */
-    }
-  }
-  u->c = ur;
-  u->s = ui;
-}
-
 #define POS_DFC_P_MAX 0.45f /* |b/a| the IVD is given at most (Theorem 1: < 1/2) */
 /* The IVD's a, b: the RLS's within the guards (header). */
 static void rls_guarded(const rls_ab_t *r, const drive_config_t *cfg, dfc_cfg_t *dc) {
@@ -205,22 +184,50 @@ static void rls_guarded(const rls_ab_t *r, const drive_config_t *cfg, dfc_cfg_t 
   dc->b = fd_clampf(r->x[1], -POS_DFC_P_MAX * am, POS_DFC_P_MAX * am);
 }
 
-/* The RLS of a, b (4.51)-(4.57) on this vector at the converged IVD's
- * angle (rls_regressor), and the IVD's a, b from it, within the guards
- * (header). One update per refresh of the whole vector (when component a
- * is the newest: every third period, 5.3 kHz, the thesis's DFC rate):
- * successive updates then share no sample, as the RLS's independent noise
- * assumes. */
-static void rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v, bool fresh) {
+/* The RLS of a, b (4.51)-(4.57) on this vector at the filter's predicted
+ * angle, and the IVD's a, b from it, within the guards (header). One
+ * update per refresh of the whole vector (when component a is the newest:
+ * every third period, 5.3 kHz, the thesis's DFC rate): successive updates
+ * then share no sample, as the RLS's independent noise assumes. */
+static bool rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v, bool fresh) {
   rls_ab_t *r = &s->dfc.rls;
   r->cfg = rls_cfg_of(cfg); /* the live tuning */
   rls_guarded(r, cfg, &s->dfc.dc);
-  if (fresh && s->dfc.sig.last == 0u && s->dfc.aligned && fabsf(s->dfc.kf.x[0]) > cfg->rls_w_min) {
-    sincos_t u = frames_sincos(2.0f * s->dfc.kf.x[1]);
-    rls_regressor(&s->dfc.dc, v, &u);
-    (void)rls_ab_update(r, v->al, v->be, u.c, u.s, v->k);
-    rls_guarded(r, cfg, &s->dfc.dc);
+  if (!(fresh && s->dfc.sig.last == 0u && s->dfc.aligned &&
+        fabsf(s->dfc.kf.x[0]) > cfg->rls_w_min)) {
+    return false;
   }
+  const sincos_t u = frames_sincos(2.0f * s->dfc.kf.x[1]);
+  const bool upd = rls_ab_update(r, v->al, v->be, u.c, u.s, v->k);
+  rls_guarded(r, cfg, &s->dfc.dc);
+  return upd;
+}
+
+/* The RLS's health (rls_ok): its a and b have settled within the band,
+ * each of them
+ *   steady: within POS_DFC_RLS_BAND of its own low-pass over the updates
+ *     (POS_DFC_RLS_AVG per update, from 0 at the start: no update, no
+ *     information, not settled; a converging estimate runs ahead of it),
+ *   known: twice the standard deviation its covariance states, sqrt(2 P)
+ *     (the floor-limited RLS's estimate has a variance of about P / 2),
+ *     within the band (a small b against the floor: p too small),
+ * and neither held at the IVD's guards (rls_guarded). A bias the model
+ * itself carries is not seen (docs/dfc.md). */
+#define POS_DFC_RLS_BAND 0.05f       /* issue 23 point 5: the 5 % band */
+#define POS_DFC_RLS_AVG  0.00390625f /* 1/256 per update: 48 ms at 5.3 kHz */
+static bool rls_health(pos_state_t *s, const drive_config_t *cfg, bool updated) {
+  const rls_ab_t *r = &s->dfc.rls;
+  bool ok = true;
+  for (unsigned j = 0u; j < 2u; ++j) {
+    if (updated) {
+      s->dfc.rls_avg[j] += POS_DFC_RLS_AVG * (r->x[j] - s->dfc.rls_avg[j]);
+    }
+    const float tol = POS_DFC_RLS_BAND * fabsf(r->x[j]);
+    const float pjj = r->p[2u * j];
+    ok = ok && fabsf(r->x[j] - s->dfc.rls_avg[j]) <= tol && 2.0f * pjj <= tol * tol;
+  }
+  const float a0 = fabsf(cfg->dfc_a), am = fabsf(r->x[0]);
+  return ok && am > 0.25f * a0 && am < 4.0f * a0 && fabsf(r->x[1]) < POS_DFC_P_MAX * am;
 }
 
 /* The measurement variance of the angle (4.29)-(4.31) or of the signals
@@ -280,7 +287,15 @@ static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sam
   if (full) { /* sequentiality: the held components turned to the newest */
     dfc_signals_vector(&s->dfc.sig, 2.0f * trk_omega(s), &v);
     if (s->dfc.rls_on) {
-      rls_step(s, cfg, &v, fresh);
+      out->rls_ok = rls_health(s, cfg, rls_step(s, cfg, &v, fresh));
+      /* the IVD to convergence, whatever dfc_iter: the filter follows its
+       * angle and the RLS regresses at the filter's prediction; after
+       * dfc_iter = 1 the angle keeps 2|p| of the raw error p sin 6theta
+       * (Theorem 1, (3.81): 0.7 of it at p = 0.35), which turns into a
+       * bias of b at the regressor (its e^{j2theta} times the 6theta error
+       * carries an e^{-j4theta} term: b - a eps / 2, eps the error's
+       * amplitude on 2theta; issue 23 point 5, docs/dfc.md) */
+      s->dfc.dc.iterations = DFC_ITER_MAX;
     }
   }
   const bool ok =

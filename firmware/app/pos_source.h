@@ -35,6 +35,8 @@ typedef struct {
   float health; /* |measurement - prediction| [rad electrical] */
   float load;   /* load torque estimate [N m]: written by the Kalman filter sources only
                    (the drive zeroes it when it starts a source) */
+  bool rls_ok;  /* ivd+kf+rls: the identified a, b have settled (pos_dfc.c, rls_health);
+                   written by that source only (the drive clears it when it starts a source) */
 } pos_estimate_t;
 
 /* What the drive knows of the last period, for the sources' models. */
@@ -85,6 +87,7 @@ typedef union {
     bool rls_on;
     kf_mech_t kf;
     rls_ab_t rls;
+    float rls_avg[2]; /* a, b low-passed over the RLS's updates (rls_health) */
     float r; /* the measurement variance of the last update (rad^2, or Gamma^2 for the EKF) */
   } dfc;
 } pos_state_t;

@@ -69,7 +69,8 @@ static const char *const signals[] = {"t",
                                       "rls_a",
                                       "rls_b",
                                       "kf_r",
-                                      "pos_emf_res"};
+                                      "pos_emf_res",
+                                      "rls_ok"};
 enum { NSIG = sizeof signals / sizeof signals[0], HEADER_LEN = 4096 };
 
 static void fill_row(const sil_step_t *st, double *r) {
@@ -159,7 +160,8 @@ static void fill_row(const sil_step_t *st, double *r) {
                     rls ? (double)st->drive->pos_st.dfc.dc.a : 0.0,
                     rls ? (double)st->drive->pos_st.dfc.dc.b : 0.0,
                     dfc ? (double)st->drive->pos_st.dfc.r : 0.0,
-                    st->drive->pos_emf_res};
+                    st->drive->pos_emf_res,
+                    tm->rls_ok ? 1.0 : 0.0};
   memcpy(r, v, sizeof v);
 }
 

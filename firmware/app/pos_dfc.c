@@ -16,9 +16,10 @@
  *                       (4.51)-(4.57), the loop of Fig. 4.4: the IVD uses
  *                       the identified a, b (held in the IVD's convergence
  *                       region |b/a| <= 0.45 and within a factor 4 of
- *                       dfc_a) and iterates DFC_ITER_MAX times (not
- *                       dfc_iter: its residual error biases b); the
- *                       RLS regressor is the filter's
+ *                       dfc_a) and, once aligned, starts its
+ *                       iterations from the filter's prediction (from
+ *                       the raw estimate their residual error biased b:
+ *                       issue 23 point 5); the RLS regressor is the filter's
  *                       predicted angle (a priori: free of this period's
  *                       signal noise, which the IVD angle carries - no
  *                       errors-in-variables bias); it identifies only above
@@ -205,9 +206,13 @@ static bool rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t 
 
 /* The RLS's health (rls_ok): its a and b have settled within the band,
  * each of them
- *   steady: within POS_DFC_RLS_BAND of its own low-pass over the updates
- *     (POS_DFC_RLS_AVG per update, from 0 at the start: no update, no
- *     information, not settled; a converging estimate runs ahead of it),
+ *   steady: the distance it still has to go within POS_DFC_RLS_BAND:
+ *     its distance from its own low-pass over the updates (1 /
+ *     POS_DFC_RLS_AVG updates; from 0 at the start: no update, no
+ *     information, not settled) is the rate it moves at times that lag,
+ *     and an RLS at its covariance P converges with a time constant of
+ *     about 1 + R / P updates (gain P / (P + R)): the distance left is the
+ *     rate times that time constant when it is the longer,
  *   known: twice the standard deviation its covariance states, sqrt(2 P)
  *     (the floor-limited RLS's estimate has a variance of about P / 2),
  *     within the band (a small b against the floor: p too small),
@@ -224,7 +229,9 @@ static bool rls_health(pos_state_t *s, const drive_config_t *cfg, bool updated) 
     }
     const float tol = POS_DFC_RLS_BAND * fabsf(r->x[j]);
     const float pjj = r->p[2u * j];
-    ok = ok && fabsf(r->x[j] - s->dfc.rls_avg[j]) <= tol && 2.0f * pjj <= tol * tol;
+    const float t_rls = 1.0f + r->cfg.r / pjj; /* updates; P >= p_min > 0 */
+    const float go = fabsf(r->x[j] - s->dfc.rls_avg[j]) * fd_maxf(1.0f, POS_DFC_RLS_AVG * t_rls);
+    ok = ok && go <= tol && 2.0f * pjj <= tol * tol;
   }
   const float a0 = fabsf(cfg->dfc_a), am = fabsf(r->x[0]);
   return ok && am > 0.25f * a0 && am < 4.0f * a0 && fabsf(r->x[1]) < POS_DFC_P_MAX * am;
@@ -288,18 +295,32 @@ static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sam
     dfc_signals_vector(&s->dfc.sig, 2.0f * trk_omega(s), &v);
     if (s->dfc.rls_on) {
       out->rls_ok = rls_health(s, cfg, rls_step(s, cfg, &v, fresh));
-      /* the IVD to convergence, whatever dfc_iter: the filter follows its
-       * angle and the RLS regresses at the filter's prediction; after
-       * dfc_iter = 1 the angle keeps 2|p| of the raw error p sin 6theta
-       * (Theorem 1, (3.81): 0.7 of it at p = 0.35), which turns into a
-       * bias of b at the regressor (its e^{j2theta} times the 6theta error
-       * carries an e^{-j4theta} term: b - a eps / 2, eps the error's
-       * amplitude on 2theta; issue 23 point 5, docs/dfc.md) */
-      s->dfc.dc.iterations = DFC_ITER_MAX;
     }
   }
-  const bool ok =
-      full && dfc_vector2(&s->dfc.dc, s->dfc.sig.g, &v, in->i_q, &c2, &s2, s->dfc.trace);
+  /* ivd+kf+rls, once aligned: the IVD's iterations start from the
+   * filter's prediction (warm), not from the raw estimate (3.8); the raw
+   * one (no iteration) checks the vector */
+  const bool warm = s->dfc.rls_on && s->dfc.aligned;
+  const uint32_t n_iter = s->dfc.dc.iterations;
+  if (warm) {
+    s->dfc.dc.iterations = 0u;
+  }
+  bool ok = full && dfc_vector2(&s->dfc.dc, s->dfc.sig.g, &v, in->i_q, &c2, &s2, s->dfc.trace);
+  s->dfc.dc.iterations = n_iter;
+  if (ok && warm) {
+    /* The filter follows the IVD's angle and the RLS regresses at the
+     * filter's prediction. From the raw estimate dfc_iter iterations leave
+     * (2|p|)^n of its error p sin 6theta (Theorem 1, (3.81): 0.7 of it
+     * for one at p = 0.35); at the regressor that error turns into a bias
+     * of b (the 6theta error times e^{j2theta} carries an e^{-j4theta}
+     * term: b - a eps / 2, eps its amplitude on 2theta; issue 23 point 5,
+     * docs/dfc.md). From the prediction they continue the last periods'
+     * iterations: the error left is (2|p|)^n times the prediction's. */
+    const sincos_t w = frames_sincos(2.0f * trk_theta(s));
+    c2 = w.c;
+    s2 = w.s;
+    ok = dfc_ivd_from(&s->dfc.dc, &v, in->i_q, &c2, &s2, s->dfc.trace);
+  }
   out->valid = ok;
   if (!ok) {
     if (!kalman) {

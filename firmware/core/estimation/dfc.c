@@ -233,6 +233,38 @@ bool dfc_vector2(const dfc_cfg_t *c, const float g[3], const dfc_vec_t *v, float
   return true;
 }
 
+bool dfc_ivd_from(const dfc_cfg_t *c, const dfc_vec_t *v, float i_q, float *c2, float *s2,
+                  float *trace) {
+  const bool full = c->method == DFC_FULL_IVD;
+  if (!(full || c->method == DFC_IVD)) {
+    return false;
+  }
+  const float inv_a = 1.0f / c->a;
+  const float zr = -v->al * inv_a, zi = v->be * inv_a, p = c->b * inv_a;
+  float ra[2] = {1.0f, 0.0f}, rb[2] = {1.0f, 0.0f};
+  if (full) {
+    const sincos_t pa = frames_sincos(c->phi_a * i_q), pb = frames_sincos(c->phi_b * i_q);
+    ra[0] = pa.c;
+    ra[1] = -pa.s;
+    rb[0] = pb.c;
+    rb[1] = -pb.s;
+  }
+  const uint32_t n = c->iterations < DFC_ITER_MAX ? c->iterations : DFC_ITER_MAX;
+  float ur = *c2, ui = *s2;
+  for (uint32_t k = 1u; k <= n; ++k) { /* (3.76) / (3.100) */
+    if (!dfc_ivd_step(zr, zi, p, v->k, rb, ra, &ur, &ui)) {
+      return false;
+    }
+    if (trace != NULL) {
+      trace[(size_t)2 * k] = ur;
+      trace[(size_t)2 * k + 1u] = ui;
+    }
+  }
+  *c2 = ur;
+  *s2 = ui;
+  return true;
+}
+
 float dfc_angle2(const dfc_cfg_t *c, const float g[3], float i_q, bool *ok) {
   float c2, s2;
   dfc_vec_t v;

@@ -125,6 +125,16 @@ static inline bool dfc_signals_complete(const dfc_signals_t *s) {
  * or not finite): *c2, *s2 are then 1, 0. */
 bool dfc_vector2(const dfc_cfg_t *c, const float g[3], const dfc_vec_t *v, float i_q, float *c2,
                  float *s2, float *trace);
+/* The IVD (3.76) / Full IVD (3.100) of c (c->iterations steps; IVD
+ * methods) started from the unit vector (*c2, *s2), a tracker's predicted
+ * e^{j 2 theta}, instead of the raw estimate (3.8): the error left after n
+ * steps is (2|p|)^n times the start's (Theorem 1, (3.81)), so a start that
+ * already carries the last periods' iterations continues them. trace (may
+ * be NULL): e^{j 2 theta_k} after step k = 1 .. iterations, as
+ * dfc_vector2's (its entry 0, the start, is left). false (and *c2, *s2
+ * unchanged) for another method or a vector with no direction. */
+bool dfc_ivd_from(const dfc_cfg_t *c, const dfc_vec_t *v, float i_q, float *c2, float *s2,
+                  float *trace);
 /* The same as an angle: 2 theta_e in [-pi, pi] (one CORDIC atan2), from
  * the plain Clarke vector of g. */
 float dfc_angle2(const dfc_cfg_t *c, const float g[3], float i_q, bool *ok);

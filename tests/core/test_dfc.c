@@ -289,9 +289,63 @@ static void test_window_moments_are_the_ripple(void **state) {
   ASSERT_IN(worst, 0.0, 1e-5); /* A */
 }
 
+/* dfc_ivd_from (the warm start of ivd+kf+rls): from the raw estimate it is
+ * dfc_vector2's iteration, step by step; from the true angle with the true
+ * p it stays there (the fixed point); from a start off by e one step
+ * leaves at most 2|p| e (Theorem 1, (3.81): the linearised step is
+ * -2p e cos 6theta) plus the second-order term; other methods refused. */
+static void test_ivd_from_a_start(void **state) {
+  (void)state;
+  const double ps[] = {-0.45, -0.35, -0.0932, 0.15, 0.35, 0.45};
+  const double a = 0.05, e = 0.05; /* rad on 2 theta */
+  double worst_same = 0.0, worst_fix = 0.0, worst_ratio = 0.0;
+  for (size_t ip = 0; ip < sizeof ps / sizeof ps[0]; ++ip) {
+    dfc_cfg_t c = {DFC_IVD, (float)a, (float)(ps[ip] * a), 0.0f, 0.0f, DFC_ITER_MAX};
+    for (int i = 0; i < 720; ++i) {
+      const double th = -T_PI + 2.0 * T_PI * i / 720.0;
+      float g[3], tr[2 * (DFC_ITER_MAX + 1u)], tr2[2 * (DFC_ITER_MAX + 1u)], c2, s2;
+      model_g(a, ps[ip] * a, th, 0.0, 0.0, g);
+      dfc_vec_t v;
+      dfc_vec_plain(g, &v);
+      assert_true(dfc_vector2(&c, g, &v, 0.0f, &c2, &s2, tr));
+      float u0c = tr[0], u0s = tr[1];
+      assert_true(dfc_ivd_from(&c, &v, 0.0f, &u0c, &u0s, tr2));
+      for (unsigned k = 1; k <= DFC_ITER_MAX; ++k) {
+        const double d = fabs(wrapd(atan2((double)tr2[2 * k + 1], (double)tr2[2 * k]) -
+                                    atan2((double)tr[2 * k + 1], (double)tr[2 * k])));
+        worst_same = d > worst_same ? d : worst_same;
+      }
+      c.iterations = 1u;
+      float wc = (float)cos(2.0 * th), ws = (float)sin(2.0 * th);
+      assert_true(dfc_ivd_from(&c, &v, 0.0f, &wc, &ws, NULL));
+      const double f = fabs(wrapd(atan2((double)ws, (double)wc) - 2.0 * th));
+      worst_fix = f > worst_fix ? f : worst_fix;
+      wc = (float)cos(2.0 * th + e);
+      ws = (float)sin(2.0 * th + e);
+      assert_true(dfc_ivd_from(&c, &v, 0.0f, &wc, &ws, NULL));
+      const double r = fabs(wrapd(atan2((double)ws, (double)wc) - 2.0 * th)) /
+                       (2.0 * fabs(ps[ip]) * e * (1.0 + 2.0 * e));
+      worst_ratio = r > worst_ratio ? r : worst_ratio;
+      c.iterations = DFC_ITER_MAX;
+    }
+  }
+  ASSERT_IN(worst_same, 0.0, 1e-6);
+  ASSERT_IN(worst_fix, 0.0, 2e-6);
+  ASSERT_IN(worst_ratio, 0.5, 1.0); /* reached at cos 6theta = +-1 */
+  const dfc_cfg_t std = {DFC_STANDARD, 0.05f, 0.0f, 0.0f, 0.0f, 1u};
+  dfc_vec_t v;
+  const float g[3] = {0.01f, -0.005f, -0.005f};
+  dfc_vec_plain(g, &v);
+  float wc = 1.0f, ws = 0.0f;
+  assert_false(dfc_ivd_from(&std, &v, 0.0f, &wc, &ws, NULL));
+  ASSERT_NEAR((double)wc, 1.0, 0.0);
+  ASSERT_NEAR((double)ws, 0.0, 0.0);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_ivd_equals_the_printed_iteration),
+      cmocka_unit_test(test_ivd_from_a_start),
       cmocka_unit_test(test_standard_dfc_error_is_3_13),
       cmocka_unit_test(test_inverse_dfc_exact_for_a_diagonal_matrix),
       cmocka_unit_test(test_check_theorem1),

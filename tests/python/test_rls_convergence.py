@@ -133,7 +133,10 @@ def measure(lg, a0: float, b0: float) -> dict:
     m = t >= t[-1] - 0.3
     ok = lg["rls_ok"]
     first_ok = float(t[np.argmax(ok > 0.5)]) if (ok > 0.5).any() else math.inf
+    # the angle's error, the polarity aside (on 2 theta, halved), last 0.3 s
+    e2 = np.angle(np.exp(2j * (lg["theta_e_est"][m] - lg["theta_e"][m]))) / 2.0
     return {"t_in": t_in, "a_end": float(np.mean(a[m])), "b_end": float(np.mean(b[m])),
+            "ang_sd": float(np.degrees(np.std(e2))),
             "a_start": float(a[0]), "b_start": float(b[0]), "ok_end": float(ok[-1]),
             "first_ok": first_ok, "faults": [], "ok_before": float(np.max(ok[t < 0.1]))}
 
@@ -170,12 +173,13 @@ def results(tmp_path_factory) -> list[tuple]:
 
     with ThreadPoolExecutor(2) as ex:
         rows = list(ex.map(one, cases()))
-    print("\n| machine | speed | start a, b | into the 5 % band | a, b: last 0.3 s | rls_ok from |")
-    print("|---|---|---|---|---|---|")
+    print("\n| machine | speed | start a, b | into the 5 % band (from the ramp's start) | "
+          "a, b: last 0.3 s | rls_ok from | angle error sD |")
+    print("|---|---|---|---|---|---|---|")
     for c, a0, b0, res in rows:
         print(f"| {c[0]} | {c[4]:.0f} rpm | {c[5] - 1:+.0%}, {c[6] - 1:+.0%} | "
               f"{res['t_in']:.3f} s | {res['a_end']:+.2%}, {res['b_end']:+.2%} | "
-              f"{res['first_ok']:.2f} s |")
+              f"{res['first_ok']:.2f} s | {res['ang_sd']:.2f} deg |")
     return rows
 
 

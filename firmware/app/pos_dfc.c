@@ -190,7 +190,8 @@ static void rls_guarded(const rls_ab_t *r, const drive_config_t *cfg, dfc_cfg_t 
  * update per refresh of the whole vector (when component a is the newest:
  * every third period, 5.3 kHz, the thesis's DFC rate): successive updates
  * then share no sample, as the RLS's independent noise assumes. */
-static bool rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v, bool fresh) {
+static bool rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v, bool fresh,
+                     const sincos_t *u /* the prediction, used once aligned */) {
   rls_ab_t *r = &s->dfc.rls;
   r->cfg = rls_cfg_of(cfg); /* the live tuning */
   rls_guarded(r, cfg, &s->dfc.dc);
@@ -198,14 +199,13 @@ static bool rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t 
         fabsf(s->dfc.kf.x[0]) > cfg->rls_w_min)) {
     return false;
   }
-  const sincos_t u = frames_sincos(2.0f * s->dfc.kf.x[1]);
-  const bool upd = rls_ab_update(r, v->al, v->be, u.c, u.s, v->k);
+  const bool upd = rls_ab_update(r, v->al, v->be, u->c, u->s, v->k);
   rls_guarded(r, cfg, &s->dfc.dc);
   return upd;
 }
 
-/* The RLS's health (rls_ok): its a and b have settled within the band,
- * each of them
+/* The RLS's health (rls_ok), after each update: its a and b have settled
+ * within the band, each of them
  *   steady: the distance it still has to go within POS_DFC_RLS_BAND:
  *     its distance from its own low-pass over the updates (1 /
  *     POS_DFC_RLS_AVG updates; from 0 at the start: no update, no
@@ -220,13 +220,11 @@ static bool rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t 
  * itself carries is not seen (docs/dfc.md). */
 #define POS_DFC_RLS_BAND 0.05f       /* issue 23 point 5: the 5 % band */
 #define POS_DFC_RLS_AVG  0.00390625f /* 1/256 per update: 48 ms at 5.3 kHz */
-static bool rls_health(pos_state_t *s, const drive_config_t *cfg, bool updated) {
+static bool rls_health(pos_state_t *s, const drive_config_t *cfg) {
   const rls_ab_t *r = &s->dfc.rls;
   bool ok = true;
   for (unsigned j = 0u; j < 2u; ++j) {
-    if (updated) {
-      s->dfc.rls_avg[j] += POS_DFC_RLS_AVG * (r->x[j] - s->dfc.rls_avg[j]);
-    }
+    s->dfc.rls_avg[j] += POS_DFC_RLS_AVG * (r->x[j] - s->dfc.rls_avg[j]);
     const float tol = POS_DFC_RLS_BAND * fabsf(r->x[j]);
     const float pjj = r->p[2u * j];
     const float t_rls = 1.0f + r->cfg.r / pjj; /* updates; P >= p_min > 0 */
@@ -291,35 +289,36 @@ static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sam
   float c2 = 1.0f, s2 = 0.0f;
   dfc_vec_t v;
   const bool full = dfc_signals_complete(&s->dfc.sig);
+  /* ivd+kf+rls, once aligned: the IVD's iterations start from the
+   * filter's prediction (warm), not from the raw estimate (3.8).
+   * The filter follows the IVD's angle and the RLS regresses at the
+   * filter's prediction. From the raw estimate dfc_iter iterations leave
+   * (2|p|)^n of its error p sin 6theta (Theorem 1, (3.81): 0.7 of it for
+   * one at p = 0.35); at the regressor that error turns into a bias of b
+   * (the 6theta error times e^{j2theta} carries an e^{-j4theta} term:
+   * b - a eps / 2, eps its amplitude on 2theta; issue 23 point 5,
+   * docs/dfc.md). From the prediction they continue the last periods'
+   * iterations: the error left is (2|p|)^n times the prediction's. */
+  const bool warm = s->dfc.rls_on && s->dfc.aligned;
+  bool ok = false;
   if (full) { /* sequentiality: the held components turned to the newest */
     dfc_signals_vector(&s->dfc.sig, 2.0f * trk_omega(s), &v);
-    if (s->dfc.rls_on) {
-      out->rls_ok = rls_health(s, cfg, rls_step(s, cfg, &v, fresh));
+    if (warm) {
+      const sincos_t w = frames_sincos(2.0f * trk_theta(s)); /* the prediction */
+      if (rls_step(s, cfg, &v, fresh, &w)) {
+        out->rls_ok = rls_health(s, cfg);
+      }
+      c2 = w.c;
+      s2 = w.s;
+      s->dfc.trace[0] = c2; /* the start, for logs */
+      s->dfc.trace[1] = s2;
+      ok = dfc_ivd_from(&s->dfc.dc, &v, in->i_q, &c2, &s2, s->dfc.trace);
+    } else {
+      if (s->dfc.rls_on) {
+        (void)rls_step(s, cfg, &v, fresh, NULL); /* the guarded a, b only */
+      }
+      ok = dfc_vector2(&s->dfc.dc, s->dfc.sig.g, &v, in->i_q, &c2, &s2, s->dfc.trace);
     }
-  }
-  /* ivd+kf+rls, once aligned: the IVD's iterations start from the
-   * filter's prediction (warm), not from the raw estimate (3.8); the raw
-   * one (no iteration) checks the vector */
-  const bool warm = s->dfc.rls_on && s->dfc.aligned;
-  const uint32_t n_iter = s->dfc.dc.iterations;
-  if (warm) {
-    s->dfc.dc.iterations = 0u;
-  }
-  bool ok = full && dfc_vector2(&s->dfc.dc, s->dfc.sig.g, &v, in->i_q, &c2, &s2, s->dfc.trace);
-  s->dfc.dc.iterations = n_iter;
-  if (ok && warm) {
-    /* The filter follows the IVD's angle and the RLS regresses at the
-     * filter's prediction. From the raw estimate dfc_iter iterations leave
-     * (2|p|)^n of its error p sin 6theta (Theorem 1, (3.81): 0.7 of it
-     * for one at p = 0.35); at the regressor that error turns into a bias
-     * of b (the 6theta error times e^{j2theta} carries an e^{-j4theta}
-     * term: b - a eps / 2, eps its amplitude on 2theta; issue 23 point 5,
-     * docs/dfc.md). From the prediction they continue the last periods'
-     * iterations: the error left is (2|p|)^n times the prediction's. */
-    const sincos_t w = frames_sincos(2.0f * trk_theta(s));
-    c2 = w.c;
-    s2 = w.s;
-    ok = dfc_ivd_from(&s->dfc.dc, &v, in->i_q, &c2, &s2, s->dfc.trace);
   }
   out->valid = ok;
   if (!ok) {

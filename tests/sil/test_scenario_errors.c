@@ -168,7 +168,8 @@ static const bad_case_t cases[] = {
      "|b/a| < 1/2 (Theorem 1"},
     /* issue 23, point 6: Theorem 1 at every load up to i_trip (2 * 2 sqrt(2)
      * A), not only at the unloaded p: p = 0.3 (1 + 0.125 |i_q|) = 0.512 at
-     * 5.657 A, 1/2 from 5.33 A (hand: 0.5 / 0.3 = 1 + 0.125 i) */
+     * 5.657 A, 1/2 from 5.33 A (0.5 / 0.3 = 1 + 0.125 i; the check's grid of 257
+     * currents first reaches it at 5.35 A) */
     {"{\"duration\": 1, \"machine\": {\"preset\": \"fabbri2022_fig33\", \"star_p\": 0.3, "
      "\"star_amp_iq\": 0.125}, \"inverter\": {\"model\": \"switching\"}, \"board\": "
      "{\"asym_edges\": 1}, \"controller\": {\"pos_source\": \"ivd\", \"align_time\": 0.1}}",

@@ -366,7 +366,8 @@ def shift_cases_drawn() -> tuple[float, float]:
     return float(rng.uniform(0.03, 0.06)), float(rng.uniform(-0.12, 0.12))
 
 
-SHIFT_CASES = {"b_2a": (SHIFT_PHI_IQ, 2.0 * SHIFT_PHI_IQ), "b_half_a": (SHIFT_PHI_IQ, 0.5 * SHIFT_PHI_IQ),
+SHIFT_CASES = {"b_2a": (SHIFT_PHI_IQ, 2.0 * SHIFT_PHI_IQ),
+               "b_half_a": (SHIFT_PHI_IQ, 0.5 * SHIFT_PHI_IQ),
                "b_0": (SHIFT_PHI_IQ, 0.0), "drawn": shift_cases_drawn()}
 
 

@@ -43,14 +43,17 @@
  * tracker's (PLL's or filter's) prediction; the magnet's polarity is resolved once, by the
  * alignment (Fabbri 2022, 3.1.3; hence align_time > 0): the d current
  * along theta = 0 pulls the rotor with a torque of the sign of
- * -sin(theta). The tracked estimate is theta or theta + pi; over the
- * alignment the source sums the change of its speed times -sin(estimate):
- * positive when the estimate is theta (the rotor accelerates the way the
- * torque pulls), negative when it is theta + pi. A rotor that does not
- * move (already at 0, or held) leaves the sum near zero: then the branch
- * nearest 0 is taken, where the current holds the north pole. A light
- * rotor swinging through the alignment is thus resolved as well as one
- * that settles (tests: both magnet polarities).
+ * -sin(theta). The tracked estimate is theta or theta + pi. First
+ * evidence, the energy: the torque derives from the potential -k cos
+ * theta, so from rest cos(theta) - cos(theta_0) >= 0 on the right branch
+ * (pol_energy). Second, where that shows no motion: the sum of the
+ * change of its speed times -sin(estimate), positive when the estimate is
+ * theta (the rotor accelerates the way the torque pulls), negative when it
+ * is theta + pi. A rotor that does not move (already at 0, or held)
+ * leaves both near zero: then the branch nearest 0 is taken, where the
+ * current holds the north pole. A light rotor swinging through the
+ * alignment is thus resolved as well as one that settles (tests: both
+ * magnet polarities; docs/dfc.md).
  */
 #include <stddef.h>
 
@@ -113,6 +116,17 @@ static rls_ab_cfg_t rls_cfg_of(const drive_config_t *cfg) {
  * angle within 0.3 rad, load within 0.3 N m (1 sigma). */
 static const float kf_p0[3] = {900.0f, 0.09f, 0.09f};
 
+static void pol_reset(pos_state_t *s) {
+  s->dfc.pol_acc = 0.0f;
+  s->dfc.w_prev = 0.0f;
+  s->dfc.e_c0 = 0.0f;
+  s->dfc.e_acc = 0.0f;
+  s->dfc.e_lp = 0.0f;
+  s->dfc.e_n0 = 0u;
+  s->dfc.e_n = 0u;
+  s->dfc.aligned = false;
+}
+
 FD_COLD static void pdfc_init(pos_state_t *s, const drive_config_t *cfg) {
   angle_pll_init(&s->dfc.pll, cfg->pll_bw, cfg->ts);
   s->dfc.track = track_of(cfg->pos_source);
@@ -131,9 +145,7 @@ FD_COLD static void pdfc_init(pos_state_t *s, const drive_config_t *cfg) {
   s->dfc.started = false;
   s->dfc.t = 0.0f;
   s->dfc.n = 0u;
-  s->dfc.pol_acc = 0.0f;
-  s->dfc.w_prev = 0.0f;
-  s->dfc.aligned = false;
+  pol_reset(s);
   for (unsigned k = 0u; k < 2u * (DFC_ITER_MAX + 1u); ++k) {
     s->dfc.trace[k] = 0.0f;
   }
@@ -145,9 +157,7 @@ static void pdfc_reset(pos_state_t *s) {
   dfc_signals_reset(&s->dfc.sig);
   s->dfc.started = false;
   s->dfc.n = 0u;
-  s->dfc.pol_acc = 0.0f;
-  s->dfc.w_prev = 0.0f;
-  s->dfc.aligned = false;
+  pol_reset(s);
 }
 
 /* The branch of 2 theta / 2 nearest ref. */
@@ -248,6 +258,32 @@ static float meas_r(const pos_state_t *s, const drive_config_t *cfg, const dfc_v
   const float g2 =
       is_ivd(cfg->pos_source) ? s->dfc.dc.a * s->dfc.dc.a : v->al * v->al + v->be * v->be;
   return cfg->kf_r_scale * 0.25f * var / fd_maxf(g2, 1e-12f);
+}
+
+/* The energy evidence: the rotor starts at rest and the alignment's torque
+ * -k sin(theta) derives from the potential -k cos(theta), so on the right
+ * branch k (cos theta(t) - cos theta_0) = kinetic energy + friction's loss
+ * >= 0 at every instant, and <= 0 on the branch pi off. Positions only: no
+ * speed estimate's ringing in it. cos(theta_0): the mean over the first
+ * POS_DFC_E_REF periods (the rotor has not moved yet). The evidence is the
+ * mean over the alignment plus the recent value (a low-pass over
+ * POS_DFC_E_REF periods): both >= 0 on the right branch; the mean holds a
+ * rotor swinging about 0 (the recent value may meet a turning point), the
+ * recent value one falling away from the unstable point pi (most of its
+ * motion comes at the end). */
+#define POS_DFC_E_REF 32u
+static void pol_energy(pos_state_t *s, float c) {
+  if (s->dfc.e_n0 < POS_DFC_E_REF) {
+    s->dfc.e_c0 += c;
+    if (++s->dfc.e_n0 == POS_DFC_E_REF) {
+      s->dfc.e_c0 *= 1.0f / (float)POS_DFC_E_REF;
+      s->dfc.e_lp = s->dfc.e_c0;
+    }
+  } else if (s->dfc.e_n < UINT32_MAX) {
+    s->dfc.e_acc += c - s->dfc.e_c0;
+    s->dfc.e_lp += (c - s->dfc.e_lp) * (1.0f / (float)POS_DFC_E_REF);
+    s->dfc.e_n++;
+  }
 }
 
 static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
@@ -364,22 +400,31 @@ static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sam
    * the sine: a bias towards theta + pi that wins where the rotor hardly
    * moves, near the alignment angle; docs/dfc.md) */
   if (!s->dfc.aligned) {
-    s->dfc.pol_acc -= (out->omega - s->dfc.w_prev) * frames_sincos(pred).s;
+    const sincos_t u = frames_sincos(pred);
+    s->dfc.pol_acc -= (out->omega - s->dfc.w_prev) * u.s;
     s->dfc.w_prev = out->omega;
+    pol_energy(s, u.c);
   }
 }
 
 /* The alignment towards electrical angle theta (0) ends: the polarity
  * from the motion it caused, or, without motion, the branch nearest it. */
-#define POS_DFC_POL_MIN 2.0f /* rad/s electrical: evidence of motion */
+#define POS_DFC_POL_MIN 2.0f  /* rad/s electrical: evidence of motion */
+#define POS_DFC_E_MIN   0.02f /* cos(theta) - cos(theta_0), mean + recent: evidence of motion */
 static void pdfc_align(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
                        float theta) {
   (void)cfg;
   (void)smp;
   const float acc = s->dfc.pol_acc;
   const float now = trk_theta(s);
+  const float e =
+      s->dfc.e_n > 0u ? s->dfc.e_acc / (float)s->dfc.e_n + (s->dfc.e_lp - s->dfc.e_c0) : 0.0f;
   float th;
-  if (acc > POS_DFC_POL_MIN) {
+  if (e > POS_DFC_E_MIN) {
+    th = now; /* the rotor went down the potential: theta */
+  } else if (e < -POS_DFC_E_MIN) {
+    th = frames_wrap_pi(now + FRAMES_PI);
+  } else if (acc > POS_DFC_POL_MIN) {
     th = now; /* the estimate moved as the torque pulled: theta */
   } else if (acc < -POS_DFC_POL_MIN) {
     th = frames_wrap_pi(now + FRAMES_PI); /* theta + pi */
@@ -388,8 +433,8 @@ static void pdfc_align(pos_state_t *s, const drive_config_t *cfg, const hal_samp
   }
   trk_reset(s, th, trk_omega(s));
   s->dfc.started = true;
+  pol_reset(s);
   s->dfc.aligned = true;
-  s->dfc.pol_acc = 0.0f;
 }
 
 FD_COLD static const char *pdfc_check_cfg(const drive_config_t *cfg, const char **field) {

@@ -79,6 +79,10 @@ typedef union {
     /* polarity: sum of the speed change times -sin(theta) while the
      * alignment pulls the rotor towards 0 (pos_dfc.c) */
     float pol_acc, w_prev;
+    /* and the energy evidence: cos(theta) - cos(theta_0), its sum and its
+     * recent value (a low-pass of cos(theta)) */
+    float e_c0, e_acc, e_lp;
+    uint32_t e_n0, e_n;
     bool aligned; /* the alignment has resolved the polarity */
     /* the tracker: the PLL above, or the Kalman filter (KF and EKF
      * sources); the RLS of a, b (ivd+kf+rls) */

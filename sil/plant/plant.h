@@ -27,17 +27,21 @@
  * (ld = L0 - M0 + L2/2 + M2, lq = L0 - M0 - L2/2 - M2) and the DFC
  * anisotropy is p = b/a = (ld - lq)/(ld + lq) (3.7), whatever the split;
  * the split sets the signal amplitude a of (3.7) (docs/star-point.md).
- * phi_iq: the saliency axis of these (incremental) inductances shifted
- * with load, 2 theta_e -> 2 theta_e + phi_iq * i_q: the phase shifts of
- * the Full IVD model (3.97) with phi_a = phi_iq i_q, phi_b = 2 phi_iq i_q.
+ * phi_self, phi_mut: the self (L2) and mutual (M2) terms' 2theta axes
+ * shifted with load, independently: 2 theta_e -> 2 theta_e + phi_self i_q
+ * in the self terms, 2 theta_e + phi_mut i_q in the mutual ones. (3.7)
+ * with L2, M2 as phasors L2 e^{j phi_self i_q}, M2 e^{j phi_mut i_q} gives
+ * the Full IVD model (3.97) exactly (plant_aniso_load): phi_a = arg(L2 -
+ * M2), phi_b = phi_a + arg(L2/2 + M2), p = |L2/2 + M2| / (L0 - M0). Equal
+ * shifts phi: phi_a = phi i_q, phi_b = 2 phi i_q (a turned saliency axis).
  * amp_iq: the amplitude of their 2theta terms with load, L2 and M2 times
  * (1 + amp_iq |i_q|) (a and b of (3.97) change with it).
  * Both act on the star point only (the dq model keeps ld, lq). */
 typedef struct {
-  int enabled;   /* 0: isotropic star point (the mean of the leg potentials) */
-  double m0, m2; /* [H] */
-  double phi_iq; /* [rad/A] */
-  double amp_iq; /* [1/A] */
+  int enabled;              /* 0: isotropic star point (the mean of the leg potentials) */
+  double m0, m2;            /* [H] */
+  double phi_self, phi_mut; /* [rad/A] */
+  double amp_iq;            /* [1/A] */
   /* the range of the load scale 1 + amp_iq |i_q| the plant uses (clamped
    * to it) and plant_aniso_ok checks; 0: 0.5 .. 2 (the scenario parser
    * sets it from the current the plant may carry, controller.i_trip) */
@@ -349,8 +353,15 @@ int plant_star_read(plant_t *pl, double v[PLANT_STAR_MAX]);
 /* Whether a machine's (3.3) matrix is an inductance matrix (positive
  * definite at every angle) that carries the position (L2 != M2). */
 int plant_aniso_ok(const plant_machine_t *m);
+/* ... and at the load i_q: the scale and the self / mutual shifts apart */
+int plant_aniso_ok_at(const plant_machine_t *m, double i_q);
 /* a and b of (3.7) (normalised to v_dc) of a machine's (3.3) matrix. */
 void plant_aniso_ab(const plant_machine_t *m, double *a, double *b);
+/* The Full IVD model (3.97) of the star point at the load i_q: the phase
+ * shifts phi_a, phi_b [rad] of its 2theta and 4theta terms and its
+ * anisotropy p = b/a, with the load scale (clamped as the plant does). */
+void plant_aniso_load(const plant_machine_t *m, double i_q, double *phi_a, double *phi_b,
+                      double *p);
 /* The static star-point divider G_c = L_Sigma / (L_Sigma T^T) of (2.90)
  * at electrical angle theta_e and q current i_q (isotropic: 1/3 each). */
 void plant_star_gain(const plant_t *pl, double theta_e, double i_q, double g[3]);

@@ -28,13 +28,14 @@
 #define STAR_K_MIN 0.5
 #define STAR_K_MAX 2.0
 
-/* The (3.3) matrix at x = 2 theta_e (+ the load shift) and its derivative
- * with respect to theta_e. */
-static void star_matrix_of(double l0, double l2, double m0, double m2, double x, double L[3][3],
-                           double dL[3][3]) {
+/* The (3.3) matrix, its self terms at xs = 2 theta_e (+ their load
+ * shift), its mutual terms at xm, and its derivative with respect to
+ * theta_e. */
+static void star_matrix_of(double l0, double l2, double m0, double m2, double xs, double xm,
+                           double L[3][3], double dL[3][3]) {
   const double q = 2.0 * PLANT_PI / 3.0;
-  const double self[3] = {x, x + q, x + 2.0 * q};
-  const double mut[3] = {x - q, x + q, x}; /* ab, ac, bc */
+  const double self[3] = {xs, xs + q, xs + 2.0 * q};
+  const double mut[3] = {xm - q, xm + q, xm}; /* ab, ac, bc */
   for (int k = 0; k < 3; k++) {
     L[k][k] = l0 + l2 * cos(self[k]);
     dL[k][k] = -2.0 * l2 * sin(self[k]);
@@ -52,41 +53,31 @@ static void star_k_range(const plant_aniso_t *an, double *lo, double *hi) {
   *hi = an->k_max > 0.0 ? an->k_max : STAR_K_MAX;
 }
 
-/* at x = 2 theta_e + phi_iq i_q, the 2theta terms scaled by the load */
-static void star_matrix(const plant_t *pl, double x, double i_q, double L[3][3], double dL[3][3]) {
-  const plant_aniso_t *an = &pl->p.machine.aniso;
+/* The load scale 1 + amp_iq |i_q|, held within its range. */
+static double star_k(const plant_aniso_t *an, double i_q) {
   double k = 1.0 + an->amp_iq * fabs(i_q), lo, hi;
   star_k_range(an, &lo, &hi);
-  k = k < lo ? lo : (k > hi ? hi : k);
-  star_matrix_of(pl->aux.l0, k * pl->aux.l2, an->m0, k * an->m2, x, L, dL);
+  return k < lo ? lo : (k > hi ? hi : k);
 }
 
-/* The matrix from (ld, lq, m0, m2) must be an inductance matrix: positive
- * definite at every angle (leading minors, checked every degree of 2
- * theta_e), and carry the position (L2 != M2, first condition of (3.7)).
- * With a load scale, at both ends of its range (the matrix is linear in
- * the scale: positive definite at both ends is positive definite
- * between). */
-int plant_aniso_ok(const plant_machine_t *m) {
-  const double m0 = m->aniso.m0, m2 = m->aniso.m2;
-  double k_lo, k_hi;
-  star_k_range(&m->aniso, &k_lo, &k_hi);
-  if (!(isfinite(m0) && isfinite(m2) && fabs(m->aniso.phi_iq) < 10.0 && m->aniso.amp_iq >= -0.5 &&
-        m->aniso.amp_iq <= 1.0 && k_lo >= STAR_K_MIN && k_lo <= 1.0 && k_hi >= 1.0 &&
-        k_hi <= STAR_K_MAX)) {
-    return 0;
-  }
-  const double l0 = 0.5 * (m->ld + m->lq) + m0, l2 = (m->ld - m->lq) - 2.0 * m2;
-  if (!(fabs(l2 - m2) > 1e-9 * l0)) {
-    return 0;
-  }
-  for (int k = 0; k < 3 * 360; k++) {
-    const double sc = (k / 360 == 0) ? 1.0 : (k / 360 == 1 ? k_lo : k_hi);
-    if (sc != 1.0 && !(fabs(m->aniso.amp_iq) > 0.0)) {
-      break; /* no load scaling */
-    }
+/* at 2 (theta_e + shift) + phi_self i_q (self terms), + phi_mut i_q
+ * (mutual terms), the 2theta terms scaled by the load */
+static void star_matrix(const plant_t *pl, double th_e, double i_q, double L[3][3],
+                        double dL[3][3]) {
+  const plant_aniso_t *an = &pl->p.machine.aniso;
+  const double k = star_k(an, i_q), x = 2.0 * (th_e + an->shift);
+  star_matrix_of(pl->aux.l0, k * pl->aux.l2, an->m0, k * an->m2, x + an->phi_self * i_q,
+                 x + an->phi_mut * i_q, L, dL);
+}
+
+/* The (3.3) matrix with its 2theta terms scaled by k and the mutual ones
+ * turned by dx from the self ones is positive definite at every angle
+ * (leading minors, checked every degree of 2 theta_e). */
+static int star_pd(double l0, double l2, double m0, double m2, double k, double dx) {
+  for (int d = 0; d < 360; d++) {
     double L[3][3], dL[3][3];
-    star_matrix_of(l0, sc * l2, m0, sc * m2, (k % 360) * (PLANT_PI / 180.0), L, dL);
+    const double x = d * (PLANT_PI / 180.0);
+    star_matrix_of(l0, k * l2, m0, k * m2, x, x + dx, L, dL);
     const double d2 = L[0][0] * L[1][1] - L[0][1] * L[1][0];
     const double d3 = L[0][0] * (L[1][1] * L[2][2] - L[1][2] * L[2][1]) -
                       L[0][1] * (L[1][0] * L[2][2] - L[1][2] * L[2][0]) +
@@ -96,6 +87,41 @@ int plant_aniso_ok(const plant_machine_t *m) {
     }
   }
   return 1;
+}
+
+/* The matrix from (ld, lq, m0, m2) must be an inductance matrix: positive
+ * definite at every angle, and carry the position (L2 != M2, first
+ * condition of (3.7)). With a load scale, at both ends of its range (the
+ * matrix is linear in the scale: positive definite at both ends is
+ * positive definite between). The self and mutual terms turned apart by
+ * the load: plant_aniso_ok_at. */
+int plant_aniso_ok(const plant_machine_t *m) {
+  const double m0 = m->aniso.m0, m2 = m->aniso.m2;
+  double k_lo, k_hi;
+  star_k_range(&m->aniso, &k_lo, &k_hi);
+  if (!(isfinite(m0) && isfinite(m2) && fabs(m->aniso.phi_self) < 10.0 &&
+        fabs(m->aniso.phi_mut) < 10.0 && m->aniso.amp_iq >= -0.5 && m->aniso.amp_iq <= 1.0 &&
+        k_lo >= STAR_K_MIN && k_lo <= 1.0 && k_hi >= 1.0 && k_hi <= STAR_K_MAX)) {
+    return 0;
+  }
+  const double l0 = 0.5 * (m->ld + m->lq) + m0, l2 = (m->ld - m->lq) - 2.0 * m2;
+  if (!(fabs(l2 - m2) > 1e-9 * l0)) {
+    return 0;
+  }
+  if (!star_pd(l0, l2, m0, m2, 1.0, 0.0)) {
+    return 0;
+  }
+  if (fabs(m->aniso.amp_iq) > 0.0) { /* the load scaling's ends */
+    return star_pd(l0, l2, m0, m2, k_lo, 0.0) && star_pd(l0, l2, m0, m2, k_hi, 0.0);
+  }
+  return 1;
+}
+
+int plant_aniso_ok_at(const plant_machine_t *m, double i_q) {
+  const double m0 = m->aniso.m0, m2 = m->aniso.m2;
+  const double l0 = 0.5 * (m->ld + m->lq) + m0, l2 = (m->ld - m->lq) - 2.0 * m2;
+  return star_pd(l0, l2, m0, m2, star_k(&m->aniso, i_q),
+                 (m->aniso.phi_mut - m->aniso.phi_self) * i_q);
 }
 
 /* g = T adj(L) / (T adj(L) T^T): the column sums of the adjugate of the
@@ -123,8 +149,7 @@ void plant_star_gain(const plant_t *pl, double theta_e, double i_q, double g[3])
     return;
   }
   double L[3][3], dL[3][3];
-  star_matrix(pl, 2.0 * (theta_e + pl->p.machine.aniso.shift) + pl->p.machine.aniso.phi_iq * i_q,
-              i_q, L, dL);
+  star_matrix(pl, theta_e, i_q, L, dL);
   star_divider(L, g);
 }
 
@@ -134,8 +159,7 @@ double plant_star_vn(const plant_t *pl, const double v[3], const double i[3], do
     return (v[0] + v[1] + v[2]) * (1.0 / 3.0);
   }
   double L[3][3], dL[3][3], g[3];
-  star_matrix(pl, 2.0 * (th_e + pl->p.machine.aniso.shift) + pl->p.machine.aniso.phi_iq * i_q, i_q,
-              L, dL);
+  star_matrix(pl, th_e, i_q, L, dL);
   star_divider(L, g);
   double vn = 0.0;
   for (int k = 0; k < 3; k++) {
@@ -192,4 +216,26 @@ void plant_aniso_ab(const plant_machine_t *m, double *a, double *b) {
   const double k = (l2 - m->aniso.m2) / (3.0 * (g0 * g0 - g2 * g2)); /* (3.7) */
   *a = g0 * k;
   *b = g2 * k;
+}
+
+/* (3.7) with the load's L2, M2 as phasors (self terms turned by phi_self
+ * i_q, mutual by phi_mut i_q, both scaled by k): the 2theta term carries
+ * L2 - M2, the 4theta term (L2/2 + M2)(L2 - M2), so the (3.97) shifts
+ * are phi_a = arg(L2 - M2), phi_b = phi_a + arg(L2/2 + M2) (from their
+ * unloaded values) and p = b/a = k |L2/2 + M2| / (L0 - M0), with the
+ * unloaded sign (checked against the divider's signal,
+ * tests/plant/test_star_point.c). */
+void plant_aniso_load(const plant_machine_t *m, double i_q, double *phi_a, double *phi_b,
+                      double *p) {
+  const plant_aniso_t *an = &m->aniso;
+  const double l2 = (m->ld - m->lq) - 2.0 * an->m2, m2 = an->m2, g0 = 0.5 * (m->ld + m->lq);
+  const double ts = an->phi_self * i_q, tm = an->phi_mut * i_q;
+  /* L2 e^{j ts} - M2 e^{j tm} and L2/2 e^{j ts} + M2 e^{j tm} */
+  const double ar = l2 * cos(ts) - m2 * cos(tm), ai = l2 * sin(ts) - m2 * sin(tm);
+  const double br = 0.5 * l2 * cos(ts) + m2 * cos(tm), bi = 0.5 * l2 * sin(ts) + m2 * sin(tm);
+  const double a0 = l2 - m2, b0 = 0.5 * l2 + m2;
+  *phi_a = atan2(ai * a0, ar * a0); /* arg of (L2 - M2)(i_q) / (L2 - M2)(0) */
+  const double db = b0 != 0.0 ? atan2(bi * b0, br * b0) : 0.0;
+  *phi_b = *phi_a + db;
+  *p = (b0 < 0.0 ? -1.0 : 1.0) * star_k(an, i_q) * sqrt(br * br + bi * bi) / g0;
 }

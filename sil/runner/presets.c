@@ -29,7 +29,7 @@ static const machine_preset_t presets[] = {
                     .lq = 475e-6,
                     .lambda_m = 0.1186 / (8.0 * 1.7320508075688772),
                     /* star point (3.3): a = 0.05, p = -0.0932 (docs/dfc.md) */
-                    .aniso = {.enabled = 1, .m0 = 20e-6, .m2 = -48.54e-6, .phi_iq = 0.0}},
+                    .aniso = {.enabled = 1, .m0 = 20e-6, .m2 = -48.54e-6, .phi_self = 0.0}},
         .inertia = 2e-4,
         .friction = 1e-5,
         .v_dc = 24.0,
@@ -49,7 +49,7 @@ static const machine_preset_t presets[] = {
                     .aniso = {.enabled = 1,
                               .m0 = 20.7e-6,
                               .m2 = 0.15 * 421.5e-6 - 0.5 * 103.3e-6,
-                              .phi_iq = 0.0,
+                              .phi_self = 0.0,
                               .amp_iq = 0.0}},
         .inertia = 2e-4,
         .friction = 1e-5,
@@ -67,7 +67,7 @@ static const machine_preset_t presets[] = {
                     .lq = 149e-6,
                     .lambda_m = 0.0236,
                     /* star point (3.3): a = 0.05, p = -0.1825 (docs/dfc.md) */
-                    .aniso = {.enabled = 1, .m0 = 6e-6, .m2 = -21.42e-6, .phi_iq = 0.0}},
+                    .aniso = {.enabled = 1, .m0 = 6e-6, .m2 = -21.42e-6, .phi_self = 0.0}},
         .inertia = 0.05,
         .friction = 1e-3,
         .v_dc = 24.0,

@@ -21,6 +21,8 @@
 #include "presets.h"
 
 #define PI 3.14159265358979323846
+/* the load grid (0 .. i_trip) Theorem 1 is checked on (check_star) */
+#define STAR_LOAD_STEPS 256
 /* star_tau at most this share of the sample's settling time (dfc_t_meas -
  * dead time): measured on the fabbri2022 presets, docs/dfc.md */
 #define STAR_TAU_SHARE 0.2
@@ -339,8 +341,10 @@ static int use_map(ctx_t *c, const char *key, const char *file, int pp, scenario
 /* The first star-point key the machine section gives ("machine.star_p",
  * ...), NULL for none. */
 static const char *star_key_given(const cJSON *m) {
-  static const char *const keys[] = {"machine.star_p", "machine.star_m2", "machine.star_m0",
-                                     "machine.star_amp_iq", "machine.star_phi_iq"};
+  static const char *const keys[] = {"machine.star_p",         "machine.star_m2",
+                                     "machine.star_m0",        "machine.star_amp_iq",
+                                     "machine.star_phi_iq",    "machine.star_phi_self",
+                                     "machine.star_phi_mutual"};
   for (size_t k = 0; m != NULL && k < sizeof keys / sizeof keys[0]; ++k) {
     if (cJSON_GetObjectItemCaseSensitive(m, keys[k] + 8) != NULL) {
       return keys[k];
@@ -350,9 +354,22 @@ static const char *star_key_given(const cJSON *m) {
 }
 
 static int parse_machine(ctx_t *c, const cJSON *m, scenario_t *sc) {
-  static const char *const keys[] = {"preset",      "pole_pairs",  "rs",     "ld",      "lq",
-                                     "ls",          "lambda_m",    "map",    "star_m0", "star_m2",
-                                     "star_phi_iq", "star_amp_iq", "star_p", NULL};
+  static const char *const keys[] = {"preset",
+                                     "pole_pairs",
+                                     "rs",
+                                     "ld",
+                                     "lq",
+                                     "ls",
+                                     "lambda_m",
+                                     "map",
+                                     "star_m0",
+                                     "star_m2",
+                                     "star_phi_iq",
+                                     "star_amp_iq",
+                                     "star_p",
+                                     "star_phi_self",
+                                     "star_phi_mutual",
+                                     NULL};
   if (check_keys(c, m, "machine", keys) != 0) {
     return -1;
   }
@@ -421,9 +438,23 @@ static int parse_machine(ctx_t *c, const cJSON *m, scenario_t *sc) {
   }
   if (get_num(c, m, M, "star_m0", -1.0, 1.0, &pm->aniso.m0) ||
       get_num(c, m, M, "star_m2", -1.0, 1.0, &pm->aniso.m2) ||
-      get_num(c, m, M, "star_phi_iq", -1.0, 1.0, &pm->aniso.phi_iq) ||
+      get_num(c, m, M, "star_phi_self", -1.0, 1.0, &pm->aniso.phi_self) ||
+      get_num(c, m, M, "star_phi_mutual", -1.0, 1.0, &pm->aniso.phi_mut) ||
       get_num(c, m, M, "star_amp_iq", -0.5, 1.0, &pm->aniso.amp_iq)) {
     return -1;
+  }
+  /* star_phi_iq: both terms' shift (a turned saliency axis: phi_a = phi_iq,
+   * phi_b = 2 phi_iq of (3.97)), an alias of the pair */
+  if (cJSON_GetObjectItemCaseSensitive(m, "star_phi_iq") != NULL) {
+    if (cJSON_GetObjectItemCaseSensitive(m, "star_phi_self") ||
+        cJSON_GetObjectItemCaseSensitive(m, "star_phi_mutual")) {
+      return fail(c, "machine.star_phi_iq",
+                  "sets star_phi_self and star_phi_mutual both: give either it or them");
+    }
+    if (get_num(c, m, M, "star_phi_iq", -1.0, 1.0, &pm->aniso.phi_self)) {
+      return -1;
+    }
+    pm->aniso.phi_mut = pm->aniso.phi_self;
   }
   /* star_p: the anisotropy p of (3.7) with L0, M0, L2 kept (Fig. 3.3):
    * gamma0 = L0 - M0, gamma2 = p gamma0 = L2/2 + M2, ld, lq = gamma0 +- gamma2 */
@@ -1277,6 +1308,59 @@ static int check_star(ctx_t *c, const cJSON *root, scenario_t *sc) {
                 "definite at |i_q| = %.3g A, below controller.i_trip (%g A), the current the plant "
                 "may carry before the drive trips: lower star_amp_iq or i_trip",
                 amp, amp, ok, i_lim);
+  }
+  /* the self and mutual terms turned apart by the load: an inductance
+   * matrix at every load up to i_trip */
+  if (pm->aniso.phi_self != pm->aniso.phi_mut) {
+    for (int k = 0; k <= STAR_LOAD_STEPS; ++k) {
+      const double i_q = i_lim * k / STAR_LOAD_STEPS;
+      if (!plant_aniso_ok_at(pm, i_q)) {
+        static const char *const ks[] = {"star_phi_self", "star_phi_mutual", NULL};
+        return fail(c, machine_key(m, ks),
+                    "star_phi_self %g, star_phi_mutual %g rad/A turn the self and mutual terms "
+                    "apart by %.3g rad at |i_q| = %.3g A, within controller.i_trip (%g A): the "
+                    "(3.3) matrix is not positive definite there (no inductance matrix)",
+                    pm->aniso.phi_self, pm->aniso.phi_mut,
+                    (pm->aniso.phi_self - pm->aniso.phi_mut) * i_q, i_q, i_lim);
+      }
+    }
+  }
+  /* Theorem 1 at every load the plant may carry: the IVD's p = b/a with
+   * the load scale and the self / mutual shifts (plant_aniso_load) up to
+   * controller.i_trip, not only the unloaded p the drive's dfc_b holds */
+  const pos_source_t src = sc->drive.pos_source;
+  if (src == POS_SOURCE_IVD || src == POS_SOURCE_IVD_KF || src == POS_SOURCE_IVD_KF_RLS) {
+    double p_max = 0.0, i_at = 0.0, pa_at = 0.0, pb_at = 0.0, i_half = -1.0;
+    for (int k = 0; k <= STAR_LOAD_STEPS; ++k) {
+      const double i_q = i_lim * k / STAR_LOAD_STEPS;
+      double pa, pb, p;
+      plant_aniso_load(pm, i_q, &pa, &pb, &p);
+      if (!(fabs(p) < 0.5) && i_half < 0.0) {
+        i_half = i_q;
+      }
+      if (fabs(p) > fabs(p_max)) {
+        p_max = p;
+        i_at = i_q;
+        pa_at = pa;
+        pb_at = pb;
+      }
+    }
+    double pa0, pb0, p0, k_at = 1.0 + amp * i_at;
+    plant_aniso_load(pm, 0.0, &pa0, &pb0, &p0);
+    k_at = k_at < pm->aniso.k_min ? pm->aniso.k_min
+                                  : (k_at > pm->aniso.k_max ? pm->aniso.k_max : k_at);
+    /* the unloaded p at or above 1/2 is the drive's dfc_b (named by p_key) */
+    if (fabs(p0) < 0.5 && !(fabs(p_max) < 0.5)) {
+      static const char *const kl[] = {"star_amp_iq", "star_phi_self", "star_phi_mutual",
+                                       "star_phi_iq", NULL};
+      return fail(c, machine_key(m, kl),
+                  "the star point's p = b/a reaches %.3g (3.7) at |i_q| = %.3g A (load scale "
+                  "%.3g, phase shifts phi_a %.3g, phi_b %.3g rad of (3.97)), |p| >= 1/2 from "
+                  "%.3g A, within controller.i_trip (%g A): the IVD needs |p| < 1/2 at every "
+                  "load (Theorem 1: no convergence otherwise; the drive's dfc_b holds the "
+                  "unloaded p %.3g): lower the load's scale or i_trip",
+                  p_max, i_at, k_at, pa_at, pb_at, i_half, i_lim, p0);
+    }
   }
   /* the drive's a against the matrix's: a's sign is L2 - M2's (3.7); the
    * other sign turns the DFC angle 2 theta_e by pi, theta_e by 90 degrees,

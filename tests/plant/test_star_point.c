@@ -29,7 +29,7 @@ static plant_params_t star_params(double theta_e, double tau, double dead) {
   p.machine.ld = 394e-6;
   p.machine.lq = 475e-6;
   p.machine.lambda_m = 0.1186 / 8.0;
-  p.machine.aniso = (plant_aniso_t){1, 20e-6, -48.54e-6, 0.0, 0.0, 0.0, 0.0, 0.0};
+  p.machine.aniso = (plant_aniso_t){1, 20e-6, -48.54e-6, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
   p.inverter.model = PLANT_INV_SWITCHING;
   p.inverter.dead_time = dead;
   p.sensors.adc_bits = 24;
@@ -129,6 +129,54 @@ static void test_gamma_is_3_6(void **state) {
   }
 }
 
+/* Issue 23, point 6: the self and mutual terms turned apart with the load
+ * (phi_self, phi_mut) and scaled (amp_iq). The divider's signal is (3.97)
+ * exactly: its 2theta and 4theta terms (a DFT over a turn of 2 theta_e)
+ * are turned from the unloaded ones by phi_a, phi_b and their ratio is p,
+ * as plant_aniso_load says ((3.7) with L2, M2 as phasors), to 1e-9. */
+static void test_gamma_is_3_97_with_independent_shifts(void **state) {
+  (void)state;
+  static const double cases[][4] = {/* phi_self, phi_mut [rad/A], amp_iq [1/A], i_q [A] */
+                                    {0.1, 0.1, 0.0, 1.5},
+                                    {0.3, -0.05, 0.0, 1.2},
+                                    {0.0, 0.2, 0.1, -1.0},
+                                    {0.25, 0.02, -0.1, 2.0}};
+  for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
+    double A[2][2] = {{0.0, 0.0}, {0.0, 0.0}}, B[2][2] = {{0.0, 0.0}, {0.0, 0.0}};
+    plant_params_t p = star_params(0.0, 0.0, 0.0);
+    p.machine.aniso.phi_self = cases[c][0];
+    p.machine.aniso.phi_mut = cases[c][1];
+    p.machine.aniso.amp_iq = cases[c][2];
+    plant_t pl;
+    test_init(&pl, &p);
+    enum { N = 36 };
+    for (int u = 0; u < 2; ++u) { /* unloaded, loaded */
+      const double i_q = u ? cases[c][3] : 0.0;
+      for (int i = 0; i < N; ++i) {
+        const double th = T_PI * i / N;
+        double g[3];
+        plant_star_gain(&pl, th, i_q, g);
+        const double al = (2.0 * g[0] - g[1] - g[2]) / 3.0, be = (g[1] - g[2]) / sqrt(3.0);
+        const double zr = -al, zi = be; /* a e^{j(2th + phi_a)} - b e^{-j(4th + phi_b)} */
+        A[u][0] += (zr * cos(2.0 * th) + zi * sin(2.0 * th)) / N;
+        A[u][1] += (zi * cos(2.0 * th) - zr * sin(2.0 * th)) / N;
+        B[u][0] += (zr * cos(4.0 * th) - zi * sin(4.0 * th)) / N;
+        B[u][1] += (zi * cos(4.0 * th) + zr * sin(4.0 * th)) / N;
+      }
+    }
+    double pa, pb, pp;
+    plant_aniso_load(&p.machine, cases[c][3], &pa, &pb, &pp);
+    const double arg_a = atan2(A[1][1], A[1][0]) - atan2(A[0][1], A[0][0]);
+    const double arg_b = atan2(B[1][1], B[1][0]) - atan2(B[0][1], B[0][0]);
+    printf("case %zu: phi_a %.6f (model %.6f), phi_b %.6f (model %.6f), p %.6f (model %.6f)\n", c,
+           arg_a, pa, -arg_b, pb, -hypot(B[1][0], B[1][1]) / hypot(A[1][0], A[1][1]), pp);
+    ASSERT_NEAR_D(arg_a, pa, 1e-9);
+    ASSERT_NEAR_D(-arg_b, pb, 1e-9);
+    /* b/a with the sign of (3.7): -B / A for a real a, b */
+    ASSERT_NEAR_D(-hypot(B[1][0], B[1][1]) / hypot(A[1][0], A[1][1]), pp, 1e-9);
+  }
+}
+
 static void test_isotropic_star_point_carries_nothing(void **state) {
   (void)state;
   plant_params_t p = star_params(0.7, 0.0, 0.0);
@@ -211,6 +259,7 @@ int main(void) {
       cmocka_unit_test(test_gamma_is_the_static_divider),
       cmocka_unit_test(test_resistive_drop_is_what_remains),
       cmocka_unit_test(test_gamma_is_3_6),
+      cmocka_unit_test(test_gamma_is_3_97_with_independent_shifts),
       cmocka_unit_test(test_isotropic_star_point_carries_nothing),
       cmocka_unit_test(test_circuit_and_channel),
       cmocka_unit_test(test_matrix_checked),

@@ -57,6 +57,26 @@ def test_table52_headline_and_no_fault(res):
     assert res.sd("dfc+kf", 500.0, 5.0).sd < res.sd("dfc+kf", 500.0, 1.0).sd
 
 
+def test_table52_headline_band_over_noise(tmp_path):
+    """Issue 23, point 7: the headline IVD+KF sD <= 1/2 DFC+KF's rests on the
+    calibrated star noise (0.0368 V, an assumption: the thesis prints
+    none). At 500 rpm, R_k = 5 sigma^2 (the thesis's own 0.66 there), three
+    noise seeds: it holds at the calibrated level for every seed, and not at
+    0.06 V, where the doc (`fluxdrive fabbri2022 --noise-sweep`) says the
+    band has ended; no fault at either. A drive that makes IVD+KF better
+    beyond the band fails the second half: the doc's band is then stale."""
+    rows = kf.noise_sweep(REAL_SIL, REPO_ROOT, tmp_path, noises=kf.SWEEP_CI, rpms=(500.0,),
+                          r_scales=(5.0,))
+    print(kf.sweep_report(rows, cal=kf.SWEEP_CI[0]))
+    assert len(rows) == len(kf.SWEEP_CI) * len(kf.SWEEP_SEEDS)
+    for r in rows:
+        assert r.faults == [], (r.noise, r.seed, r.faults)
+        if r.noise == kf.SWEEP_CI[0]:
+            assert r.ratio <= P.headline_ratio, (r.noise, r.seed, r.ratio)
+        else:
+            assert r.ratio > P.headline_ratio, (r.noise, r.seed, r.ratio)
+
+
 def test_rls_converges_from_30_percent(res):
     """Acceptance 2: a and b, started 30 % off, within 5 % of (3.7)'s values
     in under 1 s from the speed step at 500 rpm, and they stay there; the

@@ -166,6 +166,25 @@ static const bad_case_t cases[] = {
      "{\"pos_source\": \"ivd\", \"align_time\": 0.1}}",
      "machine.star_p: the star point's p = b/a = 0.6 (3.7), the drive's dfc_b: IVD needs |p| = "
      "|b/a| < 1/2 (Theorem 1"},
+    /* issue 23, point 6: Theorem 1 at every load up to i_trip (2 * 2 sqrt(2)
+     * A), not only at the unloaded p: p = 0.3 (1 + 0.125 |i_q|) = 0.512 at
+     * 5.657 A, 1/2 from 5.33 A (0.5 / 0.3 = 1 + 0.125 i; the check's grid of 257
+     * currents first reaches it at 5.35 A) */
+    {"{\"duration\": 1, \"machine\": {\"preset\": \"fabbri2022_fig33\", \"star_p\": 0.3, "
+     "\"star_amp_iq\": 0.125}, \"inverter\": {\"model\": \"switching\"}, \"board\": "
+     "{\"asym_edges\": 1}, \"controller\": {\"pos_source\": \"ivd\", \"align_time\": 0.1}}",
+     "machine.star_amp_iq: the star point's p = b/a reaches 0.512 (3.7) at |i_q| = 5.66 A (load "
+     "scale 1.71"},
+    /* the self terms turned from the mutual ones: |L2/2 e^{j 0.5 i} + M2| /
+     * (L0 - M0) = |51.65 e^{j 2.83} - 241.33| / 421.5 = 0.690 uH/uH at
+     * 5.657 A (p = -0.45 unloaded) */
+    {"{\"duration\": 1, \"machine\": {\"preset\": \"fabbri2022_fig33\", \"star_p\": -0.45, "
+     "\"star_phi_self\": 0.5}, \"inverter\": {\"model\": \"switching\"}, \"board\": "
+     "{\"asym_edges\": 1}, \"controller\": {\"pos_source\": \"ivd+kf\", \"align_time\": 0.1}}",
+     "machine.star_phi_self: the star point's p = b/a reaches -0.69 (3.7)"},
+    {"{\"duration\": 1, \"machine\": {\"preset\": \"fabbri2022_t51\", \"star_phi_iq\": 0.06, "
+     "\"star_phi_mutual\": 0.1}}",
+     "machine.star_phi_iq: sets star_phi_self and star_phi_mutual both"},
     /* M0 in H where uH were meant: L0 + 2 M0 = 434.5 uH + 60 mH, 139 times */
     {"{\"duration\": 1, \"machine\": {\"preset\": \"fabbri2022_t51\", \"star_m0\": 0.02}}",
      "machine.star_m0: 0.02 H gives the zero-sequence inductance L0 + 2 M0 = (ld + lq)/2 + 3 M0 = "
@@ -351,6 +370,30 @@ static void star_load_scale_within_the_current(void **state) {
 
 /* star_tau up to a fifth of the settling time, and any with a position
  * source that does not sample the star point */
+/* issue 23, point 6: the load's p checked only where the IVD runs (the
+ * standard DFC has no Theorem 1), and below 1/2 accepted; star_phi_iq is
+ * both terms' shift */
+static void star_load_p_accepted(void **state) {
+  (void)state;
+  static scenario_t sc;
+  char err[512] = "";
+  static const char *const ok[] = {
+      "{\"duration\": 1, \"machine\": {\"preset\": \"fabbri2022_fig33\", \"star_p\": 0.3, "
+      "\"star_amp_iq\": 0.125}, \"inverter\": {\"model\": \"switching\"}, \"board\": "
+      "{\"asym_edges\": 1}, \"controller\": {\"pos_source\": \"dfc\", \"align_time\": 0.1}}",
+      /* 0.3 (1 + 0.1 * 5.657) = 0.470 */
+      "{\"duration\": 1, \"machine\": {\"preset\": \"fabbri2022_fig33\", \"star_p\": 0.3, "
+      "\"star_amp_iq\": 0.1}, \"inverter\": {\"model\": \"switching\"}, \"board\": "
+      "{\"asym_edges\": 1}, \"controller\": {\"pos_source\": \"ivd\", \"align_time\": 0.1}}",
+      "{\"duration\": 1, \"machine\": {\"preset\": \"fabbri2022_t51\", \"star_phi_iq\": 0.06}}"};
+  for (size_t k = 0; k < sizeof ok / sizeof ok[0]; ++k) {
+    if (scenario_parse(ok[k], "ok.json", &sc, err, sizeof err) != 0) {
+      fail_msg("refused: %s", err);
+    }
+  }
+  assert_true(sc.plant.machine.aniso.phi_self == 0.06 && sc.plant.machine.aniso.phi_mut == 0.06);
+}
+
 static void star_tau_accepted(void **state) {
   (void)state;
   static scenario_t sc;
@@ -389,6 +432,7 @@ int main(void) {
                                      cmocka_unit_test(error_message_stays_utf8),
                                      cmocka_unit_test(small_inductance_is_substepped),
                                      cmocka_unit_test(star_load_scale_within_the_current),
+                                     cmocka_unit_test(star_load_p_accepted),
                                      cmocka_unit_test(star_tau_accepted)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

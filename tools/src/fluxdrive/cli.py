@@ -234,6 +234,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", metavar="DIR", help="logs (default: out/fabbri2022)")
     p.add_argument("--figures", metavar="DIR", help="figures (default: docs/figures)")
     p.add_argument("--doc", metavar="MD", help="markdown file whose results tables are replaced")
+    p.add_argument("--shifts", action="store_true",
+                   help="only print the Full IVD's two phase shifts identified on plants with "
+                        "phi_b = 2, 1/2, 0 times phi_a and a drawn pair (issue 23, point 6)")
+    p.add_argument("--noise-sweep", action="store_true",
+                   help="only print the Table 5.2 ratio IVD+KF / DFC+KF over the star channel's "
+                        "noise (0.005 .. 0.1 V, 3 seeds, 100 and 500 rpm; issue 23, point 7)")
     p.set_defaults(func=_cmd_fabbri)
 
     p = sub.add_parser("pil", help="PIL: replay a scenario's ISRs on QEMU, compare, count")

@@ -18,7 +18,9 @@ Experiments (scenario bases sil/scenarios/fabbri_dyno.json, fabbri_speed.json):
                500 rpm (1 iteration), e-bike motor at 50 rpm (4 iterations)
   phase shift  Fig. 5.5: 300 rpm on the dynamometer, i_q stepped 0 -> 1.5 A,
                a load-dependent saliency shift in the plant; DFC and IVD
-               against the Full IVD with the shift fitted from the IVD run
+               against the Full IVD with both shifts (phi_a, phi_b) fitted
+               from the IVD run's signals (star_shifts.py); `--shifts`:
+               plants with phi_b != 2 phi_a (issue 23, point 6)
   closed loop  FOC speed control at 100 and 500 rpm on the IVD position from
                standstill, both magnet polarities
 """
@@ -32,6 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import star_shifts
 from .paper_report import Run, paper_paths, replace_table, run, stacked_axes
 
 RPM = np.pi / 30.0
@@ -256,16 +259,24 @@ class ShiftRun:
     mean_deg: np.ndarray  # mean position error per step [deg electrical]
     t: np.ndarray
     err_deg: np.ndarray
+    ripple_deg: np.ndarray  # position error's std about its mean per step [deg electrical]
+    harm_deg: np.ndarray  # its anisotropy harmonic (6 f_e) per step, amplitude [deg electrical]
+    phasors: list  # (A, B) of (3.97) per step (star_shifts.signal_phasors)
 
 
 SHIFT_PHI_IQ = 0.06  # rad/A of 2theta: the plant's saliency shift (assumed, docs/dfc.md)
 SHIFT_STEP = 0.15  # s per current step
 
 
-def _shift_sc(root, source: str, phi_a: float = 0.0, phi_b: float = 0.0) -> dict:
+def _shift_sc(root, source: str, phi_a: float = 0.0, phi_b: float = 0.0,
+              plant: dict | None = None, seed: int | None = None) -> dict:
+    """The Fig. 5.5 run; `plant`: the machine's shift keys (default: the
+    turned saliency axis, star_phi_iq = SHIFT_PHI_IQ)."""
     sc = base(root, "dyno")
     sc["name"] = f"phase shift, {source}"
-    sc["machine"]["star_phi_iq"] = SHIFT_PHI_IQ
+    sc["machine"].update(plant if plant is not None else {"star_phi_iq": SHIFT_PHI_IQ})
+    if seed is not None:
+        sc.setdefault("sensors", {})["seed"] = seed
     # the servo holds the rotor near the alignment angle, then drives it
     sc["mechanics"] = {"mode": "imposed", "theta0": 0.01,
                        "speed": {"unit": "rpm", "terms": [
@@ -287,28 +298,102 @@ def _shift_sc(root, source: str, phi_a: float = 0.0, phi_b: float = 0.0) -> dict
 def _shift_measure(r: Run, label: str) -> ShiftRun:
     lg = r.log
     e = np.degrees(wrap(lg["theta_e_est"] - lg["theta_e_enc"]))
-    iq, mean = [], []
+    iq, mean, rip, harm, ph = [], [], [], [], []
+    f6 = 6.0 * PAPER.rpm_shift / 60.0 * r.summary_pp
     for i in range(len(PAPER.iq_steps)):
         a = 0.1 + i * SHIFT_STEP + 0.05
         m = (lg["t"] >= a) & (lg["t"] < a + SHIFT_STEP - 0.05)
         iq.append(float(np.mean(lg["i_q_avg"][m])))  # the period average
         mean.append(float(np.mean(e[m])))
+        rip.append(float(np.std(e[m])))
+        harm.append(amp_at(lg["t"][m], e[m], f6))
+        ph.append(star_shifts.signal_phasors(lg, m, r.summary_pp))
     m = lg["t"] >= 0.1
-    return ShiftRun(label, np.array(iq), np.array(mean), lg["t"][m], e[m])
+    return ShiftRun(label, np.array(iq), np.array(mean), lg["t"][m], e[m], np.array(rip),
+                    np.array(harm), ph)
+
+
+def identify_shifts(sil, root, out, plant: dict | None = None, seed: int | None = None,
+                    tag: str = "") -> tuple[ShiftRun, float, float]:
+    """Both (3.97) shifts [rad/A] from the IVD run's signals
+    (star_shifts.fit_shifts: each term's phase against the unloaded step's,
+    the slope over i_q): the run and (phi_a, phi_b)."""
+    r = _shift_measure(_run(sil, _shift_sc(root, "ivd", plant=plant, seed=seed), out,
+                            f"shift_ivd{tag}"), "IVD (1 iteration)")
+    phi_a, phi_b, _, _ = star_shifts.fit_shifts(r.iq, r.phasors)
+    return r, phi_a, phi_b
+
+
+def full_ivd_run(sil, root, out, phi_a: float, phi_b: float, label: str,
+                 plant: dict | None = None, seed: int | None = None, tag: str = "") -> ShiftRun:
+    sc = _shift_sc(root, "ivd", phi_a, phi_b, plant=plant, seed=seed)
+    return _shift_measure(_run(sil, sc, out, f"shift_full{tag}"), label)
+
+
+@dataclass
+class ShiftCase:
+    """A plant with its own (3.97) shifts at 1.5 A (issue 23, point 6): the
+    IVD run, the Full IVD on the true and the fitted shifts, and on the
+    old procedure's (phi_a from the mean error, phi_b = 2 phi_a)."""
+    label: str
+    phi_self: float  # the plant's keys [rad/A]
+    phi_mut: float
+    true: tuple  # (phi_a, phi_b) [rad/A]
+    fitted: tuple
+    old: tuple
+    ivd: ShiftRun
+    full_true: ShiftRun
+    full_fit: ShiftRun
+    full_old: ShiftRun
+
+
+def shift_case(sil, root, out, label: str, phi_a: float, phi_b: float, seed: int) -> ShiftCase:
+    i_ref = PAPER.iq_steps[-1]
+    s, m = star_shifts.self_mutual_for(phi_a, phi_b, i_ref)
+    plant = {"star_phi_self": s, "star_phi_mutual": m}
+    ta, tb = star_shifts.true_slopes(s, m, i_ref)
+    ivd, fa, fb_ = identify_shifts(sil, root, out, plant, seed, f"_{label}")
+    oa = float(np.polyfit(ivd.iq, np.radians(2.0 * ivd.mean_deg), 1)[0])
+    runs = [full_ivd_run(sil, root, out, x, y, lab, plant, seed, f"_{label}_{lab}")
+            for x, y, lab in ((ta, tb, "true"), (fa, fb_, "fitted"), (oa, 2.0 * oa, "old"))]
+    return ShiftCase(label, s, m, (ta, tb), (fa, fb_), (oa, 2.0 * oa), ivd, *runs)
+
+
+def shift_cases_drawn() -> tuple[float, float]:
+    """A drawn (phi_a, phi_b) [rad/A] within the drive's limits at i_max 1.5
+    A (|phi_a| i_max <= 0.1 rad, |phi_b| i_max <= 0.2 rad, drive_config_check)."""
+    rng = np.random.default_rng(2306)
+    return float(rng.uniform(0.03, 0.06)), float(rng.uniform(-0.12, 0.12))
+
+
+SHIFT_CASES = {"b_2a": (SHIFT_PHI_IQ, 2.0 * SHIFT_PHI_IQ),
+               "b_half_a": (SHIFT_PHI_IQ, 0.5 * SHIFT_PHI_IQ),
+               "b_0": (SHIFT_PHI_IQ, 0.0), "drawn": shift_cases_drawn()}
+
+
+def shift_report(cases: list[ShiftCase]) -> str:
+    L = ["| plant (3.97) at 1.5 A | star_phi_self, star_phi_mutual [rad/A] | phi_a, phi_b true "
+         "[rad/A] | fitted | old (2 phi_a) | 6 f_e harmonic at 1.5 A: true, fitted, old [deg] | "
+         "std: true, fitted, old [deg] |", "|---|---|---|---|---|---|---|"]
+    for c in cases:
+        h = [r.harm_deg[-1] for r in (c.full_true, c.full_fit, c.full_old)]
+        sd = [r.ripple_deg[-1] for r in (c.full_true, c.full_fit, c.full_old)]
+        L.append(f"| {c.label} | {c.phi_self:.4f}, {c.phi_mut:.4f} | {c.true[0]:.4f}, "
+                 f"{c.true[1]:.4f} | {c.fitted[0]:.4f}, {c.fitted[1]:.4f} | {c.old[0]:.4f}, "
+                 f"{c.old[1]:.4f} | {h[0]:.3f}, {h[1]:.3f}, {h[2]:.3f} ({h[2] / h[0]:.1f} x) | "
+                 f"{sd[0]:.3f}, {sd[1]:.3f}, {sd[2]:.3f} ({sd[2] / sd[0]:.2f} x) |")
+    return "\n".join(L)
 
 
 def phase_shift(sil, root, out) -> tuple[list, float, float]:
-    runs = []
-    for src, label in (("dfc", "DFC"), ("ivd", "IVD (1 iteration)")):
-        runs.append(_shift_measure(_run(sil, _shift_sc(root, src), out, f"shift_{src}"), label))
-    # offline fit (the thesis used MATLAB's identification toolbox): the
-    # IVD's mean error of 2theta grows as phi_a i_q; phi_b = 2 phi_a for a
-    # saliency axis turned with the load (docs/dfc.md)
-    ivd = runs[1]
-    phi_a = float(np.polyfit(ivd.iq, np.radians(2.0 * ivd.mean_deg), 1)[0])
-    sc = _shift_sc(root, "ivd", phi_a, 2.0 * phi_a)
-    runs.append(_shift_measure(_run(sil, sc, out, "shift_full"), "Full IVD (fitted phi_a, phi_b)"))
-    return runs, phi_a, 2.0 * phi_a
+    runs = [_shift_measure(_run(sil, _shift_sc(root, "dfc"), out, "shift_dfc"), "DFC")]
+    # offline fit (the thesis used MATLAB's identification toolbox): both
+    # terms' phases from the IVD run's signals (issue 23, point 6; no longer
+    # phi_b = 2 phi_a assumed)
+    ivd, phi_a, phi_b = identify_shifts(sil, root, out)
+    runs.append(ivd)
+    runs.append(full_ivd_run(sil, root, out, phi_a, phi_b, "Full IVD (fitted phi_a, phi_b)"))
+    return runs, phi_a, phi_b
 
 
 @dataclass
@@ -471,8 +556,8 @@ def report(res: Results) -> str:
     runs, pa, pb = res.shift
     L += ["", "### Load-dependent phase shift (Fig. 5.5): 300 rpm, i_q steps", "",
           f"Plant: saliency shift {SHIFT_PHI_IQ} rad/A of 2theta (phi_a = {SHIFT_PHI_IQ} i_q, "
-          f"phi_b = {2 * SHIFT_PHI_IQ} i_q). Fitted from the IVD run: phi_a = {pa:.4f} rad/A, "
-          f"phi_b = {pb:.4f} rad/A.", "",
+          f"phi_b = {2 * SHIFT_PHI_IQ} i_q). Fitted from the IVD run's signals, each term's "
+          f"phase (fluxdrive.star_shifts): phi_a = {pa:.4f} rad/A, phi_b = {pb:.4f} rad/A.", "",
           "| source | " + " | ".join(f"i_q {q:g} A" for q in PAPER.iq_steps) + " |",
           "|---|" + "---|" * len(PAPER.iq_steps)]
     for s in runs:
@@ -536,6 +621,18 @@ def plot_shift_loop(res: Results, path: Path) -> None:
 def main_fabbri(args) -> int:
     root, sil, out, figs = paper_paths(args, "fabbri2022")
     from . import fabbri2022_kf as kf
+    if getattr(args, "shifts", False):
+        # issue 23, point 6: both shifts identified on plants whose phi_b is
+        # not 2 phi_a (the doc's table is patched by hand from this output)
+        cases = [shift_case(sil, root, out, lab, pa, pb, 1 + k)
+                 for k, (lab, (pa, pb)) in enumerate(SHIFT_CASES.items())]
+        print(shift_report(cases))
+        return 0
+    if getattr(args, "noise_sweep", False):
+        # issue 23, point 7: the Table 5.2 headline over the noise level (the
+        # doc's table beside Table 5.2 is patched by hand from this output)
+        print(kf.sweep_report(kf.noise_sweep(sil, root, out), cal=0.0368))
+        return 0
     res = Results(sil, root, out)
     table = report(res)
     plot_harmonic(res, figs / "fabbri2022_harmonic.png")

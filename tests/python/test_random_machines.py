@@ -339,7 +339,7 @@ def test_ivd_convergence_theorem1(tmp_path, request):
 
 # (d) Sensorless start and speed control (Fabbri 2022) on drawn star-point
 # machines: free rotor at a start angle, alignment, speed step.
-SL_SOURCES = ("dfc+kf", "ivd+kf")
+SL_SOURCES = ("dfc+kf", "ivd+kf")  # FLUXDRIVE_SL_SOURCES="dfc ivd" runs others (docs/machines.md)
 RUN_STATE = 2  # DRIVE_STATE_RUN in the log's state column
 SL_ALIGN = 0.1  # s: align_time (the polarity from the motion it causes)
 SL_STEP = 0.15  # s: the speed step, after the alignment
@@ -424,8 +424,9 @@ def test_sensorless_start_and_speed(tmp_path, request):
     alignment's end on: the wrong branch is 180 off); after the machine's
     settling time (_sl_settle) the speed's mean and spread and the angle's
     mean error within the fabbri2022 acceptance (SL_TOL_*)."""
+    sources = os.environ.get("FLUXDRIVE_SL_SOURCES", "").split() or SL_SOURCES
     cases = [(mach.draw("star", s), src, k, th) for s in seeds(request.config)
-             for src in SL_SOURCES for k, th in enumerate(_sl_starts(s))]
+             for src in sources for k, th in enumerate(_sl_starts(s))]
 
     def one(c):
         d, src, k, th = c

@@ -8,8 +8,10 @@
  *   dfc+kf, ivd+kf      the method's angle, Kalman filter (4.46)-(4.49),
  *                       R_k of (4.29) (DFC: the measured |Gamma|, the b
  *                       term included, (4.31)) or (4.30) (IVD: the b term
- *                       removed, |Gamma| -> a), times kf_r_scale, with the
- *                       speed-dependent signal variance (4.42)/(4.43)
+ *                       removed, |Gamma| -> a), with the speed-dependent
+ *                       signal variance (4.42)/(4.43), plus kf_r_sys
+ *                       times the method's own angle error ((3.13),
+ *                       Theorem 1: meas_r_sys), times kf_r_scale
  *   ekf                 the Kalman filter updated on the signal vector
  *                       itself (4.35)-(4.41), a and b known
  *   ivd+kf+rls          ivd+kf with a, b identified online by the RLS of

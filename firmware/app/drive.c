@@ -594,7 +594,10 @@ static FD_NOINLINE void drive_pos_check_step(drive_t *drv) {
  * pushes it back (torque x error < 0). Held for DRIVE_RA_TIME without a
  * break, it trips lost_control (lc_cause DRIVE_LC_RUNAWAY) if the speed
  * itself has moved meanwhile by DRIVE_RA_FLOOR speed_max further from the
- * reference: the rotor went away against the torque (a wrong polarity or
+ * reference - the mean over the window's last quarter against the mean
+ * over its first, not two single samples of a noisy estimate (a PLL's
+ * speed swinging about a rotor that heads for its reference tripped it on a
+ * drawn machine) - : the rotor went away against the torque (a wrong polarity or
  * angle turns the torque against the loop). A speed that moves back (a
  * healthy drive braking to its reference, a reversal, a load step the loop
  * catches) or that the reference outruns (a ramp faster than the torque
@@ -612,11 +615,24 @@ static void drive_runaway_check(drive_t *drv, float w, float w_ref, float torque
     drv->ra_n = 0u;
     return;
   }
-  if (drv->ra_n++ == 0u) {
-    drv->ra_w0 = w;
+  const float t_loop = (float)c->slow_div * c->ts;
+  const float nf = DRIVE_RA_TIME / t_loop + 0.5f; /* periods in the window, rounded */
+  const uint32_t n_win = nf >= 2.0f ? (uint32_t)nf : 1u;
+  const uint32_t q = n_win >= 4u ? n_win / 4u : 1u;
+  if (drv->ra_n == 0u) {
+    drv->ra_w0 = 0.0f;
+    drv->ra_w1 = 0.0f;
   }
-  if ((float)drv->ra_n * (float)c->slow_div * c->ts >= DRIVE_RA_TIME) {
-    const float away = e > 0.0f ? w - drv->ra_w0 : drv->ra_w0 - w;
+  drv->ra_n++;
+  if (drv->ra_n <= q) {
+    drv->ra_w0 += w;
+  }
+  if (drv->ra_n + q > n_win) {
+    drv->ra_w1 += w;
+  }
+  if (drv->ra_n >= n_win) {
+    const float d = (drv->ra_w1 - drv->ra_w0) / (float)q;
+    const float away = e > 0.0f ? d : -d;
     if (away > floor) {
       drv->tm.lc_cause = DRIVE_LC_RUNAWAY;
       drive_trip(drv, DRIVE_FAULT_LOST_CONTROL);
@@ -738,6 +754,7 @@ static void drive_start(drive_t *drv) {
   memset(drv->lc_n, 0, sizeof drv->lc_n);
   drv->ra_n = 0u;
   drv->ra_w0 = 0.0f;
+  drv->ra_w1 = 0.0f;
   drv->tm.lc_cause = 0u;
   drv->v_applied = (ab_t){0.0f, 0.0f};
   const bool align = drv->cfg.align_time > 0.0f && (drv->pos_src->caps & POS_CAP_ALIGN) != 0u;

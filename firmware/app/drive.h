@@ -163,9 +163,9 @@ typedef struct drive_s {
   float torque_min_avail, torque_max_avail; /* what the law can deliver now */
   uint32_t lc_n[DRIVE_LC_COUNT];            /* periods each condition has held */
   uint32_t ra_n;                            /* speed-loop periods the run-away condition held */
-  float ra_w0;                              /* the speed when its window began [rad/s] */
-  float torque_scale, flux_scale;           /* torque and flux amplitude on MTPA at i_max */
-  float lc_n_fast, lc_n_track;              /* lc_time, lc_track_time in periods */
+  float ra_w0, ra_w1; /* the speed's sums over the window's first and last quarter [rad/s] */
+  float torque_scale, flux_scale; /* torque and flux amplitude on MTPA at i_max */
+  float lc_n_fast, lc_n_track;    /* lc_time, lc_track_time in periods */
   float inv_pole_pairs;
   float v_lin;            /* linear voltage range now [V] */
   float duty_lo, duty_hi; /* duty range: the board's, narrowed by a DFC window */

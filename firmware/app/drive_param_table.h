@@ -185,6 +185,8 @@
     "KF/EKF: omega_f of (4.42), electrical")                                                                \
   X(104, kf_r_m2,       F32,  "1/(rad/s)^2", 0.0f,   0.0f,    1.0f,     LIVE, "controller.kf_r_m2",        \
     "KF/EKF: speed-dependent signal variance m_2 omega^2 (4.43), per sigma_v^2")                          \
+  X(111, kf_r_sys,      F32,  "",       1.0f,        0.0f,    100.0f,   LIVE, "controller.kf_r_sys",       \
+    "KF: the method's own angle error added to R_k, times kf_r_sys: the standard DFC's Delta_0 (3.13), the IVD's bound after dfc_iter iterations (Theorem 1); 0: (4.29) alone, as the thesis's Table 5.2") \
   X(105, rls_lambda,    F32,  "",       0.9999f,     0.9f,    1.0f,     LIVE, "controller.rls_lambda",     \
     "RLS: forgetting factor lambda of the a, b identification (4.55)-(4.57)")                              \
   X(106, rls_p_max,     F32,  "",       1e-5f,       1e-12f,  1.0f,     LIVE, "controller.rls_p_max",      \

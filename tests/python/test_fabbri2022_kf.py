@@ -155,6 +155,7 @@ def test_laws_on_ivd_kf(res):
      "rls_p_min <= rls_p_max"),
     ({"pos_source": "ivd+kf", "kf_q_omega": -1.0}, "controller.kf_q_omega", "must be in"),
     ({"pos_source": "ekf", "dfc_sigma": 0.0}, "controller.dfc_sigma", "must be in"),
+    ({"pos_source": "dfc+kf", "kf_r_sys": -1.0}, "controller.kf_r_sys", "must be in"),
     ({"pos_source": "ivd+kf+"}, "controller.pos_source", "ivd+kf+rls"),
 ])
 def test_bad_filter_settings_are_refused(tmp_path, keys, field, why):

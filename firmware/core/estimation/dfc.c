@@ -177,10 +177,17 @@ bool dfc_vector2(const dfc_cfg_t *c, const float g[3], const dfc_vec_t *v, float
   *s2 = 0.0f;
   if (c->method == DFC_INVERSE) {
     /* (3.15): kappa_x = sum L_Sigma / L_Sigma,x = 1 / (Gamma_x / v_dc + 1/3);
-     * (3.16): its Clarke vector turns as e^{-j2theta} */
+     * (3.16): its Clarke vector turns as e^{-j2theta}. On the components
+     * at the newest one's instant: v's vector (the held components turned,
+     * sequentiality) with the three's mean; g itself when v is plain. On
+     * the raw held components (one period old on average) the angle lagged
+     * by w_e ts: -2.7 degrees at 790 rad/s (docs/machines.md). */
+    const float g0 = (g[0] + g[1] + g[2]) * (1.0f / 3.0f);
+    const float hb = 0.86602540f * v->be;
+    const float gs[3] = {g0 + v->al, g0 - 0.5f * v->al + hb, g0 - 0.5f * v->al - hb};
     float k[3], ka, kb;
     for (int x = 0; x < 3; ++x) {
-      const float d = g[x] + (1.0f / 3.0f);
+      const float d = gs[x] + (1.0f / 3.0f);
       k[x] = fabsf(d) > 1e-6f ? 1.0f / d : 0.0f;
     }
     dfc_clarke(k, &ka, &kb);

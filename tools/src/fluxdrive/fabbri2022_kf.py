@@ -86,8 +86,11 @@ def speed_sc(root: Path, source: str, rpm: float, noise: float, r_scale: float =
     sc["sensors"]["star_noise"] = noise
     if seed is not None:
         sc["sensors"]["seed"] = seed
+    # R_k as the thesis's (4.29)/(4.30) alone (kf_r_sys 0): the chapter-4
+    # figures are the thesis's filter; the drive's default adds the method's
+    # own angle error (docs/dfc.md, "Covariances")
     sc["controller"].update({"pos_source": source, "dfc_sigma": sigma_of(noise),
-                             "kf_r_scale": r_scale})
+                             "kf_r_scale": r_scale, "kf_r_sys": 0.0})
     if source == "encoder" and not enc_align:
         # the plant's encoder offset is known: a light free rotor still
         # swings when an alignment ends, and its offset would be taken there

@@ -207,7 +207,7 @@ static bool rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t 
   rls_ab_t *r = &s->dfc.rls;
   r->cfg = rls_cfg_of(cfg); /* the live tuning */
   rls_guarded(r, cfg, &s->dfc.dc);
-  if (!(fresh && s->dfc.sig.last == 0u && s->dfc.aligned &&
+  if (!(u != NULL && fresh && s->dfc.sig.last == 0u && s->dfc.aligned &&
         fabsf(s->dfc.kf.x[0]) > cfg->rls_w_min)) {
     return false;
   }

@@ -206,12 +206,9 @@ static bool rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t 
                      const sincos_t *u /* the prediction, used once aligned */) {
   rls_ab_t *r = &s->dfc.rls;
   r->cfg = rls_cfg_of(cfg); /* the live tuning */
-  rls_guarded(r, cfg, &s->dfc.dc);
-  if (!(u != NULL && fresh && s->dfc.sig.last == 0u && s->dfc.aligned &&
-        fabsf(s->dfc.kf.x[0]) > cfg->rls_w_min)) {
-    return false;
-  }
-  const bool upd = rls_ab_update(r, v->al, v->be, u->c, u->s, v->k);
+  const bool upd = u != NULL && fresh && s->dfc.sig.last == 0u && s->dfc.aligned &&
+                   fabsf(s->dfc.kf.x[0]) > cfg->rls_w_min &&
+                   rls_ab_update(r, v->al, v->be, u->c, u->s, v->k);
   rls_guarded(r, cfg, &s->dfc.dc);
   return upd;
 }

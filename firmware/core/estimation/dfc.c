@@ -169,6 +169,53 @@ static inline void dfc_clarke(const float x[3], float *al, float *be) {
   *be = (x[1] - x[2]) * DFC_SQRT3_INV;
 }
 
+/* The standard DFC's / IVD's / Full IVD's estimate (3.8) / (3.98) (from_raw:
+ * from zeta, trace[0..1] the raw one) or, from the start *ur, *ui, the
+ * iterations (3.76) / (3.100) alone (c->iterations of them, IVD methods):
+ * dfc_vector2 and dfc_ivd_from share it. */
+static bool ivd_run(const dfc_cfg_t *c, const dfc_vec_t *v, float i_q, bool from_raw, float *ur,
+                    float *ui, float *trace) {
+  const float inv_a = 1.0f / c->a;
+  const float zr = -v->al * inv_a, zi = v->be * inv_a; /* zeta = e^{j2th} - p e^{-j4th} */
+  const bool full = c->method == DFC_FULL_IVD;
+  float ra[2] = {1.0f, 0.0f}, rb[2] = {1.0f, 0.0f};
+  if (full) {
+    const sincos_t pa = frames_sincos(c->phi_a * i_q), pb = frames_sincos(c->phi_b * i_q);
+    ra[0] = pa.c;
+    ra[1] = -pa.s;
+    rb[0] = pb.c;
+    rb[1] = -pb.s;
+  }
+  if (from_raw) { /* (3.8) / (3.98): the raw estimate */
+    if (!dfc_normalise(zr, zi, ur, ui)) {
+      return false;
+    }
+    if (full) {
+      const float r = *ur * ra[0] - *ui * ra[1];
+      *ui = *ur * ra[1] + *ui * ra[0];
+      *ur = r;
+    }
+    if (trace != NULL) {
+      trace[0] = *ur;
+      trace[1] = *ui;
+    }
+  }
+  const uint32_t n = (c->method == DFC_IVD || full)
+                         ? (c->iterations < DFC_ITER_MAX ? c->iterations : DFC_ITER_MAX)
+                         : 0u;
+  const float p = c->b * inv_a;
+  for (uint32_t k = 1u; k <= n; ++k) { /* (3.76) / (3.100) */
+    if (!dfc_ivd_step(zr, zi, p, v->k, rb, ra, ur, ui)) {
+      return false;
+    }
+    if (trace != NULL) {
+      trace[(size_t)2 * k] = *ur;
+      trace[(size_t)2 * k + 1u] = *ui;
+    }
+  }
+  return true;
+}
+
 bool dfc_vector2(const dfc_cfg_t *c, const float g[3], const dfc_vec_t *v, float i_q, float *c2,
                  float *s2, float *trace) {
   float ur = 1.0f, ui = 0.0f;
@@ -198,39 +245,7 @@ bool dfc_vector2(const dfc_cfg_t *c, const float g[3], const dfc_vec_t *v, float
       trace[1] = ui;
     }
   } else {
-    const float inv_a = 1.0f / c->a;
-    const float zr = -v->al * inv_a, zi = v->be * inv_a; /* zeta = e^{j2th} - p e^{-j4th} */
-    const bool full = c->method == DFC_FULL_IVD;
-    float ra[2] = {1.0f, 0.0f}, rb[2] = {1.0f, 0.0f};
-    if (full) {
-      const sincos_t pa = frames_sincos(c->phi_a * i_q), pb = frames_sincos(c->phi_b * i_q);
-      ra[0] = pa.c;
-      ra[1] = -pa.s;
-      rb[0] = pb.c;
-      rb[1] = -pb.s;
-    }
-    /* (3.8) / (3.98): the raw estimate */
-    ok = dfc_normalise(zr, zi, &ur, &ui);
-    if (ok && full) {
-      const float r = ur * ra[0] - ui * ra[1];
-      ui = ur * ra[1] + ui * ra[0];
-      ur = r;
-    }
-    if (ok && trace != NULL) {
-      trace[0] = ur;
-      trace[1] = ui;
-    }
-    const uint32_t n = (c->method == DFC_IVD || full)
-                           ? (c->iterations < DFC_ITER_MAX ? c->iterations : DFC_ITER_MAX)
-                           : 0u;
-    const float p = c->b * inv_a;
-    for (uint32_t k = 1u; ok && k <= n; ++k) { /* (3.76) / (3.100) */
-      ok = dfc_ivd_step(zr, zi, p, v->k, rb, ra, &ur, &ui);
-      if (ok && trace != NULL) {
-        trace[(size_t)2 * k] = ur;
-        trace[(size_t)2 * k + 1u] = ui;
-      }
-    }
+    ok = ivd_run(c, v, i_q, true, &ur, &ui, trace);
   }
   if (!ok) {
     return false;
@@ -242,30 +257,12 @@ bool dfc_vector2(const dfc_cfg_t *c, const float g[3], const dfc_vec_t *v, float
 
 bool dfc_ivd_from(const dfc_cfg_t *c, const dfc_vec_t *v, float i_q, float *c2, float *s2,
                   float *trace) {
-  const bool full = c->method == DFC_FULL_IVD;
-  if (!(full || c->method == DFC_IVD)) {
+  if (!(c->method == DFC_IVD || c->method == DFC_FULL_IVD)) {
     return false;
   }
-  const float inv_a = 1.0f / c->a;
-  const float zr = -v->al * inv_a, zi = v->be * inv_a, p = c->b * inv_a;
-  float ra[2] = {1.0f, 0.0f}, rb[2] = {1.0f, 0.0f};
-  if (full) {
-    const sincos_t pa = frames_sincos(c->phi_a * i_q), pb = frames_sincos(c->phi_b * i_q);
-    ra[0] = pa.c;
-    ra[1] = -pa.s;
-    rb[0] = pb.c;
-    rb[1] = -pb.s;
-  }
-  const uint32_t n = c->iterations < DFC_ITER_MAX ? c->iterations : DFC_ITER_MAX;
   float ur = *c2, ui = *s2;
-  for (uint32_t k = 1u; k <= n; ++k) { /* (3.76) / (3.100) */
-    if (!dfc_ivd_step(zr, zi, p, v->k, rb, ra, &ur, &ui)) {
-      return false;
-    }
-    if (trace != NULL) {
-      trace[(size_t)2 * k] = ur;
-      trace[(size_t)2 * k + 1u] = ui;
-    }
+  if (!ivd_run(c, v, i_q, false, &ur, &ui, trace)) {
+    return false;
   }
   *c2 = ur;
   *s2 = ui;

@@ -34,7 +34,7 @@ export PYTHONPATH="$src/tools/src${PYTHONPATH:+:$PYTHONPATH}"
 # the decoupled DFVC of Varatharajan 2022 on the same map through MTPA,
 # flux weakening and the MTPV limit: agreement, and the target of
 # fewer than 2500 instructions per ISR on average (measured 2489, worst
-# 2797: docs/benchmarks.md, "Decoupled DFVC")
+# 2795: docs/benchmarks.md, "Decoupled DFVC")
 "$python" -m fluxdrive pil "$src/sil/scenarios/pil_dfvc_decoupled.json" --law dfvc_decoupled \
   --isrs all --check-mean 2500 --sil "$sil" --elf "$build/cross/pil/fluxdrive-pil.elf" \
   --out "$build/work" --markdown "$build/benchmarks-decoupled.md"

@@ -157,6 +157,26 @@ static inline sincos_t dfvc_sat_small_rot(float x) {
   return (sincos_t){x * (1.0f - x2 * (1.0f / 6.0f)), 1.0f - x2 * (0.5f - x2 * (1.0f / 24.0f))};
 }
 
+/* The flux-axis current of the reference: the current model's current at
+ * the flux lambda_ref along the observed flux lam (amplitude lam_amp), from
+ * the controller's map at the measured current i, linearised with its
+ * incremental inductance (25): u . (i + L_d^-1 (lambda_ref u - lambda^i)),
+ * u = lam / lam_amp, with u . i = i_f (the measured current in the observed
+ * flux frame). For a linear machine it is exact and does not depend on i;
+ * on a map i enters through the map's curvature only. */
+static float dfvc_sat_ref_if(float i_f, dq_t li, machine_ldq_t l, dq_t lam, float lam_amp,
+                             float lambda_ref) {
+  const float det = l.dd * l.qq - l.dq * l.qd;
+  const float den = lam_amp * det; /* lam_amp >= 0: > 0 with a flux and det > 0 */
+  if (!(den > 0.0f)) {
+    return 0.0f;
+  }
+  const float s = lambda_ref / lam_amp;
+  const dq_t e = {s * lam.d - li.d, s * lam.q - li.q};
+  /* lam . adj(L_d) e / (|lam| det) */
+  return i_f + (lam.d * (l.qq * e.d - l.dq * e.q) + lam.q * (l.dd * e.q - l.qd * e.d)) / den;
+}
+
 static inline float dfvc_sat_zf(ab_t x) {
   return fd_zero_if_finite(x.alpha) + fd_zero_if_finite(x.beta);
 }
@@ -232,12 +252,13 @@ void dfvc_sat_step(dfvc_sat_t *c, const dfvc_sat_in_t *in, dfvc_sat_out_t *out) 
                                  .mtpv_cross = q.mtpv_cross,
                                  .mtpv_angle = q.mtpv_angle,
                                  .adapt = 1};
-  dfvc_sat_refs_out_t r;
-  dfvc_sat_refs_update(&c->refs, &ri, &r);
+  /* into the output (no copy; the fault paths below clear it) */
+  dfvc_sat_refs_update(&c->refs, &ri, &out->r);
+  const dfvc_sat_refs_out_t *r = &out->r;
 
   /* regulators (26)-(28) */
-  const dfvc_sat_pi_in_t pin = {r.lambda_ref, r.itau_ref, o.lambda_s_next, o.i_dqs, in->omega_r,
-                                m->rs,        g,          in->v_lin};
+  const dfvc_sat_pi_in_t pin = {r->lambda_ref, r->itau_ref, o.lambda_s_next, o.i_dqs, in->omega_r,
+                                m->rs,         g,           in->v_lin};
   dfvc_sat_pi_out_t po;
   dfvc_sat_pi_step(&c->pi, &pin, &po);
 
@@ -247,8 +268,8 @@ void dfvc_sat_step(dfvc_sat_t *c, const dfvc_sat_in_t *in, dfvc_sat_out_t *out) 
       frames_sincos_add(o.sc_s_next, dfvc_sat_small_rot(k->rot_advance * in->omega_r * k->ts));
   const ab_t v_ab = frames_park_inv(po.v_ft, scv);
 
-  const float z = dfvc_sat_zf(v_ab) + fd_zero_if_finite(r.lambda_ref) +
-                  fd_zero_if_finite(r.itau_ref) + dfvc_sat_zf(o.lambda_next);
+  const float z = dfvc_sat_zf(v_ab) + fd_zero_if_finite(r->lambda_ref) +
+                  fd_zero_if_finite(r->itau_ref) + dfvc_sat_zf(o.lambda_next);
   if (!fd_isfinite(z)) {
     dfvc_sat_reset(c);
     memset(out, 0, sizeof(*out));
@@ -256,7 +277,12 @@ void dfvc_sat_step(dfvc_sat_t *c, const dfvc_sat_in_t *in, dfvc_sat_out_t *out) 
     return;
   }
   out->v_ab_ref = v_ab;
-  out->i_ab_mid = frames_park_inv((dq_t){o.i_dqs.d, po.itau_pred}, scv);
+  /* the dead-time compensation's current: the references' (the flux
+   * reference's current and i_tau_ref), as FOC's is its reference current;
+   * not the measured one, whose sign near zero current would feed back
+   * through the compensation (docs/faults.md, issue 23 point 17) */
+  out->i_ab_mid = frames_park_inv(
+      (dq_t){dfvc_sat_ref_if(o.i_dqs.d, li, l, lam, o.lambda_s, r->lambda_ref), r->itau_ref}, scv);
   out->i_dq = i;
   out->lambda_s = o.lambda_s;
   out->delta = fd_atan2f(lam.q, lam.d); /* load angle, telemetry */
@@ -267,9 +293,8 @@ void dfvc_sat_step(dfvc_sat_t *c, const dfvc_sat_in_t *in, dfvc_sat_out_t *out) 
     const float eb = o.lambda.beta - o.lambda_cm.beta;
     out->obs_err = sqrtf(ea * ea + eb * eb);
   }
-  out->r = r;
   out->v_ft = po.v_ft;
   out->sat = po.sat;
   out->fault = 0u;
-  c->tm = (dfvc_sat_tm_t){r.lambda_mtpa, r.torque_mtpv, g.a, g.b, q.mtpa_angle, q.mtpv_angle};
+  c->tm = (dfvc_sat_tm_t){r->lambda_mtpa, r->torque_mtpv, g.a, g.b, q.mtpa_angle, q.mtpv_angle};
 }

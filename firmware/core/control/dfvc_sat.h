@@ -71,7 +71,7 @@ enum { DFVC_SAT_FAULT_INPUT = 1u << 0, DFVC_SAT_FAULT_STATE = 1u << 1 };
 
 typedef struct {
   ab_t v_ab_ref;  /* [V] */
-  ab_t i_ab_mid;  /* current expected over [tau+1, tau+2) (dead-time comp.) [A] */
+  ab_t i_ab_mid;  /* the references' current over [tau+1, tau+2) (dead-time comp.) [A] */
   dq_t i_dq;      /* rotor-frame current at tau [A] */
   float lambda_s; /* observed flux amplitude [Vs] */
   float delta;    /* observed load angle [rad] */

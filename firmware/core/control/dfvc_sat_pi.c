@@ -72,6 +72,5 @@ void dfvc_sat_pi_step(dfvc_sat_pi_t *c, const dfvc_sat_pi_in_t *in, dfvc_sat_pi_
   c->u_t_prev = ua.q;
   out->v_ft = (dq_t){vf, vt};
   out->u = ua;
-  out->itau_pred = itau_pred;
   out->sat = (sf ? DFVC_SAT_PI_SAT_F : 0u) | (st ? DFVC_SAT_PI_SAT_T : 0u);
 }

@@ -63,10 +63,9 @@ typedef struct {
 enum { DFVC_SAT_PI_SAT_F = 1u << 0, DFVC_SAT_PI_SAT_T = 1u << 1 };
 
 typedef struct {
-  dq_t v_ft;       /* (f, tau) voltage [V] */
-  dq_t u;          /* virtual inputs applied (u_f [V], u_tau [A/s]) */
-  float itau_pred; /* i_tau at tau+1 predicted [A] */
-  unsigned sat;    /* DFVC_SAT_PI_SAT_* */
+  dq_t v_ft;    /* (f, tau) voltage [V] */
+  dq_t u;       /* virtual inputs applied (u_f [V], u_tau [A/s]) */
+  unsigned sat; /* DFVC_SAT_PI_SAT_* */
 } dfvc_sat_pi_out_t;
 
 /* Returns 0, or -1 for invalid parameters (ts, omega, v_f_max > 0 finite). */

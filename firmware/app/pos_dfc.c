@@ -153,7 +153,7 @@ FD_COLD static void pdfc_init(pos_state_t *s, const drive_config_t *cfg) {
   }
 }
 
-static void pdfc_reset(pos_state_t *s) {
+FD_COLD static void pdfc_reset(pos_state_t *s) { /* at an enable, not in a period */
   kf_mech_reset(&s->dfc.kf, 0.0f, 0.0f, kf_p0);
   s->dfc.miss = 0u;
   dfc_signals_reset(&s->dfc.sig);
@@ -430,11 +430,12 @@ static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sam
 }
 
 /* The alignment towards electrical angle theta (0) ends: the polarity
- * from the motion it caused, or, without motion, the branch nearest it. */
+ * from the motion it caused, or, without motion, the branch nearest it.
+ * Once per start, not in a period: FD_COLD (flash), as pdfc_reset. */
 #define POS_DFC_POL_MIN 2.0f  /* rad/s electrical: evidence of motion */
 #define POS_DFC_E_MIN   0.02f /* cos(theta) - cos(theta_0), mean + recent: evidence of motion */
-static void pdfc_align(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
-                       float theta) {
+FD_COLD static void pdfc_align(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
+                               float theta) {
   (void)cfg;
   (void)smp;
   const float acc = s->dfc.pol_acc;

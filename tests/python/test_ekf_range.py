@@ -60,12 +60,14 @@ P_MAX = 0.35  # the source's limit (pos_dfc.c POS_DFC_EKF_P_MAX)
 
 
 def scenario(p: float, angle: float = 0.5, seed: int = 1, duration: float = 0.6,
-             **ctl) -> dict:
+             star_fs: float | None = None, **ctl) -> dict:
     sc = json.loads((REPO_ROOT / "sil" / "scenarios" / "fabbri_speed.json").read_text())
     sc["machine"] = {"preset": "fabbri2022_fig33", "star_p": p}
     sc["duration"] = duration
     sc["mechanics"]["theta0"] = angle / POLES
     sc["sensors"].update({"star_noise": NOISE, "seed": seed})
+    if star_fs is not None:
+        sc["sensors"]["star_full_scale"] = star_fs
     sigma = math.sqrt(4.0 / 3.0) * NOISE / V_DC  # fabbri2022_kf.sigma_of
     sc["controller"].update({"pos_source": "ekf", "dfc_sigma": sigma, **ctl})
     return sc
@@ -83,14 +85,17 @@ def sil(sc: dict, log: bool = True):
 
 
 def one(case) -> tuple:
-    p, angle, seed = case
-    r, lg = sil(scenario(p, angle, seed))
+    p, angle, seed = case[:3]
+    extra = dict(case[3]) if len(case) > 3 else {}
+    fs = extra.pop("star_fs", None)
+    r, lg = sil(scenario(p, angle, seed, star_fs=fs, **extra))
     if r.returncode != 0:
         return case, {"error": r.stderr.strip()[-300:]}
     rpm = 30.0 / math.pi
     out = {"faults": json.loads(r.stdout)["faults_seen"]}
     # the start: the first 3 ms (48 periods) from the first update
-    k0 = int(np.nonzero(lg["kf_r"] > 0.0)[0][0])
+    first = np.nonzero(lg["kf_r"] > 0.0)[0]  # (a source without a filter: the alignment's start)
+    k0 = int(first[0]) if len(first) else int(np.nonzero(lg["state"] == 4)[0][0])
     m = slice(k0, k0 + 48)
     out["start_w"] = float(np.max(np.abs(lg["speed_est"][m])) * rpm)
     out["start_rotor"] = float(np.max(np.abs(lg["speed"][m])) * rpm)
@@ -179,3 +184,38 @@ def test_refused_when_dfc_b_is_given():
         else:
             assert r.returncode == 2, r.stderr
             assert "controller.dfc_b: the EKF needs |p| = |dfc_b / dfc_a| <= 0.35" in r.stderr
+
+
+# The sweep that measured the band (docs/dfc.md, "EKF: the range of p"):
+# FD_EKF_SWEEP=1 runs p beyond the band as well, 16 start angles x seeds
+# 1-3, with the limit lifted (FD_EKF_SWEEP needs a build with
+# POS_DFC_EKF_P_MAX raised, e.g. the mutant ekf_p_limit_off, for |p| > 0.35),
+# and FD_EKF_STAR_FS=40 the star channel unclipped (the scenario's 13 V
+# clips the Fig. 3.3 machine's larger components from p = -0.37: a = 0.29
+# there, six times the Table 5.1 motor's). Prints faulted runs per p.
+# FD_EKF_SWEEP_P=p1,p2,.. other p; FD_EKF_SWEEP_SOURCE another source.
+SWEEP_P = (-0.45, -0.43, -0.41, -0.40, -0.38, -0.37, -0.36, -0.35, -0.34, 0.30, 0.32, 0.35,
+           0.40, 0.45, 0.49)
+
+
+@pytest.mark.skipif(os.environ.get("FD_EKF_SWEEP", "") in ("", "0"), reason="FD_EKF_SWEEP unset")
+def test_sweep_of_p():
+    fs = os.environ.get("FD_EKF_STAR_FS")
+    extra = {"star_fs": float(fs)} if fs else {}
+    src = os.environ.get("FD_EKF_SWEEP_SOURCE", "ekf")
+    if src != "ekf":
+        extra["pos_source"] = src
+    ps = tuple(float(x) for x in os.environ.get("FD_EKF_SWEEP_P", "").split(",") if x) or SWEEP_P
+    angles = tuple(round(2.0 * math.pi * (k + 0.5) / 16, 3) for k in range(16))
+    cases = [(p, a, s, extra) for p in ps for a in angles for s in SEEDS]
+    with ProcessPoolExecutor(max_workers=2) as ex:
+        res = list(ex.map(one, cases, chunksize=4))
+    print(f"\n{src} sweep, star_full_scale {fs or 'the scenario'}: {len(angles)} angles x "
+          f"{len(SEEDS)} seeds per p")
+    for p in ps:
+        r = [o for c, o in res if c[0] == p]
+        bad = [o for o in r if o.get("faults") or "error" in o
+               or not -POS_ERR_MAX <= o["err_lo"] <= o["err_hi"] <= POS_ERR_MAX]
+        err = [o.get("error", "")[:60] for o in r if "error" in o]
+        print(f"  p {p:+.2f}: {len(r)} runs, {len(bad)} failed (fault or error beyond "
+              f"pos_err_max){'; ' + err[0] if err else ''}")

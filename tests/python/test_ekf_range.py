@@ -6,7 +6,8 @@ set (L0, M0, L2 kept), the calibrated star noise 0.0368 V
 (docs/results-fabbri2022.md) and the filters told the matching dfc_sigma,
 the speed scenario sil/scenarios/fabbri_speed.json: offset calibration,
 alignment (the light rotor swings through the corners of h at up to
-~130 rpm), speed step to 500 rpm at 0.15 s; 0.6 s, full-rate logs.
+~130 rpm), speed step to 500 rpm at 0.15 s; 0.4 s (the sweep: 0.6 s),
+full-rate logs.
 The band: p from -0.34 to +0.30 (both signs), start angles over the whole
 electrical turn (8), noise seeds 1-3. Beyond +0.30 the Fig. 3.3 machine's
 a itself vanishes (a = 0 at p = +0.368: every star-point source fails
@@ -59,7 +60,7 @@ RUN_STATE = 2
 P_MAX = 0.35  # the source's limit (pos_dfc.c POS_DFC_EKF_P_MAX)
 
 
-def scenario(p: float, angle: float = 0.5, seed: int = 1, duration: float = 0.6,
+def scenario(p: float, angle: float = 0.5, seed: int = 1, duration: float = 0.4,
              star_fs: float | None = None, **ctl) -> dict:
     sc = json.loads((REPO_ROOT / "sil" / "scenarios" / "fabbri_speed.json").read_text())
     sc["machine"] = {"preset": "fabbri2022_fig33", "star_p": p}
@@ -202,6 +203,7 @@ SWEEP_P = (-0.45, -0.43, -0.41, -0.40, -0.38, -0.37, -0.36, -0.35, -0.34, 0.30, 
 def test_sweep_of_p():
     fs = os.environ.get("FD_EKF_STAR_FS")
     extra = {"star_fs": float(fs)} if fs else {}
+    extra["duration"] = 0.6
     src = os.environ.get("FD_EKF_SWEEP_SOURCE", "ekf")
     if src != "ekf":
         extra["pos_source"] = src

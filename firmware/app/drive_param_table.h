@@ -146,7 +146,7 @@
   X(8,  dfc_a,          F32,  "",       0.05f,       -1.0f,   1.0f,     IDLE, "controller.dfc_a",          \
     "DFC: amplitude a of the 2theta term of Gamma / v_dc (3.6)-(3.7)")                                     \
   X(9,  dfc_b,          F32,  "",       -0.0047f,    -1.0f,   1.0f,     LIVE, "controller.dfc_b",          \
-    "DFC: amplitude b of the 4theta term of Gamma / v_dc (3.6)-(3.7); IVD needs |b/a| < 1/2")               \
+    "DFC: amplitude b of the 4theta term of Gamma / v_dc (3.6)-(3.7); IVD needs |b/a| < 1/2, the EKF <= 0.35") \
   X(27, dfc_iter,       U16,  "",       1.0f,        0.0f,    8.0f,     LIVE, "controller.dfc_iter",       \
     "IVD: iterations of (3.76) / (3.100)")                                                                  \
   X(28, dfc_phi_a,      F32,  "rad/A",  0.0f,        -1.0f,   1.0f,     LIVE, "controller.dfc_phi_a",      \

@@ -308,6 +308,24 @@ static void pol_energy(pos_state_t *s, float c) {
   }
 }
 
+/* The EKF's first angle: the model (4.35) inverted on the whole turn, by
+ * the IVD run to convergence (3.76) (Theorem 1: |p| < 1/2, pdfc_check_cfg),
+ * not the standard DFC's angle, off by up to asin|p| / 2 (0.23 rad at
+ * |p| = 0.45): near a corner of h (|h'| = 2|a| |1 + 2p e^{-j6theta}|, down
+ * to 2|a| (1 - 2|p|)) that start lies on the other arm of the fold, the
+ * linearised update (4.36) pulls it away from the rotor's angle, and the
+ * angle's jumps between updates go into the speed (prior 30 rad/s). */
+static float ekf_start_angle(const pos_state_t *s, const dfc_vec_t *v, float theta0) {
+  dfc_cfg_t d = s->dfc.dc;
+  d.method = DFC_IVD;
+  d.iterations = DFC_ITER_MAX;
+  float c2, s2;
+  if (!dfc_vector2(&d, s->dfc.sig.g, v, 0.0f, &c2, &s2, NULL)) {
+    return theta0;
+  }
+  return 0.5f * fd_cordic_atan2f(s2, c2);
+}
+
 static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
                         pos_io_t *io) {
   const pos_input_t *in = &io->in;
@@ -391,7 +409,8 @@ static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sam
   }
   const float theta0 = 0.5f * fd_cordic_atan2f(s2, c2); /* (3.10), branch 0 */
   if (!s->dfc.started) {
-    trk_reset(s, theta0, 0.0f); /* polarity: the alignment decides */
+    /* polarity: the alignment decides */
+    trk_reset(s, s->dfc.track == TRACK_EKF ? ekf_start_angle(s, &v, theta0) : theta0, 0.0f);
     s->dfc.started = true;
   }
   const float pred = trk_theta(s); /* the prediction, before this period's measurement */
@@ -406,7 +425,7 @@ static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sam
     if (fresh) {
       s->dfc.r = meas_r(s, cfg, &v);
       if (s->dfc.track == TRACK_EKF) {
-        (void)kf_mech_update_ekf(kf, v.al, v.be, s->dfc.dc.a, s->dfc.dc.b, s->dfc.r);
+        (void)kf_mech_update_ekf(kf, v.al, v.be, s->dfc.dc.a, s->dfc.dc.b, v.k, s->dfc.r);
       } else {
         (void)kf_mech_update(kf, th, s->dfc.r);
       }
@@ -454,18 +473,39 @@ FD_COLD static void pdfc_align(pos_state_t *s, const drive_config_t *cfg, const 
   } else {
     th = nearest_branch(now, theta);
   }
-  trk_reset(s, th, trk_omega(s));
+  if (s->dfc.track == TRACK_EKF) {
+    /* h(theta) (4.35) is pi-periodic: the branch is a relabelling, not a
+     * new measurement; the covariance the filter has built stays (reset to
+     * kf_p0, its next updates took steps of the angle's prior, 0.3 rad,
+     * on a linearisation valid over a tenth of that near the corners of
+     * h at high |p|: the jump of issue 23 point 4) */
+    s->dfc.kf.x[1] = th;
+  } else {
+    trk_reset(s, th, trk_omega(s));
+  }
   s->dfc.started = true;
   pol_reset(s);
   s->dfc.aligned = true;
 }
 
+/* |b/a| the EKF is given at most: measured on the Fig. 3.3 machine, where
+ * it works to |p| = 0.36 (0.40 with the star channel unclipped) and not
+ * from 0.37 (0.41); docs/dfc.md, "EKF: the range of p" */
+#define POS_DFC_EKF_P_MAX 0.35f
 FD_COLD static const char *pdfc_check_cfg(const drive_config_t *cfg, const char **field) {
   const dfc_cfg_t d = cfg_of(cfg);
   const int e = dfc_check(&d);
   if (e != DFC_OK) {
     *field = e == DFC_ERR_P ? "dfc_b" : (e == DFC_ERR_PHI ? "dfc_phi_a" : "dfc_a");
     return dfc_strerror(e);
+  }
+  if (track_of(cfg->pos_source) == TRACK_EKF &&
+      !(fabsf(cfg->dfc_b) <= POS_DFC_EKF_P_MAX * fabsf(cfg->dfc_a))) {
+    *field = "dfc_b";
+    return "the EKF needs |p| = |dfc_b / dfc_a| <= 0.35: its update (4.36) is linearised on "
+           "h(theta), whose slope falls to 2 |a| (1 - 2|p|) at the corners of h, where beyond "
+           "that the filter stops on the wrong side (docs/dfc.md, \"EKF: the range of p\"); "
+           "use ivd+kf";
   }
   if (track_of(cfg->pos_source) != TRACK_PLL) {
     const kf_mech_cfg_t kc = kf_cfg_of(cfg);

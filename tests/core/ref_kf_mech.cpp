@@ -120,10 +120,10 @@ void test_against_eigen(void **state) {
 
 /* The EKF on the DFC signals (4.35)-(4.41) against its Eigen form: H the
  * 2x3 Jacobian (4.36), K = P H^T (H P H^T + R)^-1, Joseph update; the
- * rotor at constant acceleration, signals with noise. Also: the EKF
- * tracks the true angle within 10 mrad rms. */
-void test_ekf_against_eigen(void **state) {
-  (void)state;
+ * rotor at constant acceleration, signals with noise, the 4theta term
+ * through the sequentiality map km (dfc_vec_t.k: q = km (cos 4theta,
+ * -sin 4theta)). Also: the EKF tracks the true angle within 10 mrad rms. */
+void ekf_against_eigen(const double km[4], const char *name) {
   std::mt19937 rng(4041);
   std::normal_distribution<double> n01(0.0, 1.0);
   kf_mech_cfg_t c = {62.5e-6f, 8.0f, 2e-4f, 1e-5f, {1.0f, 0.0f, 1e-6f}};
@@ -141,25 +141,36 @@ void test_ekf_against_eigen(void **state) {
   Eigen::Matrix3d P = Eigen::Matrix3d::Zero();
   P.diagonal() << p0[0], p0[1], p0[2];
   const double a = 0.05, b = -0.0047, sig = 5e-4, r = sig * sig;
+  const float kmf[4] = {static_cast<float>(km[0]), static_cast<float>(km[1]),
+                        static_cast<float>(km[2]), static_cast<float>(km[3])};
+  const auto q4 = [km](double t4, double *qr, double *qi) {
+    *qr = km[0] * std::cos(t4) - km[1] * std::sin(t4);
+    *qi = km[2] * std::cos(t4) - km[3] * std::sin(t4);
+  };
   double w = 0.0, th = 0.2, w_x = 0.0, w_th = 0.0, e2 = 0.0;
   int ne = 0;
   for (int n = 0; n < 64000; ++n) {
     const double te = 0.004; /* accelerates to ~ 900 rpm in 4 s */
-    const double ga = -a * std::cos(2 * th) + b * std::cos(4 * th) + sig * n01(rng);
-    const double gb = a * std::sin(2 * th) + b * std::sin(4 * th) + sig * n01(rng);
+    double qr, qi;
+    q4(4 * th, &qr, &qi);
+    const double ga = -a * std::cos(2 * th) + b * qr + sig * n01(rng);
+    const double gb = a * std::sin(2 * th) - b * qi + sig * n01(rng);
     assert_true(kf_mech_update_ekf(&k, static_cast<float>(ga), static_cast<float>(gb),
-                                   static_cast<float>(a), static_cast<float>(b),
+                                   static_cast<float>(a), static_cast<float>(b), kmf,
                                    static_cast<float>(r)));
     {
       const double t2 = 2 * x(1), t4 = 4 * x(1);
       Eigen::Matrix<double, 2, 3> H = Eigen::Matrix<double, 2, 3>::Zero();
-      H(0, 1) = 2 * a * std::sin(t2) - 4 * b * std::sin(t4);
-      H(1, 1) = 2 * a * std::cos(t2) + 4 * b * std::cos(t4);
+      double hr, hi; /* q at theta and its derivative (d/dtheta: 4 x (-sin, -cos) through km) */
+      q4(t4, &hr, &hi);
+      const double dqr = -4 * (km[0] * std::sin(t4) + km[1] * std::cos(t4));
+      const double dqi = -4 * (km[2] * std::sin(t4) + km[3] * std::cos(t4));
+      H(0, 1) = 2 * a * std::sin(t2) + b * dqr;
+      H(1, 1) = 2 * a * std::cos(t2) - b * dqi;
       const Eigen::Matrix2d R = r * Eigen::Matrix2d::Identity();
       const Eigen::Matrix<double, 3, 2> K =
           P * H.transpose() * (H * P * H.transpose() + R).inverse();
-      const Eigen::Vector2d e(ga - (-a * std::cos(t2) + b * std::cos(t4)),
-                              gb - (a * std::sin(t2) + b * std::sin(t4)));
+      const Eigen::Vector2d e(ga - (-a * std::cos(t2) + b * hr), gb - (a * std::sin(t2) - b * hi));
       x += K * e;
       x(1) = wrap(x(1));
       const Eigen::Matrix3d A = Eigen::Matrix3d::Identity() - K * H;
@@ -180,18 +191,35 @@ void test_ekf_against_eigen(void **state) {
     }
   }
   const double rms = std::sqrt(e2 / ne);
-  std::printf("ref_kf_mech EKF: 64000 periods: speed %.2e (relative), angle %.2e rad against "
-              "Eigen; angle error %.2e rad rms against the rotor\n",
-              w_x, w_th, rms);
+  std::printf("ref_kf_mech EKF (%s): 64000 periods: speed %.2e (relative), angle %.2e rad "
+              "against Eigen; angle error %.2e rad rms against the rotor\n",
+              name, w_x, w_th, rms);
   assert_true(w_x < 1e-3);
   assert_true(w_th < 1e-4);
   assert_true(rms < 0.01);
+}
+
+void test_ekf_against_eigen(void **state) {
+  (void)state;
+  const double eye[4] = {1.0, 0.0, 0.0, 1.0}; /* no sequentiality: (4.35) */
+  ekf_against_eigen(eye, "K = I");
+}
+
+/* The 4theta term turned and scaled as the sequentiality compensation maps
+ * it at speed (here 0.4 rad, x 0.95, fixed): the filter's h and H follow
+ * km (an EKF on (4.35) with K = I would be 20 mrad off the reference). */
+void test_ekf_sequentiality_map_against_eigen(void **state) {
+  (void)state;
+  const double r = 0.95, c = r * std::cos(0.4), s = r * std::sin(0.4);
+  const double km[4] = {c, -s, s, c};
+  ekf_against_eigen(km, "K turned 0.4 rad");
 }
 
 } // namespace
 
 int main(void) {
   const struct CMUnitTest tests[] = {cmocka_unit_test(test_against_eigen),
-                                     cmocka_unit_test(test_ekf_against_eigen)};
+                                     cmocka_unit_test(test_ekf_against_eigen),
+                                     cmocka_unit_test(test_ekf_sequentiality_map_against_eigen)};
   return cmocka_run_group_tests(tests, nullptr, nullptr);
 }

@@ -4,7 +4,7 @@ set(FD_PYTHON "" CACHE FILEPATH "Python of the tools venv (scripts/setup.sh)")
 if(FD_PYTHON)
   # tests that run on their own (in parallel with the rest, found by -R),
   # left out of python/pytest
-  set(alone param_ranges random_machines start_polarity rls_convergence)
+  set(alone param_ranges random_machines start_polarity ekf_range rls_convergence)
   set(ignore "")
   foreach(name ${alone})
     list(APPEND ignore --ignore=${CMAKE_CURRENT_SOURCE_DIR}/python/test_${name}.py)
@@ -20,8 +20,10 @@ if(FD_PYTHON)
   # docs/machines.md); start_polarity: the star-point sources' polarity
   # decision over start angles, noise, sources and presets (issue 23,
   # point 1: a seeded subset, the full grid with FD_POLARITY_FULL=1);
-  # rls_convergence: the RLS of a, b from +-50 % starts on the star-point
-  # presets and drawn machines (issue 23, point 5; FLUXDRIVE_RLS_SEEDS)
+  # ekf_range: the ekf over the range of p it accepts, refused beyond
+  # (issue 23, point 4); rls_convergence: the RLS of a, b from +-50 %
+  # starts on the star-point presets and drawn machines (issue 23, point 5;
+  # FLUXDRIVE_RLS_SEEDS, FLUXDRIVE_RLS_FULL)
   foreach(name ${alone})
     add_test(NAME python/${name}
              COMMAND ${FD_PYTHON} -m pytest -q ${CMAKE_CURRENT_SOURCE_DIR}/python/test_${name}.py

@@ -93,7 +93,8 @@ bool kf_mech_update(kf_mech_t *k, float theta_meas, float r) {
   return true;
 }
 
-bool kf_mech_update_ekf(kf_mech_t *k, float g_al, float g_be, float a, float b, float r) {
+bool kf_mech_update_ekf(kf_mech_t *k, float g_al, float g_be, float a, float b, const float km[4],
+                        float r) {
   if (!(fd_isfinite(g_al) && fd_isfinite(g_be) && fd_isfinite(a) && fd_isfinite(b)) ||
       !(r > 0.0f) || !fd_isfinite(r)) {
     return false;
@@ -102,9 +103,14 @@ bool kf_mech_update_ekf(kf_mech_t *k, float g_al, float g_be, float a, float b, 
   float s2, c2;
   fd_sincosf(2.0f * x[1], &s2, &c2);
   const float c4 = c2 * c2 - s2 * s2, s4 = 2.0f * s2 * c2;
+  /* the 4theta term as the signal vector carries it: q = K (cos 4theta,
+   * -sin 4theta) (dfc.h: the map the IVD applies; K = I at standstill,
+   * where this is (4.35)); h = (-a cos 2theta + b q_r, a sin 2theta - b q_i) */
+  const float qr = km[0] * c4 - km[1] * s4, qi = km[2] * c4 - km[3] * s4;
   /* innovation (4.41) and the theta column of H (4.36) */
-  const float e1 = g_al - (-a * c2 + b * c4), e2 = g_be - (a * s2 + b * s4);
-  const float h1 = 2.0f * a * s2 - 4.0f * b * s4, h2 = 2.0f * a * c2 + 4.0f * b * c4;
+  const float e1 = g_al - (-a * c2 + b * qr), e2 = g_be - (a * s2 - b * qi);
+  const float h1 = 2.0f * a * s2 - 4.0f * b * (km[0] * s4 + km[1] * c4);
+  const float h2 = 2.0f * a * c2 + 4.0f * b * (km[2] * s4 + km[3] * c4);
   /* P H^T = c h^T with c = P's theta column; S = (h h^T) p22 + r I (4.37) */
   const float c1 = p[P12], cc2 = p[P22], c3 = p[P23];
   const float s11 = h1 * h1 * cc2 + r, s12 = h1 * h2 * cc2, s22 = h2 * h2 * cc2 + r;

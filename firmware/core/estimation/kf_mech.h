@@ -54,11 +54,15 @@ void kf_mech_predict(kf_mech_t *k, float t_e);
 bool kf_mech_update(kf_mech_t *k, float theta_meas, float r);
 /* The EKF's update on the DFC signals themselves (4.35)-(4.41): the
  * measurement (g_al, g_be) (normalised as in dfc.h) against
- * h(theta) = (-a cos 2theta + b cos 4theta, a sin 2theta + b sin 4theta),
+ * h(theta) = (-a cos 2theta + b q_r, a sin 2theta - b q_i) with
+ * q = km (cos 4theta, -sin 4theta), km the sequentiality map of the 4theta
+ * term (dfc_vec_t.k, row-major; the identity gives (4.35):
+ * (-a cos 2theta + b cos 4theta, a sin 2theta + b sin 4theta)),
  * H = dh/dx (4.36) on the predicted angle, R = r I (4.38), Joseph form.
  * false (nothing changed) for non-finite inputs or r <= 0. The prediction
  * is kf_mech_predict's (the model is linear). */
-bool kf_mech_update_ekf(kf_mech_t *k, float g_al, float g_be, float a, float b, float r);
+bool kf_mech_update_ekf(kf_mech_t *k, float g_al, float g_be, float a, float b, const float km[4],
+                        float r);
 /* (4.42) and (4.43) in one: r0 + m max(|omega| - omega_f, 0) + m2 omega^2. */
 float kf_mech_r_speed(float r0, float m, float omega_f, float m2, float omega);
 

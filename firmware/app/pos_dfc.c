@@ -268,8 +268,12 @@ static float meas_r_sys(const pos_state_t *s, const drive_config_t *cfg) {
 
 /* The measurement variance of the angle (4.29)-(4.31) plus kf_r_sys times
  * the method's own error (meas_r_sys), or of the signals (4.38), with
- * (4.42)/(4.43), times kf_r_scale. */
-static float meas_r(const pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v) {
+ * (4.42)/(4.43), times kf_r_scale. The warm-started IVD (ivd+kf+rls once
+ * aligned) has no such error: its fixed point is the angle itself, and what
+ * is left is (2|p|)^n of the prediction's error, which the filter's own
+ * covariance carries (none added; nor its cost in the ISR). */
+static float meas_r(const pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v,
+                    bool warm) {
   const float s2 = cfg->dfc_sigma * cfg->dfc_sigma;
   const float var =
       kf_mech_r_speed(s2, cfg->kf_r_m * s2, cfg->kf_r_wf, cfg->kf_r_m2 * s2, s->dfc.kf.x[0]);
@@ -279,7 +283,8 @@ static float meas_r(const pos_state_t *s, const drive_config_t *cfg, const dfc_v
   /* (4.29): |Gamma|^2, the b term in it (4.31); the IVD has removed it (4.30) */
   const float g2 =
       is_ivd(cfg->pos_source) ? s->dfc.dc.a * s->dfc.dc.a : v->al * v->al + v->be * v->be;
-  return cfg->kf_r_scale * (0.25f * var / fd_maxf(g2, 1e-12f) + cfg->kf_r_sys * meas_r_sys(s, cfg));
+  const float sys = warm ? 0.0f : cfg->kf_r_sys * meas_r_sys(s, cfg);
+  return cfg->kf_r_scale * (0.25f * var / fd_maxf(g2, 1e-12f) + sys);
 }
 
 /* The energy evidence: the rotor starts at rest and the alignment's torque
@@ -423,7 +428,7 @@ static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sam
     out->rate = pll->omega_rate;
   } else {
     if (fresh) {
-      s->dfc.r = meas_r(s, cfg, &v);
+      s->dfc.r = meas_r(s, cfg, &v, warm);
       if (s->dfc.track == TRACK_EKF) {
         (void)kf_mech_update_ekf(kf, v.al, v.be, s->dfc.dc.a, s->dfc.dc.b, v.k, s->dfc.r);
       } else {

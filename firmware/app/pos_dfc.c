@@ -66,8 +66,11 @@
 
 enum { TRACK_PLL = 0, TRACK_KF = 1, TRACK_EKF = 2 };
 
-static bool is_ivd(pos_source_t src) {
-  return src == POS_SOURCE_IVD || src == POS_SOURCE_IVD_KF || src == POS_SOURCE_IVD_KF_RLS;
+/* a mask, inlined: called on every period's estimate */
+#define POS_DFC_IVD_MASK                                                                           \
+  ((1u << POS_SOURCE_IVD) | (1u << POS_SOURCE_IVD_KF) | (1u << POS_SOURCE_IVD_KF_RLS))
+static inline bool is_ivd(pos_source_t src) {
+  return (unsigned)src < 32u && ((1u << (unsigned)src) & POS_DFC_IVD_MASK) != 0u;
 }
 
 static uint8_t track_of(pos_source_t src) {
@@ -141,6 +144,7 @@ FD_COLD static void pdfc_init(pos_state_t *s, const drive_config_t *cfg) {
   s->dfc.rls_avg[0] = 0.0f; /* not settled before its updates (rls_health) */
   s->dfc.rls_avg[1] = 0.0f;
   s->dfc.r = 0.0f;
+  s->dfc.warm2 = 1.0f;
   s->dfc.miss = 0u;
   s->dfc.dc = cfg_of(cfg);
   dfc_signals_reset(&s->dfc.sig);
@@ -202,14 +206,32 @@ static void rls_guarded(const rls_ab_t *r, const drive_config_t *cfg, dfc_cfg_t 
  * update per refresh of the whole vector (when component a is the newest:
  * every third period, 5.3 kHz, the thesis's DFC rate): successive updates
  * then share no sample, as the RLS's independent noise assumes. */
+/* (2|p|)^2n: the warm-started IVD's n iterations contract the
+ * prediction's error of 2theta by (2|p|)^n (Theorem 1, (3.81)); its
+ * square scales the prediction's variance into the measurement's
+ * (meas_r). Taken when the RLS moves a, b (every third period at most). */
+static void warm_gain(pos_state_t *s) {
+  const float p = fd_minf(fabsf(s->dfc.dc.b) / fd_maxf(fabsf(s->dfc.dc.a), 1e-12f), 0.5f);
+  float c = 1.0f;
+  for (unsigned k = 0u; k < s->dfc.dc.iterations && k < DFC_ITER_MAX; ++k) {
+    c *= 2.0f * p;
+  }
+  s->dfc.warm2 = c * c;
+}
+
 static bool rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v, bool fresh,
                      const sincos_t *u /* the prediction, used once aligned */) {
   rls_ab_t *r = &s->dfc.rls;
-  r->cfg = rls_cfg_of(cfg); /* the live tuning */
-  const bool upd = u != NULL && fresh && s->dfc.sig.last == 0u && s->dfc.aligned &&
-                   fabsf(s->dfc.kf.x[0]) > cfg->rls_w_min &&
-                   rls_ab_update(r, v->al, v->be, u->c, u->s, v->k);
+  bool upd = false;
+  if (u != NULL && fresh && s->dfc.sig.last == 0u && s->dfc.aligned &&
+      fabsf(s->dfc.kf.x[0]) > cfg->rls_w_min) {
+    r->cfg = rls_cfg_of(cfg); /* the live tuning, for this update and rls_health */
+    upd = rls_ab_update(r, v->al, v->be, u->c, u->s, v->k);
+  }
   rls_guarded(r, cfg, &s->dfc.dc);
+  if (upd) {
+    warm_gain(s);
+  }
   return upd;
 }
 
@@ -262,16 +284,23 @@ static float meas_r_sys(const pos_state_t *s, const drive_config_t *cfg) {
       tn *= 2.0f * p; /* Theorem 1 */
     }
   }
-  const float d = fd_cordic_atan2f(tn, 1.0f);
+  /* atan(tn) to 0.005 rad (x / (1 + 0.28125 x^2), and its complement
+   * above 1): a variance, no CORDIC call */
+  const float d =
+      tn <= 1.0f ? tn / (1.0f + 0.28125f * tn * tn) : 0.5f * FRAMES_PI - tn / (tn * tn + 0.28125f);
   return 0.125f * d * d;
 }
 
 /* The measurement variance of the angle (4.29)-(4.31) plus kf_r_sys times
- * the method's own error (meas_r_sys), or of the signals (4.38), with
- * (4.42)/(4.43), times kf_r_scale. The warm-started IVD (ivd+kf+rls once
- * aligned) has no such error: its fixed point is the angle itself, and what
- * is left is (2|p|)^n of the prediction's error, which the filter's own
- * covariance carries (none added; nor its cost in the ISR). */
+ * the method's own error, or of the signals (4.38), with (4.42)/(4.43),
+ * times kf_r_scale. The method's error: from a raw start the bound of
+ * meas_r_sys; from the filter's prediction (the warm-started IVD of
+ * ivd+kf+rls once aligned, whose fixed point is the angle itself) what the
+ * iterations leave of the prediction's error, (2|p|)^2n P_22. Not nothing:
+ * right after the alignment's branch flip the reset filter's P_22 is 0.09
+ * rad^2, and without the term the filter took that period's angle as exact
+ * (R 1.5e-7 rad^2) and its speed jumped by 2000 rad/s (drawn star seed 1
+ * from 3.1 and 3.2 rad, tests/python/test_start_polarity.py). */
 static float meas_r(const pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v,
                     bool warm) {
   const float s2 = cfg->dfc_sigma * cfg->dfc_sigma;
@@ -283,7 +312,8 @@ static float meas_r(const pos_state_t *s, const drive_config_t *cfg, const dfc_v
   /* (4.29): |Gamma|^2, the b term in it (4.31); the IVD has removed it (4.30) */
   const float g2 =
       is_ivd(cfg->pos_source) ? s->dfc.dc.a * s->dfc.dc.a : v->al * v->al + v->be * v->be;
-  const float sys = warm ? 0.0f : cfg->kf_r_sys * meas_r_sys(s, cfg);
+  const float sys =
+      cfg->kf_r_sys * (warm ? s->dfc.warm2 * kf_mech_var_theta(&s->dfc.kf) : meas_r_sys(s, cfg));
   return cfg->kf_r_scale * (0.25f * var / fd_maxf(g2, 1e-12f) + sys);
 }
 
@@ -491,6 +521,7 @@ FD_COLD static void pdfc_align(pos_state_t *s, const drive_config_t *cfg, const 
   s->dfc.started = true;
   pol_reset(s);
   s->dfc.aligned = true;
+  warm_gain(s); /* the warm start's, at the a, b in force */
 }
 
 /* |b/a| the EKF is given at most: measured on the Fig. 3.3 machine, where

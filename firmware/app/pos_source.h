@@ -92,7 +92,8 @@ typedef union {
     kf_mech_t kf;
     rls_ab_t rls;
     float rls_avg[2]; /* a, b low-passed over the RLS's updates (rls_health) */
-    float r; /* the measurement variance of the last update (rad^2, or Gamma^2 for the EKF) */
+    float r;     /* the measurement variance of the last update (rad^2, or Gamma^2 for the EKF) */
+    float warm2; /* ((2|p|)^n)^2 of the warm-started IVD at the RLS's a, b (pos_dfc.c) */
   } dfc;
 } pos_state_t;
 

@@ -52,6 +52,10 @@ void kf_mech_predict(kf_mech_t *k, float t_e);
 /* (4.17)-(4.20) with the measured angle and its variance r [rad^2];
  * false (nothing changed) when they are not finite or r <= 0. */
 bool kf_mech_update(kf_mech_t *k, float theta_meas, float r);
+/* The angle's variance P_22 [rad^2] (after a prediction: the prior's). */
+static inline float kf_mech_var_theta(const kf_mech_t *k) {
+  return k->p[3]; /* P22 */
+}
 /* The EKF's update on the DFC signals themselves (4.35)-(4.41): the
  * measurement (g_al, g_be) (normalised as in dfc.h) against
  * h(theta) = (-a cos 2theta + b q_r, a sin 2theta - b q_i) with

@@ -17,6 +17,13 @@
 #include <math.h>
 #include <string.h>
 
+/* The smallest incremental inductance of a linear machine: ld lowered by
+ * the magnet's saturation (plant_magnetics.h), lq. */
+static double linear_l_min(const plant_machine_t *m) {
+  const double ld = m->ld / (1.0 + (m->ld_sat > 0.0 ? m->ld_sat : 0.0));
+  return ld < m->lq ? ld : m->lq;
+}
+
 int plant_substeps_link(const plant_params_t *p) {
   if (p->dclink.kind == PLANT_DC_IDEAL || !plant_finite_pos(p->dclink.r) ||
       !plant_finite_pos(p->dclink.c)) {
@@ -40,9 +47,8 @@ int plant_substeps_mech(const plant_params_t *p) {
   if (p->mech.mode == PLANT_MECH_IMPOSED || !plant_finite_pos(p->mech.j)) {
     return 1; /* no mechanical state, or one plant_check refuses */
   }
-  const double lmin = p->machine.map != NULL
-                          ? plant_fluxmap_l_min(p->machine.map)
-                          : (p->machine.ld < p->machine.lq ? p->machine.ld : p->machine.lq);
+  const double lmin =
+      p->machine.map != NULL ? plant_fluxmap_l_min(p->machine.map) : linear_l_min(&p->machine);
   double psi = fabs(p->machine.lambda_m);
   if (p->machine.map != NULL) {
     double pd = 0.0, pq = 0.0;
@@ -70,9 +76,8 @@ int plant_substeps_mech(const plant_params_t *p) {
 }
 
 int plant_substeps_needed(const plant_params_t *p) {
-  const double lmin = p->machine.map != NULL
-                          ? plant_fluxmap_l_min(p->machine.map)
-                          : (p->machine.ld < p->machine.lq ? p->machine.ld : p->machine.lq);
+  const double lmin =
+      p->machine.map != NULL ? plant_fluxmap_l_min(p->machine.map) : linear_l_min(&p->machine);
   double lo = 1.0, hi = 1.0;
   if (p->faults.rs_scale.n > 0) {
     profile_bounds(&p->faults.rs_scale, &lo, &hi);
@@ -152,6 +157,10 @@ int plant_init(plant_t *pl, const plant_params_t *p, const char **field) {
   a->mag = p->machine.map != NULL
                ? plant_mag_map(p->machine.map)
                : plant_mag_linear(p->machine.ld, p->machine.lq, p->machine.lambda_m);
+  if (p->machine.map == NULL && p->machine.ld_sat > 0.0) {
+    a->mag.sat = p->machine.ld_sat;
+    a->mag.i_sat = p->machine.i_sat;
+  }
   a->inv_j = 1.0 / p->mech.j;
   a->inv_r = p->dclink.kind != PLANT_DC_IDEAL ? 1.0 / p->dclink.r : 0.0;
   a->inv_c = p->dclink.kind != PLANT_DC_IDEAL ? 1.0 / p->dclink.c : 0.0;

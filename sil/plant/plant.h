@@ -55,6 +55,12 @@ typedef struct {
   double rs;       /* stator phase resistance [Ohm] */
   double ld, lq;   /* [H] */
   double lambda_m; /* PM flux linkage (peak, per phase) [Vs] */
+  /* d-axis magnet saturation (linear machines; plant_magnetics.h): the
+   * incremental d inductance ld / (1 + ld_sat tanh(x / i_sat)), x the d
+   * current of the unsaturated machine: lower where the d current adds to
+   * the magnet's flux, higher where it opposes it. ld_sat 0: none */
+  double ld_sat; /* [0, 0.5] */
+  double i_sat;  /* [A] > 0 */
   /* NULL: linear (ld, lq, lambda_m); else the saturated machine's flux map
    * (plant_fluxmap.h; ld, lq, lambda_m unused), owned by the caller */
   const plant_fluxmap_t *map;

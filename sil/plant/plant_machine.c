@@ -30,6 +30,10 @@ int plant_machine_check(const plant_machine_t *m, const char **field) {
     bad = "machine.lq";
   } else if (!plant_finite_nonneg(m->lambda_m)) {
     bad = "machine.lambda_m";
+  } else if (!(m->ld_sat >= 0.0 && m->ld_sat <= 0.5)) {
+    bad = "machine.ld_sat";
+  } else if (m->ld_sat > 0.0 && !plant_finite_pos(m->i_sat)) {
+    bad = "machine.i_sat";
   } else if (m->aniso.enabled && !plant_aniso_ok(m)) {
     bad = "machine.star_m0"; /* the (3.3) matrix is not positive definite */
   }

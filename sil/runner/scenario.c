@@ -369,6 +369,8 @@ static int parse_machine(ctx_t *c, const cJSON *m, scenario_t *sc) {
                                      "star_p",
                                      "star_phi_self",
                                      "star_phi_mutual",
+                                     "ld_sat",
+                                     "i_sat",
                                      NULL};
   if (check_keys(c, m, "machine", keys) != 0) {
     return -1;
@@ -402,7 +404,8 @@ static int parse_machine(ctx_t *c, const cJSON *m, scenario_t *sc) {
     }
   }
   if (sc->plant.machine.map != NULL) {
-    static const char *const linear_only[] = {"ld", "lq", "ls", "lambda_m", NULL};
+    static const char *const linear_only[] = {"ld",     "lq",    "ls", "lambda_m",
+                                              "ld_sat", "i_sat", NULL};
     for (int k = 0; linear_only[k] != NULL; ++k) {
       if (cJSON_GetObjectItemCaseSensitive(m, linear_only[k]) != NULL) {
         char key[32];
@@ -430,6 +433,14 @@ static int parse_machine(ctx_t *c, const cJSON *m, scenario_t *sc) {
     }
     pm->ld = pm->lq = ls;
     c->ls_given = 1;
+  }
+  /* the magnet's d-axis saturation (plant.h, plant_magnetics.h) */
+  if (get_num(c, m, M, "ld_sat", 0.0, 0.5, &pm->ld_sat) ||
+      get_num(c, m, M, "i_sat", 1e-3, 1e4, &pm->i_sat)) {
+    return -1;
+  }
+  if (pm->ld_sat > 0.0 && !(pm->i_sat > 0.0)) {
+    return fail(c, "machine.i_sat", "must be given (> 0 A) with machine.ld_sat > 0");
   }
   /* the star point's inductance matrix (3.3), plant.h */
   const char *star = star_key_given(m);

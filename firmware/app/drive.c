@@ -9,6 +9,7 @@
  * side of the concurrency contract is drive_host.c.
  */
 #include "drive.h"
+#include "drive_hold.h"
 #include "drive_pos_check.h"
 #include "drive_overrun.h"
 #include "drive_safe.h"
@@ -110,8 +111,21 @@ FD_COLD int drive_config_usable(const drive_config_t *cfg, drive_law_t law, mach
     err->reason = pwhy;
     return -1;
   }
+  if (cfg->start_mode == 1u && ps->hold == NULL) {
+    err->field = "start_mode";
+    err->reason = "the held start (1) needs a star-point position source (an angle at standstill); "
+                  "the encoder starts by its alignment or its known enc_offset (0)";
+    return -1;
+  }
   return 0;
 }
+
+/* The encoder's alignment (drive_derive, drive_align): damping ratio, the
+ * swing left when it is taken as settled [rad electrical], and the swings
+ * after align_time it may take to settle before the position fault. */
+#define DRIVE_ALIGN_ZETA   0.7f
+#define DRIVE_ALIGN_CALM   0.01f
+#define DRIVE_ALIGN_SWINGS 10.0f
 
 /* What the ISR would otherwise divide for every period (LIVE parameters
  * included: called again when they change). */
@@ -133,6 +147,23 @@ FD_COLD static void drive_derive(drive_t *drv) {
   drv->lc_n_fast = c->lc_time / c->ts;
   drv->lc_n_track = c->lc_track_time / c->ts;
   drv->inv_pole_pairs = 1.0f / c->pole_pairs;
+  drv->hold.v_pulse = drive_hold_v_pulse(c);
+  /* the encoder's alignment: the rotor swings about the current's axis at
+   * w_n = p sqrt(1.5 lambda_m i_align / J) (electrical), the PM torque
+   * 1.5 p lambda_m i_q; the current's angle led by -k_d omega_e damps it
+   * (theta'' = -w_n^2 (theta + k_d theta'): zeta = k_d w_n / 2) */
+  const float wn2 =
+      1.5f * c->pole_pairs * c->pole_pairs * c->lambda_m * c->align_current / c->inertia;
+  const float wn = wn2 > 0.0f ? sqrtf(wn2) : 0.0f;
+  drv->align_kd = wn > 0.0f ? 2.0f * DRIVE_ALIGN_ZETA / wn : 0.0f;
+  /* settled: |omega_e| < DRIVE_ALIGN_CALM w_n for 2 / w_n (over a quarter
+   * swing: a swing left would show its speed peak), i.e. a swing of at most
+   * DRIVE_ALIGN_CALM rad electrical left */
+  drv->align_w_calm = DRIVE_ALIGN_CALM * wn;
+  drv->align_calm_need = wn > 0.0f ? (uint32_t)(2.0f / (wn * c->ts)) + 1u : 0u;
+  const float t_out =
+      c->align_time + (wn > 0.0f ? DRIVE_ALIGN_SWINGS * 2.0f * FRAMES_PI / wn : 0.0f);
+  drv->align_n_timeout = (uint32_t)(t_out / c->ts) + 1u;
 }
 
 FD_COLD int drive_config_fits_board(const drive_config_t *cfg, const hal_caps_t *caps,
@@ -522,7 +553,8 @@ static ab_t drive_write(drive_t *drv, const float duty[3], const float dtc[3], f
   req.n_star = 0u;
   req.t_star_req[0] = 0.0f;
   req.t_star_req[1] = 0.0f;
-  if (drv->gated) {
+  const bool window = drv->gated && !drv->hold.plain;
+  if (window) {
     drive_window_pattern(drv, dc, &req);
   }
   hal_pwm_t got;
@@ -533,8 +565,10 @@ static ab_t drive_write(drive_t *drv, const float duty[3], const float dtc[3], f
     drv->tm.duty[x] = d;
     pole[x] = (d > 0.0f && d < 1.0f) ? d - dtc[x] : d;
   }
-  if (drv->gated) {
+  if (window) {
     dfc_window_moments(got.on, got.off, drv->win_m); /* for the next sample */
+  } else if (drv->gated) {
+    drv->win_m[0] = drv->win_m[1] = drv->win_m[2] = 0.0f; /* a plain pattern: nothing to correct */
   }
   return frames_clarke((abc_t){pole[0] * v_dc, pole[1] * v_dc, pole[2] * v_dc});
 }
@@ -728,18 +762,57 @@ static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
 }
 
 /* Alignment: d current along theta = 0 for align_time, then the position
- * source takes theta = 0 as its reference. */
+ * source takes the current's angle as its reference. A star-point source
+ * reads the polarity from the motion (pos_dfc.c). An encoder's offset is
+ * taken only once the rotor rests (issue 23, point 18: a light free rotor
+ * swung through the offset, -57.5 deg): the current's angle leads against
+ * the encoder's speed, -k_d omega_e (at most 45 deg), which damps the
+ * swing (drive_derive), and the alignment ends when the rotor has settled
+ * (|omega_e| < align_w_calm for align_calm_need periods), or trips the
+ * position fault after DRIVE_ALIGN_SWINGS swings more. */
 static void drive_align(drive_t *drv, const float i[3], const hal_sample_t *s) {
   const drive_config_t *c = &drv->cfg;
   const ab_t i_ab = frames_clarke((abc_t){i[0], i[1], i[2]});
-  const dq_t v = current_ctrl_update(&drv->align_cc, (dq_t){c->align_current, 0.0f},
-                                     (dq_t){i_ab.alpha, i_ab.beta}, 0.0f, c->v_margin * drv->v_lin);
+  const bool enc = !drv->gated && drv->align_kd > 0.0f;
+  const float w = drv->pos.out.omega;
+  const float phi =
+      enc ? fd_clampf(-drv->align_kd * w, -0.25f * FRAMES_PI, 0.25f * FRAMES_PI) : 0.0f;
+  const sincos_t sc = frames_sincos(phi);
+  const dq_t v =
+      current_ctrl_update(&drv->align_cc, (dq_t){c->align_current * sc.c, c->align_current * sc.s},
+                          (dq_t){i_ab.alpha, i_ab.beta}, 0.0f, c->v_margin * drv->v_lin);
   const modulation_out_t m =
       modulation_minmax((ab_t){v.d, v.q}, s->v_dc, drv->duty_lo, drv->duty_hi);
   const float none[3] = {0.0f, 0.0f, 0.0f};
   drv->v_applied = drive_write(drv, m.duty, none, s->v_dc);
-  if ((float)++drv->align_n * c->ts >= c->align_time) {
-    drv->pos_src->align(&drv->pos_st, c, s, 0.0f);
+  drv->align_calm_n = fabsf(w) < drv->align_w_calm ? drv->align_calm_n + 1u : 0u;
+  const bool settled = !enc || drv->align_calm_n >= drv->align_calm_need;
+  if ((float)++drv->align_n * c->ts >= c->align_time && settled) {
+    drv->pos_src->align(&drv->pos_st, c, s, phi);
+    ctrl_reset(&drv->ctrl);
+    drv->v_applied = (ab_t){0.0f, 0.0f};
+    drv->state = DRIVE_STATE_RUN;
+  } else if (enc && drv->align_n >= drv->align_n_timeout) {
+    drive_trip(drv, DRIVE_FAULT_POSITION); /* the rotor did not settle */
+  }
+}
+
+/* The held start (drive_hold.h): zero current, two opposite d pulses, then
+ * the run on the estimated angle from standstill. */
+static void drive_hold(drive_t *drv, const float i[3], const hal_sample_t *s) {
+  const ab_t i_ab = frames_clarke((abc_t){i[0], i[1], i[2]});
+  ab_t v;
+  float theta = 0.0f;
+  const int r = drive_hold_step(drv, i_ab, drv->cfg.v_margin * drv->v_lin, &v, &theta);
+  if (r == DRIVE_HOLD_FAIL) {
+    drive_trip(drv, DRIVE_FAULT_POSITION);
+    return;
+  }
+  const modulation_out_t m = modulation_minmax(v, s->v_dc, drv->duty_lo, drv->duty_hi);
+  const float none[3] = {0.0f, 0.0f, 0.0f};
+  drv->v_applied = drive_write(drv, m.duty, none, s->v_dc);
+  if (r == DRIVE_HOLD_DONE) {
+    drv->pos_src->hold(&drv->pos_st, theta);
     ctrl_reset(&drv->ctrl);
     drv->v_applied = (ab_t){0.0f, 0.0f};
     drv->state = DRIVE_STATE_RUN;
@@ -757,10 +830,14 @@ static void drive_start(drive_t *drv) {
   drv->ra_w1 = 0.0f;
   drv->tm.lc_cause = 0u;
   drv->v_applied = (ab_t){0.0f, 0.0f};
-  const bool align = drv->cfg.align_time > 0.0f && (drv->pos_src->caps & POS_CAP_ALIGN) != 0u;
+  const bool hold = drv->cfg.start_mode == 1u && drv->pos_src->hold != NULL;
+  const bool align =
+      hold || (drv->cfg.align_time > 0.0f && (drv->pos_src->caps & POS_CAP_ALIGN) != 0u);
   if (align) {
     current_ctrl_reset(&drv->align_cc);
     drv->align_n = 0u;
+    drv->align_calm_n = 0u;
+    drive_hold_reset(drv);
   }
   const float mid = 0.5f * (drv->duty_lo + drv->duty_hi);
   const hal_pwm_t p = hal_pwm_centred(mid, mid, mid);
@@ -876,7 +953,11 @@ void drive_isr(drive_t *drv) {
       drive_safe_leave_gates(drv);
       drv->state = DRIVE_STATE_IDLE;
     } else if (drv->state == DRIVE_STATE_ALIGN) {
-      drive_align(drv, i, &s);
+      if (drv->cfg.start_mode == 1u) {
+        drive_hold(drv, i, &s);
+      } else {
+        drive_align(drv, i, &s);
+      }
     } else {
       drive_run(drv, i, &s);
     }

@@ -140,6 +140,8 @@
     "alignment before run: d current along the assumed axis for this long (0: no alignment, else >= ts)")               \
   X(45, align_current,  F32,  "A",      1.0f,        0.0f,    1e4f,     IDLE, "controller.align_current",  \
     "d current of the alignment")                                                                           \
+  X(61, start_mode,     U16,  "",       0.0f,        0.0f,    1.0f,     IDLE, "controller.start_mode",     \
+    "start of a position source: 0 align (d current along theta = 0 for align_time, the rotor turns), 1 hold (star point: angle at standstill, polarity from d-axis saturation pulses, no free rotor)") \
   X(46, pos_err_max,    F32,  "rad",    0.5f,        0.01f,   3.2f,     LIVE, "controller.pos_err_max",    \
     "position fault: measured angle this far (electrical) from the PLL's prediction")                       \
   /* Direct Flux Control position (Fabbri 2022; docs/dfc.md) */                                            \

@@ -524,6 +524,16 @@ FD_COLD static void pdfc_align(pos_state_t *s, const drive_config_t *cfg, const 
   warm_gain(s); /* the warm start's, at the a, b in force */
 }
 
+/* The held start (drive_hold.c): the estimate's branch nearest theta, the
+ * polarity resolved; the evidence of an alignment is not used (the rotor
+ * was held, a load may have moved it a little). */
+static void pdfc_hold(pos_state_t *s, float theta) {
+  trk_reset(s, nearest_branch(trk_theta(s), theta), trk_omega(s));
+  s->dfc.started = true;
+  s->dfc.aligned = true;
+  s->dfc.pol_acc = 0.0f;
+}
+
 /* |b/a| the EKF is given at most: measured on the Fig. 3.3 machine, where
  * it works to |p| = 0.36 (0.40 with the star channel unclipped) and not
  * from 0.37 (0.41); docs/dfc.md, "EKF: the range of p" */
@@ -555,9 +565,10 @@ FD_COLD static const char *pdfc_check_cfg(const drive_config_t *cfg, const char 
     *field = "rls_p_min";
     return "the RLS covariance limits need rls_p_min <= rls_p_max";
   }
-  if (!(cfg->align_time > 0.0f)) {
+  if (cfg->start_mode == 0u && !(cfg->align_time > 0.0f)) {
     *field = "align_time";
-    return "a star-point source resolves the magnet's polarity by the alignment: align_time > 0";
+    return "a star-point source resolves the magnet's polarity by the alignment: align_time > 0 "
+           "(or the held start, start_mode 1)";
   }
   return NULL;
 }
@@ -568,7 +579,8 @@ FD_COLD static const char *pdfc_check_cfg(const drive_config_t *cfg, const char 
                                            pdfc_reset,                                             \
                                            pdfc_update,                                            \
                                            pdfc_align,                                             \
-                                           pdfc_check_cfg}
+                                           pdfc_check_cfg,                                         \
+                                           pdfc_hold}
 POS_DFC_ROW(dfc);
 POS_DFC_ROW(dfc_inv);
 POS_DFC_ROW(ivd);

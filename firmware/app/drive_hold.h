@@ -10,7 +10,7 @@
  * meets the lower incremental inductance and builds the larger current
  * (Fabbri 2022, 3.1.3: theta is known from 2 theta only up to pi). The
  * pulses carry no torque (d current along the estimate). Then the run
- * starts from standstill on the estimated angle: about 2 ms with the
+ * starts from standstill on the estimated angle: 2.44 ms with the
  * gates on and no torque, the only time an active load can move the rotor.
  */
 #ifndef FLUXDRIVE_DRIVE_HOLD_H
@@ -24,11 +24,12 @@ enum {
   DRIVE_HOLD_FAIL = 2  /* no angle, or no polarity evidence: the position fault */
 };
 
-/* Periods of each phase (at 16 kHz: 0.5 ms, 2 x 0.75 ms) */
-#define DRIVE_HOLD_N_ACQ   8u /* zero current: three DFC components, then five updates */
-#define DRIVE_HOLD_N_PULSE 3u /* voltage pulse */
-#define DRIVE_HOLD_N_AVG   1u /* samples of its current averaged */
-#define DRIVE_HOLD_N_ZERO  10u /* the current back to zero (deadbeat, drive_hold.c) */
+/* Periods of each phase: the acquisition, then per pulse N_PULSE + N_AVG +
+ * 1 and N_ZERO; 39 periods in all, 2.44 ms at 16 kHz */
+#define DRIVE_HOLD_N_ACQ   8u   /* zero current: three DFC components, then five updates */
+#define DRIVE_HOLD_N_PULSE 3u   /* voltage pulse */
+#define DRIVE_HOLD_N_AVG   1u   /* samples of its current averaged */
+#define DRIVE_HOLD_N_ZERO  10u  /* the current back to zero (deadbeat, drive_hold.c) */
 #define DRIVE_HOLD_K_DB    0.8f /* of the deadbeat step: margin for R, L errors */
 /* the pulses' currents must differ by this fraction of their mean */
 #define DRIVE_HOLD_EVIDENCE_MIN 0.02f

@@ -4,7 +4,7 @@ set(FD_PYTHON "" CACHE FILEPATH "Python of the tools venv (scripts/setup.sh)")
 if(FD_PYTHON)
   # tests that run on their own (in parallel with the rest, found by -R),
   # left out of python/pytest
-  set(alone param_ranges random_machines start_polarity ekf_range rls_convergence)
+  set(alone param_ranges random_machines start_polarity ekf_range rls_convergence held_start)
   set(ignore "")
   foreach(name ${alone})
     list(APPEND ignore --ignore=${CMAKE_CURRENT_SOURCE_DIR}/python/test_${name}.py)
@@ -23,7 +23,9 @@ if(FD_PYTHON)
   # ekf_range: the ekf over the range of p it accepts, refused beyond
   # (issue 23, point 4); rls_convergence: the RLS of a, b from +-50 %
   # starts on the star-point presets and drawn machines (issue 23, point 5;
-  # FLUXDRIVE_RLS_SEEDS, FLUXDRIVE_RLS_FULL)
+  # FLUXDRIVE_RLS_SEEDS, FLUXDRIVE_RLS_FULL); held_start: the held start against
+  # an active load and the encoder's alignment on a light free rotor
+  # (issue 23, points 3 and 18)
   foreach(name ${alone})
     add_test(NAME python/${name}
              COMMAND ${FD_PYTHON} -m pytest -q ${CMAKE_CURRENT_SOURCE_DIR}/python/test_${name}.py

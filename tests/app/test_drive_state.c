@@ -693,7 +693,9 @@ static void watchdog_needs_both_contexts(void **state) {
   hal.reset_by_watchdog = false;
 }
 
-/* Alignment: gates on with d current along theta = 0 for align_time, then
+/* Alignment: gates on with d current along theta = 0 for align_time and
+ * until the encoder's speed has stayed calm for align_calm_need periods
+ * (2 / w_n: 26 ms with the default machine, w_n = 77 rad/s at 1 A), then
  * the encoder's offset is what it reads there. */
 static void alignment_sets_the_encoder_offset(void **state) {
   (void)state;
@@ -708,11 +710,43 @@ static void alignment_sets_the_encoder_offset(void **state) {
   run_isrs(drv.cfg.offset_samples + 1);
   assert_int_equal(drv.state, DRIVE_STATE_ALIGN);
   assert_true(hal.gates_on);
-  run_isrs((int)(0.01f / drv.cfg.ts) + 1);
+  const int need = (int)drv.align_calm_need;
+  assert_true(need > (int)(0.01f / drv.cfg.ts) + 1); /* the calm outlasts align_time here */
+  run_isrs(need - 2);
+  assert_int_equal(drv.state, DRIVE_STATE_ALIGN); /* not yet settled */
+  run_isrs(2);
   assert_int_equal(drv.state, DRIVE_STATE_RUN);
   const float half = 3.14159265f / (float)drv.cfg.enc_cpr;
   const float want = remainderf(drv.cfg.pole_pairs * (0.5f + half), 6.2831853f);
   assert_float_equal(drv.pos_st.enc.offset, want, 1e-4f);
+}
+
+/* A rotor that keeps swinging through the encoder's alignment (issue 23,
+ * point 18): no offset is taken; the position fault after
+ * DRIVE_ALIGN_SWINGS swings more (align_n_timeout), gates off. */
+static void swinging_rotor_never_aligns(void **state) {
+  (void)state;
+  drive_config_t cfg;
+  drive_config_default(&cfg);
+  cfg.align_time = 0.01f;
+  cfg.align_current = 1.0f;
+  setup_with(&cfg);
+  sample(0.0f, 0.0f, 0.0f, 310.0f);
+  drive_cmd_enable(&drv, true);
+  const float off0 = drv.pos_st.enc.offset;
+  for (int k = 0; k < (int)drv.cfg.offset_samples + (int)drv.align_n_timeout + 2; ++k) {
+    /* 0.1 rad mechanical at 5 Hz: 2 x 10 x 2 pi rad/s electrical peak */
+    hal.sample.enc_angle = 1.0f + 0.1f * sinf(31.4159f * (float)k * drv.cfg.ts);
+    drive_isr(&drv);
+    if (drv.state == DRIVE_STATE_FAULT) {
+      break;
+    }
+    assert_true(drv.state != DRIVE_STATE_RUN);
+  }
+  assert_int_equal(drv.state, DRIVE_STATE_FAULT);
+  assert_int_equal(drv.faults, DRIVE_FAULT_POSITION);
+  assert_false(hal.gates_on);
+  assert_float_equal(drv.pos_st.enc.offset, off0, 0.0f);
 }
 
 /* The angle the law uses is the position source's, extrapolated from the
@@ -825,6 +859,7 @@ int main(void) {
                                      cmocka_unit_test(parameter_requests_are_applied_by_the_isr),
                                      cmocka_unit_test(watchdog_needs_both_contexts),
                                      cmocka_unit_test(alignment_sets_the_encoder_offset),
+                                     cmocka_unit_test(swinging_rotor_never_aligns),
                                      cmocka_unit_test(angle_extrapolated_from_timestamps),
                                      cmocka_unit_test(bad_config_is_named),
                                      cmocka_unit_test(non_finite_law_input_trips_control),

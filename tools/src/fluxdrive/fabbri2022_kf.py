@@ -92,8 +92,9 @@ def speed_sc(root: Path, source: str, rpm: float, noise: float, r_scale: float =
     sc["controller"].update({"pos_source": source, "dfc_sigma": sigma_of(noise),
                              "kf_r_scale": r_scale, "kf_r_sys": 0.0})
     if source == "encoder" and not enc_align:
-        # the plant's encoder offset is known: a light free rotor still
-        # swings when an alignment ends, and its offset would be taken there
+        # the plant's encoder offset is known: the table's encoder rows as
+        # the thesis's (the alignment, damped and waiting for the rotor to
+        # settle, is measured on its own: enc_aligned)
         sc["controller"]["align_time"] = 0.0
     sc["references"]["speed"]["terms"][0]["value"] = rpm
     return sc
@@ -563,8 +564,10 @@ def report(res: ResultsKF) -> str:
           f"known). With the scenario's 0.1 s alignment instead, at 100 rpm: position error "
           f"{ea.pos_mean:+.1f} deg mean, speed error sD {ea.sd:.2f} rpm, faults "
           f"{', '.join(ea.faults) or 'none'}; the rotor turns at {ea.speed_align_end:+.1f} rpm "
-          "when the alignment ends and the offset is taken (the light free rotor swings about "
-          "the axis, nearly undamped)."]
+          "when the alignment ends and the offset is taken (the alignment damps this light "
+          "free rotor's swing by the encoder's speed and ends only once it has settled: "
+          "`docs/dfc.md`, \"Encoder alignment\"; before that fix, issue 23 point 18, the "
+          "offset was taken mid-swing, -57.5 deg)."]
     L += ["", "IVD+KF / DFC+KF sD (the issue: at most 1/2): " + ", ".join(
         f"{rpm:g} rpm R {rs:g} sigma^2: {res.sd('ivd+kf', rpm, rs).sd / res.sd('dfc+kf', rpm, rs).sd:.2f}"
         for rpm, _ in PAPER_KF.table52_sd for rs in PAPER_KF.r_scales), "",

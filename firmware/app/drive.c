@@ -161,6 +161,10 @@ FD_COLD static void drive_derive(drive_t *drv) {
    * DRIVE_ALIGN_CALM rad electrical left */
   drv->align_w_calm = DRIVE_ALIGN_CALM * wn;
   drv->align_calm_need = wn > 0.0f ? (uint32_t)(2.0f / (wn * c->ts)) + 1u : 0u;
+  /* a rotor calm from the alignment's start for 1 / w_n started within
+   * DRIVE_ALIGN_CALM rad of the axis (from rest at theta_0 its speed
+   * passes DRIVE_ALIGN_CALM w_n after DRIVE_ALIGN_CALM / (w_n theta_0)) */
+  drv->align_still_need = wn > 0.0f ? (uint32_t)(1.0f / (wn * c->ts)) + 1u : 0u;
   const float t_out =
       c->align_time + (wn > 0.0f ? DRIVE_ALIGN_SWINGS * 2.0f * FRAMES_PI / wn : 0.0f);
   drv->align_n_timeout = (uint32_t)(t_out / c->ts) + 1u;
@@ -768,7 +772,8 @@ static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
  * swung through the offset, -57.5 deg): the current's angle leads against
  * the encoder's speed, -k_d omega_e (at most 45 deg), which damps the
  * swing (drive_derive), and the alignment ends when the rotor has settled
- * (|omega_e| < align_w_calm for align_calm_need periods), or trips the
+ * (|omega_e| < align_w_calm for align_calm_need periods, or from the start
+ * for align_still_need), or trips the
  * position fault after DRIVE_ALIGN_SWINGS swings more. */
 static void drive_align(drive_t *drv, const float i[3], const hal_sample_t *s) {
   const drive_config_t *c = &drv->cfg;
@@ -786,8 +791,12 @@ static void drive_align(drive_t *drv, const float i[3], const hal_sample_t *s) {
   const float none[3] = {0.0f, 0.0f, 0.0f};
   drv->v_applied = drive_write(drv, m.duty, none, s->v_dc);
   drv->align_calm_n = fabsf(w) < drv->align_w_calm ? drv->align_calm_n + 1u : 0u;
-  const bool settled = !enc || drv->align_calm_n >= drv->align_calm_need;
-  if ((float)++drv->align_n * c->ts >= c->align_time && settled) {
+  const uint32_t n = ++drv->align_n;
+  /* calm for 2 / w_n, or from the start on for 1 / w_n (a rotor that never
+   * moved: started at the axis, or held) */
+  const bool settled = !enc || drv->align_calm_n >= drv->align_calm_need ||
+                       (drv->align_calm_n == n && n >= drv->align_still_need);
+  if ((float)n * c->ts >= c->align_time && settled) {
     drv->pos_src->align(&drv->pos_st, c, s, phi);
     ctrl_reset(&drv->ctrl);
     drv->v_applied = (ab_t){0.0f, 0.0f};

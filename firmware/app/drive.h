@@ -145,11 +145,12 @@ typedef struct drive_s {
    * damped by its speed, held until the rotor has settled) */
   current_ctrl_t align_cc;
   uint32_t align_n;
-  uint32_t align_calm_n;    /* periods the encoder's speed has stayed below align_w_calm */
-  float align_kd;           /* the damping: angle of the current per electrical rad/s [s] */
-  float align_w_calm;       /* settled: |speed| below this [rad/s electrical] ... */
-  uint32_t align_calm_need; /* ... for this many periods */
-  uint32_t align_n_timeout; /* not settled after this many periods: position fault */
+  uint32_t align_calm_n;     /* periods the encoder's speed has stayed below align_w_calm */
+  float align_kd;            /* the damping: angle of the current per electrical rad/s [s] */
+  float align_w_calm;        /* settled: |speed| below this [rad/s electrical] ... */
+  uint32_t align_calm_need;  /* ... for this many periods */
+  uint32_t align_still_need; /* ... or from the start for this many */
+  uint32_t align_n_timeout;  /* not settled after this many periods: position fault */
 
   /* the held start (start_mode 1, state align; drive_hold.c) */
   struct {

@@ -694,9 +694,9 @@ static void watchdog_needs_both_contexts(void **state) {
 }
 
 /* Alignment: gates on with d current along theta = 0 for align_time and
- * until the encoder's speed has stayed calm for align_calm_need periods
- * (2 / w_n: 26 ms with the default machine, w_n = 77 rad/s at 1 A), then
- * the encoder's offset is what it reads there. */
+ * until the encoder's speed has stayed calm: a rotor that never moved for
+ * align_still_need periods (1 / w_n: 13 ms with the default machine, w_n =
+ * 77 rad/s at 1 A), then the encoder's offset is what it reads there. */
 static void alignment_sets_the_encoder_offset(void **state) {
   (void)state;
   drive_config_t cfg;
@@ -710,7 +710,7 @@ static void alignment_sets_the_encoder_offset(void **state) {
   run_isrs(drv.cfg.offset_samples + 1);
   assert_int_equal(drv.state, DRIVE_STATE_ALIGN);
   assert_true(hal.gates_on);
-  const int need = (int)drv.align_calm_need;
+  const int need = (int)drv.align_still_need;
   assert_true(need > (int)(0.01f / drv.cfg.ts) + 1); /* the calm outlasts align_time here */
   run_isrs(need - 2);
   assert_int_equal(drv.state, DRIVE_STATE_ALIGN); /* not yet settled */

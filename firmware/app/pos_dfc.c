@@ -530,8 +530,8 @@ FD_COLD static void pdfc_align(pos_state_t *s, const drive_config_t *cfg, const 
 static void pdfc_hold(pos_state_t *s, float theta) {
   trk_reset(s, nearest_branch(trk_theta(s), theta), trk_omega(s));
   s->dfc.started = true;
+  pol_reset(s);
   s->dfc.aligned = true;
-  s->dfc.pol_acc = 0.0f;
 }
 
 /* |b/a| the EKF is given at most: measured on the Fig. 3.3 machine, where

@@ -773,8 +773,8 @@ static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
  * the encoder's speed, -k_d omega_e (at most 45 deg), which damps the
  * swing (drive_derive), and the alignment ends when the rotor has settled
  * (|omega_e| < align_w_calm for align_calm_need periods, or from the start
- * for align_still_need), or trips the
- * position fault after DRIVE_ALIGN_SWINGS swings more. */
+ * for align_still_need), or trips the position fault after
+ * DRIVE_ALIGN_SWINGS swings more. */
 static void drive_align(drive_t *drv, const float i[3], const hal_sample_t *s) {
   const drive_config_t *c = &drv->cfg;
   const ab_t i_ab = frames_clarke((abc_t){i[0], i[1], i[2]});
@@ -846,8 +846,8 @@ static void drive_start(drive_t *drv) {
     current_ctrl_reset(&drv->align_cc);
     drv->align_n = 0u;
     drv->align_calm_n = 0u;
-    drive_hold_reset(drv);
   }
+  drive_hold_reset(drv); /* also its plain pattern: a start aborted mid-pulse left it */
   const float mid = 0.5f * (drv->duty_lo + drv->duty_hi);
   const hal_pwm_t p = hal_pwm_centred(mid, mid, mid);
   hal_pwm_write(&p, NULL);

@@ -147,7 +147,6 @@ FD_COLD static void drive_derive(drive_t *drv) {
   drv->lc_n_fast = c->lc_time / c->ts;
   drv->lc_n_track = c->lc_track_time / c->ts;
   drv->inv_pole_pairs = 1.0f / c->pole_pairs;
-  drv->hold.v_pulse = drive_hold_v_pulse(c);
   /* the encoder's alignment: the rotor swings about the current's axis at
    * w_n = p sqrt(1.5 lambda_m i_align / J) (electrical), the PM torque
    * 1.5 p lambda_m i_q; the current's angle led by -k_d omega_e damps it

@@ -154,14 +154,14 @@ typedef struct drive_s {
 
   /* the held start (start_mode 1, state align; drive_hold.c) */
   struct {
-    uint8_t phase; /* DRIVE_HOLD_* */
-    uint16_t n;    /* periods into the phase */
-    float theta;   /* the estimate's angle the pulses are applied along [rad] */
-    float i0;      /* the d current when a pulse began [A] */
-    float di[2];   /* the d current each pulse built, along theta and theta + pi [A] */
-    float v_pulse; /* the pulse voltage of the linear R-L model (drive_derive) [V] */
-    dq_t v_prev;   /* the voltage asked last period, in the estimate's frame [V] */
-    bool plain;    /* the pattern without the DFC window (a pulse's clean sample) */
+    uint8_t phase;           /* DRIVE_HOLD_* */
+    uint16_t n;              /* periods into the phase */
+    float theta;             /* the estimate's angle the pulses are applied along [rad] */
+    float i0;                /* the d current when a pulse began [A] */
+    float di[2];             /* the d current each pulse built, along theta and theta + pi [A] */
+    uint8_t n_pulse, n_zero; /* periods of each pulse and of the way back (drive_hold.c) */
+    dq_t v_prev;             /* the voltage asked last period, in the estimate's frame [V] */
+    bool plain;              /* the pattern without the DFC window (a pulse's clean sample) */
   } hold;
 
   /* position */

@@ -12,12 +12,17 @@
 
 enum { PH_ACQ = 0, PH_PULSE0, PH_ZERO0, PH_PULSE1, PH_ZERO1 };
 
-float drive_hold_v_pulse(const drive_config_t *cfg) {
-  /* i(N Ts) = V / R (1 - exp(-N Ts R / Ld)) = i_max: the linear R-L model,
-   * what the controller knows (the saturation changes it by some %, which
-   * is the evidence) */
-  const float x = (float)DRIVE_HOLD_N_PULSE * cfg->ts * cfg->rs / cfg->ld;
-  return cfg->i_max * cfg->rs / (1.0f - expf(-x));
+/* The pulse's periods: the voltage limit v_max until the controller's
+ * linear R-L model reaches i_max, i(t) = v_max / R (1 - exp(-t R / Ld)),
+ * but no longer than tau = Ld / R (beyond it the current is set by R, no
+ * longer by the inductance that carries the evidence: on fabbri2022_t51
+ * tau is 2.9 periods), within DRIVE_HOLD_N_PULSE_MIN .. _MAX. */
+static unsigned pulse_periods(const drive_config_t *c, float v_max) {
+  const float tau = c->ld / c->rs;
+  const float r = c->i_max * c->rs / v_max;
+  const float t = r < 1.0f ? fd_minf(tau, -tau * logf(1.0f - r)) : tau;
+  const float n = ceilf(t / c->ts);
+  return (unsigned)fd_clampf(n, (float)DRIVE_HOLD_N_PULSE_MIN, (float)DRIVE_HOLD_N_PULSE_MAX);
 }
 
 void drive_hold_reset(drive_t *drv) {
@@ -29,6 +34,8 @@ void drive_hold_reset(drive_t *drv) {
   drv->hold.di[1] = 0.0f;
   drv->hold.v_prev = (dq_t){0.0f, 0.0f};
   drv->hold.plain = false;
+  drv->hold.n_pulse = DRIVE_HOLD_N_PULSE_MIN;
+  drv->hold.n_zero = DRIVE_HOLD_N_ZERO;
 }
 
 /* The current back to zero in the estimate's frame, deadbeat on the
@@ -72,20 +79,21 @@ static bool pulse(drive_t *drv, ab_t i_ab, float v_max, float sgn, unsigned k, a
   } else if (n == 1u) {
     drv->hold.i0 = i_d; /* before the pulse acts, the first sample after a plain period */
   }
-  drv->hold.plain = n < DRIVE_HOLD_N_PULSE + DRIVE_HOLD_N_AVG;
-  if (n < DRIVE_HOLD_N_PULSE) {
-    const float v = sgn * fd_minf(drv->hold.v_pulse, v_max);
+  const unsigned np = drv->hold.n_pulse;
+  drv->hold.plain = n < np + DRIVE_HOLD_N_AVG;
+  if (n < np) {
+    const float v = sgn * v_max;
     *v_ab = (ab_t){v * sc.c, v * sc.s};
     drv->hold.v_prev = (dq_t){v, 0.0f};
     return false;
   }
   *v_ab = (ab_t){0.0f, 0.0f};
   drv->hold.v_prev = (dq_t){0.0f, 0.0f};
-  if (n < DRIVE_HOLD_N_PULSE + 1u) {
+  if (n < np + 1u) {
     return false;
   }
   drv->hold.di[k] += sgn * (i_d - drv->hold.i0) * (1.0f / (float)DRIVE_HOLD_N_AVG);
-  return n >= DRIVE_HOLD_N_PULSE + DRIVE_HOLD_N_AVG;
+  return n >= np + DRIVE_HOLD_N_AVG;
 }
 
 int drive_hold_step(drive_t *drv, ab_t i_ab, float v_max, ab_t *v_ab, float *theta_out) {
@@ -95,6 +103,10 @@ int drive_hold_step(drive_t *drv, ab_t i_ab, float v_max, ab_t *v_ab, float *the
   if (ph == PH_ACQ) {
     if (drv->hold.n >= DRIVE_HOLD_N_ACQ && drv->pos.out.valid) {
       drv->hold.theta = drv->pos.out.theta;
+      const unsigned np = pulse_periods(&drv->cfg, v_max);
+      drv->hold.n_pulse = (uint8_t)np;
+      /* the way back takes as long as the way up at the voltage limit */
+      drv->hold.n_zero = (uint8_t)(np + 4u > DRIVE_HOLD_N_ZERO ? np + 4u : DRIVE_HOLD_N_ZERO);
       next = true;
     } else if (drv->hold.n >= 4u * DRIVE_HOLD_N_ACQ) {
       return DRIVE_HOLD_FAIL; /* no angle at standstill */
@@ -107,7 +119,7 @@ int drive_hold_step(drive_t *drv, ab_t i_ab, float v_max, ab_t *v_ab, float *the
     }
   } else {
     *v_ab = zero_current(drv, i_ab, v_max);
-    if (drv->hold.n + 1u >= DRIVE_HOLD_N_ZERO) {
+    if (drv->hold.n + 1u >= drv->hold.n_zero) {
       if (ph == PH_ZERO1) {
         /* the pulse along the north pole built the larger current */
         const float d0 = drv->hold.di[0], d1 = drv->hold.di[1];

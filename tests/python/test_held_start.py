@@ -6,19 +6,22 @@ The held start: with zero current the star-point source measures 2 theta_e
 at standstill, two opposite d-axis voltage pulses show the magnet's polarity
 by the d-axis saturation (the plant's machine.ld_sat, machine.i_sat), then
 the speed loop closes from standstill. The rotor is never pulled: it is
-free, with no torque, for the start's 39 periods (2.4375 ms at 16 kHz) and
-for nothing else. An active load T_L applied when the gates come on (a
-brake released at the start) turns it by p T_L t^2 / (2 J) over that time
-(t from the load's onset to the run): on fabbri2022_t51 / _fig33 at 100 %
-rated load 2.0 deg electrical, on the e-bike 1.2 deg. The bound, MOVE_MAX:
-3 deg electrical; and the rotor must move as that free-rotor model says
-(within 10 % + 0.2 deg): the pulses carry no torque.
+free, with no torque, for the start's t_s (39 periods, 2.44 ms at 16 kHz,
+on fabbri2022_t51; up to 52, 3.25 ms, where the pulses are longer:
+drive_hold.c) and for nothing else. An active load T_L applied when the
+gates come on (a brake released at the start) turns it by
+p T_L t^2 / (2 J) over that time (t from the load's onset to the run): on
+fabbri2022_t51 / _fig33 at 100 % rated load 2.0 deg electrical, on the
+e-bike 2.2 deg, on the drawn star:3 (a light rotor, 1 mH) 5.3 deg. The
+bound, MOVE_MAX: 6 deg electrical; and the rotor must move as that
+free-rotor model says (within 10 % + 0.2 deg): the pulses carry no torque.
 
 The grid (test_start_against_load): every star-point preset, every
 star-point source, start angles every 0.5 rad over the electrical turn,
-the load 0 (the light free rotor), 50 % and 100 % of the preset's rated
-torque, noise seeds 1-3 (in turn), the calibrated star noise 0.0368 V.
-Each run ends 9.5 ms after the start: the estimate must stay within
+the load 0 (the light free rotor), 50 % and 100 % of the rated torque;
+and three drawn star-point machines (star:1..3), angles every 1 rad, load
+0 and 100 %; noise seeds 1-3 (in turn), the calibrated star noise 0.0368
+V. Each run ends 10.7 to 11.6 ms after the start (at 0.03 s): the estimate must stay within
 pos_err_max (0.5 rad) of the plant's angle (a wrong polarity is pi off).
 Not longer: at 100 % rated load the speed loop may not catch the load (on
 t51 / fig33 the torque the DFC window's voltage allows is about rated, on
@@ -42,6 +45,7 @@ import numpy as np
 import pytest
 
 from conftest import REAL_SIL, REPO_ROOT
+from fluxdrive import machines as mach
 
 pytestmark = pytest.mark.skipif(not REAL_SIL.exists(), reason="fluxdrive-sil not built")
 
@@ -49,7 +53,7 @@ V_DC = 24.0
 NOISE = 0.0368  # V, the calibrated star noise (docs/results-fabbri2022.md)
 T_LOAD = 0.016  # s: the gates come on (256 offset samples at 16 kHz): the load's onset
 RUN_STATE, START_STATE = 2, 4
-MOVE_MAX = 3.0  # deg electrical
+MOVE_MAX = 6.0  # deg electrical
 RIGHT = 0.5  # rad: pos_err_max's default
 # preset: (pole pairs, inertia, rated torque [N m], rated current [A], controller keys)
 PRESETS = {
@@ -61,21 +65,50 @@ PRESETS = {
                          {"dfc_iter": 4, "dfc_b": -0.1825 * 0.05, "align_current": 5.0,
                           "i_max": 42.4, "i_trip": 60.0, "torque_max": 30.0, "speed_bw": 150}),
 }
+# machines nobody tuned for: drawn star-point machines (`fluxdrive machines
+# draw --kind star --seed 1..3`, docs/machines.md), rated as drawn, the
+# controller overloadable to 2 x rated as the presets above
+DRAWN = ("star:1", "star:2", "star:3")
 SOURCES = ("dfc", "dfc_inv", "ivd", "dfc+kf", "ivd+kf", "ekf", "ivd+kf+rls")
 ANGLES = tuple(round(0.5 * k, 1) for k in range(13))  # rad electrical, 0 .. 6.0
 LOADS = (0.0, 0.5, 1.0)  # of the rated torque
 LD_SAT = 0.1  # the plant's d-axis saturation: ld down to ld / 1.1 along the magnet
 
 
+def drawn(name: str) -> tuple:
+    """(pole pairs, inertia, rated torque, rated current, controller keys,
+    scenario sections) of a drawn machine."""
+    kind, seed = name.split(":")
+    d = mach.draw(kind, int(seed))
+    c = d.sections["controller"]
+    i_max, t_max = c["i_max"], c["torque_max"]
+    keys = {"i_max": 2.0 * i_max, "i_trip": 3.0 * i_max, "torque_max": 2.0 * t_max,
+            "speed_max": c["speed_max"], "speed_trip": c["speed_trip"],
+            "v_dc_max": c["v_dc_max"], "v_dc_min": c["v_dc_min"],
+            "align_current": c["align_current"]}
+    sections = {"machine": dict(d.sections["machine"]), "mechanics": d.sections["mechanics"],
+                "dc_link": d.sections["dc_link"],
+                "sensors": {k: v for k, v in d.sections["sensors"].items() if k != "star_noise"}}
+    return (d.sections["machine"]["pole_pairs"], d.sections["mechanics"]["j"], t_max,
+            i_max / math.sqrt(2.0), keys, sections)
+
+
+def machine(name: str) -> tuple:
+    if name in PRESETS:
+        return (*PRESETS[name], {"machine": {"preset": name}})
+    return drawn(name)
+
+
 def scenario(preset, source, angle, load, seed, duration, rpm=0.0, start_mode=1, sat=LD_SAT):
-    pp, _, t_rated, i_rated, keys = PRESETS[preset]
+    pp, _, t_rated, i_rated, keys, sections = machine(preset)
     sc = json.loads((REPO_ROOT / "sil" / "scenarios" / "fabbri_speed.json").read_text())
-    sc["machine"] = {"preset": preset}
+    for k, v in sections.items():
+        sc[k] = {**sc.get(k, {}), **v} if k != "machine" else dict(v)
     if sat > 0.0:
         sc["machine"].update({"ld_sat": sat, "i_sat": i_rated})
     sc["duration"] = duration
     sc["log"] = {"decimation": 1}
-    sc["mechanics"]["theta0"] = angle / pp
+    sc["mechanics"] = {**sc["mechanics"], "theta0": angle / pp}
     if load > 0.0:
         sc["mechanics"]["load_torque"] = {
             "terms": [{"type": "step", "t": T_LOAD, "value": load * t_rated}]}
@@ -100,7 +133,7 @@ def run(sc) -> np.ndarray | str:
 
 def predicted_move(preset, load, t_free) -> float:
     """deg electrical: the free rotor under the load for t_free."""
-    pp, j, t_rated, _, _ = PRESETS[preset]
+    pp, j, t_rated = machine(preset)[:3]
     return math.degrees(pp * load * t_rated * t_free ** 2 / (2.0 * j))
 
 
@@ -134,10 +167,10 @@ def one_start(case):
 def start_cases() -> list:
     cases = []
     k = 0
-    for pre in PRESETS:
+    for pre in (*PRESETS, *DRAWN):
         for src in SOURCES:
-            for a in ANGLES:
-                for load in LOADS:
+            for a in (ANGLES if pre in PRESETS else ANGLES[::2]):
+                for load in (LOADS if pre in PRESETS else (0.0, 1.0)):
                     cases.append((pre, src, a, load, 1 + k % 3))
                     k += 1
     return cases
@@ -174,7 +207,7 @@ def test_start_against_load():
 # ------------------------------------------------- speed control after it
 
 SPEED_CASES = [(pre, src, a, load) for pre in PRESETS for src in ("ivd", "ekf")
-               for a in (1.0, 4.0) for load in (0.0, 0.5)]
+               for a in (1.0,) for load in (0.0, 0.5)]
 
 
 def rpm_of(preset) -> float:

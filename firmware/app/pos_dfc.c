@@ -538,6 +538,7 @@ static void pdfc_hold(pos_state_t *s, float theta) {
  * it works to |p| = 0.36 (0.40 with the star channel unclipped) and not
  * from 0.37 (0.41); docs/dfc.md, "EKF: the range of p" */
 #define POS_DFC_EKF_P_MAX 0.35f
+
 FD_COLD static const char *pdfc_check_cfg(const drive_config_t *cfg, const char **field) {
   const dfc_cfg_t d = cfg_of(cfg);
   const int e = dfc_check(&d);

@@ -806,8 +806,10 @@ static void drive_align(drive_t *drv, const float i[3], const hal_sample_t *s) {
 }
 
 /* The held start (drive_hold.h): zero current, two opposite d pulses, then
- * the run on the estimated angle from standstill. */
-static void drive_hold(drive_t *drv, const float i[3], const hal_sample_t *s) {
+ * the run on the estimated angle from standstill. In flash (FD_COLD), as
+ * drive_hold.c: the ISR's only for the start's few ms, and the G474's CCM
+ * has no room left for it. */
+FD_COLD FD_NOINLINE static void drive_hold(drive_t *drv, const float i[3], const hal_sample_t *s) {
   const ab_t i_ab = frames_clarke((abc_t){i[0], i[1], i[2]});
   ab_t v;
   float theta = 0.0f;

@@ -774,7 +774,7 @@ static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
  * (|omega_e| < align_w_calm for align_calm_need periods, or from the start
  * for align_still_need), or trips the position fault after
  * DRIVE_ALIGN_SWINGS swings more. */
-static void drive_align(drive_t *drv, const float i[3], const hal_sample_t *s) {
+FD_COLD FD_NOINLINE static void drive_align(drive_t *drv, const float i[3], const hal_sample_t *s) {
   const drive_config_t *c = &drv->cfg;
   const ab_t i_ab = frames_clarke((abc_t){i[0], i[1], i[2]});
   const bool enc = !drv->gated && drv->align_kd > 0.0f;
@@ -829,7 +829,7 @@ FD_COLD FD_NOINLINE static void drive_hold(drive_t *drv, const float i[3], const
   }
 }
 
-static void drive_start(drive_t *drv) {
+FD_COLD FD_NOINLINE static void drive_start(drive_t *drv) {
   ctrl_reset(&drv->ctrl);
   drv->pos.in = (pos_input_t){0.0f, 0.0f}; /* no torque before the run */
   drv->speed_active = false;

@@ -441,7 +441,7 @@ static void send_periodic(can_proto_t *p, can_period_t which, const drive_t *drv
     frame_init(&f, CAN_MSG_TM_FLUX, node);
     can_codec_set(CAN_SIG_FLUX, f.data, tm->law_tm.flux);
     can_codec_set(CAN_SIG_FLUX_REF, f.data, tm->law_tm.flux_ref);
-    can_codec_set(CAN_SIG_DELTA, f.data, tm->law_tm.delta);
+    can_codec_set(CAN_SIG_DELTA, f.data, ctrl_tm_delta(&tm->law_tm));
     can_codec_set(CAN_SIG_I_QS_REF, f.data, tm->law_tm.i_qs_ref);
     break;
   case CAN_PERIOD_TM_POSITION:

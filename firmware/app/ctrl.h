@@ -14,6 +14,7 @@
 #ifndef FLUXDRIVE_CTRL_H
 #define FLUXDRIVE_CTRL_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "control/current_ctrl.h"
@@ -21,6 +22,7 @@
 #include "control/dfvc.h"
 #include "control/dfvc_sat.h"
 #include "drive_config.h"
+#include "math/fast_trig.h"
 #include "math/frames.h"
 #include "model/machine.h"
 
@@ -28,13 +30,22 @@
 typedef struct {
   float flux;     /* stator flux amplitude estimate [Vs] */
   float flux_ref; /* [Vs] */
-  float delta;    /* load angle [rad] */
-  float i_ds;     /* stator-flux frame currents [A] */
+  float delta;    /* load angle [rad], unless delta_lazy: ctrl_tm_delta */
+  float lam_d;    /* delta_lazy: the flux in the rotor frame whose angle it is [Vs] */
+  float lam_q;
+  bool delta_lazy; /* a law whose ISR needs no load angle leaves it to the readers */
+  float i_ds;      /* stator-flux frame currents [A] */
   float i_qs;
   float i_qs_ref;
   float torque;  /* torque estimate [N m] */
   float obs_err; /* |observer flux - current-model flux| [Vs] (flux laws) */
 } ctrl_telemetry_t;
+
+/* The load angle of a telemetry copy (main loop, logs): one atan2 where
+ * it is read, not every ISR (the decoupled DFVC's: telemetry only). */
+static inline float ctrl_tm_delta(const ctrl_telemetry_t *t) {
+  return t->delta_lazy ? fd_atan2f(t->lam_q, t->lam_d) : t->delta;
+}
 
 typedef struct {
   ab_t i_ab;      /* measured currents at the sampling instant [A] */

@@ -145,24 +145,6 @@ typedef struct drive_s {
    * damped by its speed, held until the rotor has settled) */
   current_ctrl_t align_cc;
   uint32_t align_n;
-  uint32_t align_calm_n;     /* periods the encoder's speed has stayed below align_w_calm */
-  float align_kd;            /* the damping: angle of the current per electrical rad/s [s] */
-  float align_w_calm;        /* settled: |speed| below this [rad/s electrical] ... */
-  uint32_t align_calm_need;  /* ... for this many periods */
-  uint32_t align_still_need; /* ... or from the start for this many */
-  uint32_t align_n_timeout;  /* not settled after this many periods: position fault */
-
-  /* the held start (start_mode 1, state align; drive_hold.c) */
-  struct {
-    uint8_t phase;           /* DRIVE_HOLD_* */
-    uint16_t n;              /* periods into the phase */
-    float theta;             /* the estimate's angle the pulses are applied along [rad] */
-    float i0;                /* the d current when a pulse began [A] */
-    float di[2];             /* the d current each pulse built, along theta and theta + pi [A] */
-    uint8_t n_pulse, n_zero; /* periods of each pulse and of the way back (drive_hold.c) */
-    dq_t v_prev;             /* the voltage asked last period, in the estimate's frame [V] */
-    bool plain;              /* the pattern without the DFC window (a pulse's clean sample) */
-  } hold;
 
   /* position */
   const pos_source_row_t *pos_src;
@@ -244,6 +226,26 @@ typedef struct drive_s {
   /* the ISR overrun check (drive_overrun.c), at the slow rate */
   uint32_t overrun_seen; /* the board's overrun count at the last slow period */
   uint32_t overrun_hist; /* bit j: overruns in the slow period j back */
+  /* the alignment's settling (drive_align; an encoder's: damped by its
+   * speed, held until the rotor has settled) */
+  uint32_t align_calm_n;     /* periods the encoder's speed has stayed below align_w_calm */
+  float align_kd;            /* the damping: angle of the current per electrical rad/s [s] */
+  float align_w_calm;        /* settled: |speed| below this [rad/s electrical] ... */
+  uint32_t align_calm_need;  /* ... for this many periods */
+  uint32_t align_still_need; /* ... or from the start for this many */
+  uint32_t align_n_timeout;  /* not settled after this many periods: position fault */
+
+  /* the held start (start_mode 1, state align; drive_hold.c) */
+  struct {
+    uint8_t phase;           /* DRIVE_HOLD_* */
+    uint16_t n;              /* periods into the phase */
+    float theta;             /* the estimate's angle the pulses are applied along [rad] */
+    float i0;                /* the d current when a pulse began [A] */
+    float di[2];             /* the d current each pulse built, along theta and theta + pi [A] */
+    uint8_t n_pulse, n_zero; /* periods of each pulse and of the way back (drive_hold.c) */
+    dq_t v_prev;             /* the voltage asked last period, in the estimate's frame [V] */
+    bool plain;              /* the pattern without the DFC window (a pulse's clean sample) */
+  } hold;
 } drive_t;
 
 /* Validates cfg, initialises everything and latches DRIVE_FAULT_WATCHDOG

@@ -83,14 +83,19 @@ static void dfvc_law_step(dfvc_law_t law, ctrl_state_t *s, const ctrl_setup_t *s
   out->torque_min = fd_maxf(d.torque_min, -su->cfg->torque_max);
   out->torque_max = fd_minf(d.torque_max, su->cfg->torque_max);
   out->fault = d.fault;
-  out->tm = (ctrl_telemetry_t){.flux = d.lambda_s,
-                               .flux_ref = d.lambda_ref,
-                               .delta = d.delta,
-                               .i_ds = d.i_ds,
-                               .i_qs = d.i_qs,
-                               .i_qs_ref = d.i_qs_ref,
-                               .torque = d.torque,
-                               .obs_err = d.obs_err};
+  /* every field written (no zero-fill call in the ISR) */
+  ctrl_telemetry_t *tm = &out->tm;
+  tm->flux = d.lambda_s;
+  tm->flux_ref = d.lambda_ref;
+  tm->delta = d.delta; /* the load-angle limit's: taken every ISR */
+  tm->lam_d = 0.0f;
+  tm->lam_q = 0.0f;
+  tm->delta_lazy = false;
+  tm->i_ds = d.i_ds;
+  tm->i_qs = d.i_qs;
+  tm->i_qs_ref = d.i_qs_ref;
+  tm->torque = d.torque;
+  tm->obs_err = d.obs_err;
 }
 
 static void db_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *in, ctrl_out_t *out) {

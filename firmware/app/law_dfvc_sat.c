@@ -71,14 +71,19 @@ static void dfvc_sat_law_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctr
   out->torque_max = fd_minf(d.r.torque_max, su->cfg->torque_max);
   out->torque_min = -out->torque_max;
   out->fault = d.fault;
-  out->tm = (ctrl_telemetry_t){.flux = d.lambda_s,
-                               .flux_ref = d.r.lambda_ref,
-                               .delta = d.delta,
-                               .i_ds = d.i_ft.d,
-                               .i_qs = d.i_ft.q,
-                               .i_qs_ref = d.r.itau_ref,
-                               .torque = d.torque,
-                               .obs_err = d.obs_err};
+  /* every field written (no zero-fill call in the ISR) */
+  ctrl_telemetry_t *tm = &out->tm;
+  tm->flux = d.lambda_s;
+  tm->flux_ref = d.r.lambda_ref;
+  tm->delta = 0.0f; /* telemetry only: its readers take it from lam_d, lam_q */
+  tm->lam_d = d.lambda_dq.d;
+  tm->lam_q = d.lambda_dq.q;
+  tm->delta_lazy = true;
+  tm->i_ds = d.i_ft.d;
+  tm->i_qs = d.i_ft.q;
+  tm->i_qs_ref = d.r.itau_ref;
+  tm->torque = d.torque;
+  tm->obs_err = d.obs_err;
 }
 
 const ctrl_law_t ctrl_law_dfvc_decoupled = {"dfvc_decoupled",   CTRL_CAP_FLUX,

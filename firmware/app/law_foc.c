@@ -97,6 +97,9 @@ static void foc_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *i
   tm->flux = sqrtf(flux.d * flux.d + flux.q * flux.q);
   tm->flux_ref = 0.0f;
   tm->delta = 0.0f;
+  tm->lam_d = 0.0f;
+  tm->lam_q = 0.0f;
+  tm->delta_lazy = false;
   tm->i_ds = 0.0f;
   tm->i_qs = 0.0f;
   tm->i_qs_ref = 0.0f;

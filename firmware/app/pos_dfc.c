@@ -257,7 +257,7 @@ static bool rls_health(pos_state_t *s, const drive_config_t *cfg) {
   for (unsigned j = 0u; j < 2u; ++j) {
     s->dfc.rls_avg[j] += POS_DFC_RLS_AVG * (r->x[j] - s->dfc.rls_avg[j]);
     const float tol = POS_DFC_RLS_BAND * fabsf(r->x[j]);
-    const float pjj = r->p[2u * j];
+    const float pjj = r->p[(size_t)2u * j];
     const float t_rls = 1.0f + r->cfg.r / pjj; /* updates; P >= p_min > 0 */
     const float go = fabsf(r->x[j] - s->dfc.rls_avg[j]) * fd_maxf(1.0f, POS_DFC_RLS_AVG * t_rls);
     ok = ok && go <= tol && 2.0f * pjj <= tol * tol;
@@ -496,15 +496,14 @@ FD_COLD static void pdfc_align(pos_state_t *s, const drive_config_t *cfg, const 
   const float now = trk_theta(s);
   const float e =
       s->dfc.e_n > 0u ? s->dfc.e_acc / (float)s->dfc.e_n + (s->dfc.e_lp - s->dfc.e_c0) : 0.0f;
+  /* the energy first (the rotor went down the potential: theta), then the
+   * speed change (the estimate moved as the torque pulled: theta) */
+  const bool e_says = e > POS_DFC_E_MIN || e < -POS_DFC_E_MIN;
+  const bool a_says = acc > POS_DFC_POL_MIN || acc < -POS_DFC_POL_MIN;
   float th;
-  if (e > POS_DFC_E_MIN) {
-    th = now; /* the rotor went down the potential: theta */
-  } else if (e < -POS_DFC_E_MIN) {
-    th = frames_wrap_pi(now + FRAMES_PI);
-  } else if (acc > POS_DFC_POL_MIN) {
-    th = now; /* the estimate moved as the torque pulled: theta */
-  } else if (acc < -POS_DFC_POL_MIN) {
-    th = frames_wrap_pi(now + FRAMES_PI); /* theta + pi */
+  if (e_says || a_says) {
+    const bool theta_right = e_says ? e > 0.0f : acc > 0.0f;
+    th = theta_right ? now : frames_wrap_pi(now + FRAMES_PI); /* theta + pi */
   } else {
     th = nearest_branch(now, theta);
   }

@@ -121,7 +121,7 @@ static void fill_row(const sil_step_t *st, double *r) {
                     tm->law_tm.flux_ref,
                     tm->law_tm.flux,
                     atan2(lq, ld),
-                    tm->law_tm.delta,
+                    ctrl_tm_delta(&tm->law_tm),
                     p->v_dc,
                     tm->duty[0],
                     tm->duty[1],

@@ -307,9 +307,10 @@ static void test_refs_online(void **st) {
 
 /* The dead-time compensation's current (i_ab_mid) is the references':
  * i_tau_ref on the tau axis and, on the flux axis, the current of the
- * reference flux along the observed flux (exact on a machine of constant
- * inductances: u . L^-1 (lambda_ref u - lambda_m d), u the observed flux's
- * direction), whatever current was measured; not the measured current,
+ * reference flux along the current model's flux (exact on a machine of
+ * constant inductances: u . L^-1 (lambda_ref u - lambda_m d), u the current
+ * model's flux direction at the measured current), whatever current was
+ * measured; not the measured current,
  * whose sign near zero fed back through the compensation (issue 23 point
  * 17, docs/faults.md). Its magnitude from two measured currents out of the
  * same state, against the hand value. */
@@ -341,7 +342,9 @@ static void test_deadtime_current_is_the_references(void **st) {
     in.i_ab = meas[k];
     dfvc_sat_step(&c2, &in, &o);
     assert_int_equal(o.fault, 0);
-    const double ud = cos((double)o.delta), uq = sin((double)o.delta);
+    /* along the current model's flux at the measured current (linear IPM) */
+    const double ld = LD * (double)o.i_dq.d + LM, lq = LQ * (double)o.i_dq.q;
+    const double ud = ld / hypot(ld, lq), uq = lq / hypot(ld, lq);
     const double ed = o.r.lambda_ref * ud - LM, eq = o.r.lambda_ref * uq;
     const double i_f = ud * ed / LD + uq * eq / LQ;
     const double want = hypot(i_f, (double)o.r.itau_ref);

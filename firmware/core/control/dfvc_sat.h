@@ -74,7 +74,8 @@ typedef struct {
   ab_t i_ab_mid;  /* the references' current over [tau+1, tau+2) (dead-time comp.) [A] */
   dq_t i_dq;      /* rotor-frame current at tau [A] */
   float lambda_s; /* observed flux amplitude [Vs] */
-  float delta;    /* observed load angle [rad] */
+  dq_t lambda_dq; /* observed flux in the rotor frame [Vs]: the load angle's (telemetry: its
+                     readers take the angle, not the ISR) */
   dq_t i_ft;      /* (i_f, i_tau) at tau [A] */
   float torque;   /* 3/2 p lambda_hat i_tau [N m] */
   float obs_err;  /* |lambda_hat - lambda^i| [Vs] */

@@ -121,6 +121,15 @@ static rls_ab_cfg_t rls_cfg_of(const drive_config_t *cfg) {
  * angle within 0.3 rad, load within 0.3 N m (1 sigma). */
 static const float kf_p0[3] = {900.0f, 0.09f, 0.09f};
 
+#define POS_DFC_P_MAX 0.45f /* |b/a| the IVD is given at most (Theorem 1: < 1/2) */
+/* The IVD's a, b: the RLS's within the guards (header). */
+static void rls_guarded(const rls_ab_t *r, const drive_config_t *cfg, dfc_cfg_t *dc) {
+  const float a0 = fabsf(cfg->dfc_a);
+  const float am = fd_clampf(fabsf(r->x[0]), 0.25f * a0, 4.0f * a0);
+  dc->a = cfg->dfc_a < 0.0f ? -am : am;
+  dc->b = fd_clampf(r->x[1], -POS_DFC_P_MAX * am, POS_DFC_P_MAX * am);
+}
+
 static void pol_reset(pos_state_t *s) {
   s->dfc.pol_acc = 0.0f;
   s->dfc.w_prev = 0.0f;
@@ -147,6 +156,9 @@ FD_COLD static void pdfc_init(pos_state_t *s, const drive_config_t *cfg) {
   s->dfc.warm2 = 1.0f;
   s->dfc.miss = 0u;
   s->dfc.dc = cfg_of(cfg);
+  if (s->dfc.rls_on) {
+    rls_guarded(&s->dfc.rls, cfg, &s->dfc.dc); /* the RLS's start, guarded */
+  }
   dfc_signals_reset(&s->dfc.sig);
   s->dfc.started = false;
   s->dfc.t = 0.0f;
@@ -192,20 +204,6 @@ static void trk_reset(pos_state_t *s, float theta, float omega) {
   }
 }
 
-#define POS_DFC_P_MAX 0.45f /* |b/a| the IVD is given at most (Theorem 1: < 1/2) */
-/* The IVD's a, b: the RLS's within the guards (header). */
-static void rls_guarded(const rls_ab_t *r, const drive_config_t *cfg, dfc_cfg_t *dc) {
-  const float a0 = fabsf(cfg->dfc_a);
-  const float am = fd_clampf(fabsf(r->x[0]), 0.25f * a0, 4.0f * a0);
-  dc->a = cfg->dfc_a < 0.0f ? -am : am;
-  dc->b = fd_clampf(r->x[1], -POS_DFC_P_MAX * am, POS_DFC_P_MAX * am);
-}
-
-/* The RLS of a, b (4.51)-(4.57) on this vector at the filter's predicted
- * angle, and the IVD's a, b from it, within the guards (header). One
- * update per refresh of the whole vector (when component a is the newest:
- * every third period, 5.3 kHz, the thesis's DFC rate): successive updates
- * then share no sample, as the RLS's independent noise assumes. */
 /* (2|p|)^2n: the warm-started IVD's n iterations contract the
  * prediction's error of 2theta by (2|p|)^n (Theorem 1, (3.81)); its
  * square scales the prediction's variance into the measurement's
@@ -219,6 +217,11 @@ static void warm_gain(pos_state_t *s) {
   s->dfc.warm2 = c * c;
 }
 
+/* The RLS of a, b (4.51)-(4.57) on this vector at the filter's predicted
+ * angle, and the IVD's a, b from it, within the guards (header). One
+ * update per refresh of the whole vector (when component a is the newest:
+ * every third period, 5.3 kHz, the thesis's DFC rate): successive updates
+ * then share no sample, as the RLS's independent noise assumes. */
 static bool rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v, bool fresh,
                      const sincos_t *u /* the prediction, used once aligned */) {
   rls_ab_t *r = &s->dfc.rls;
@@ -228,8 +231,8 @@ static bool rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t 
     r->cfg = rls_cfg_of(cfg); /* the live tuning, for this update and rls_health */
     upd = rls_ab_update(r, v->al, v->be, u->c, u->s, v->k);
   }
-  rls_guarded(r, cfg, &s->dfc.dc);
-  if (upd) {
+  if (upd) { /* the IVD's a, b move only here (pdfc_update keeps them) */
+    rls_guarded(r, cfg, &s->dfc.dc);
     warm_gain(s);
   }
   return upd;
@@ -369,7 +372,12 @@ static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sam
   kf_mech_t *kf = &s->dfc.kf;
   const bool kalman = s->dfc.track != TRACK_PLL;
   /* the live parameters (b, iterations, phase shifts) in force */
+  const float rls_a = s->dfc.dc.a, rls_b = s->dfc.dc.b;
   s->dfc.dc = cfg_of(cfg);
+  if (s->dfc.rls_on) { /* the RLS's a, b, guarded at its updates (rls_step) */
+    s->dfc.dc.a = rls_a;
+    s->dfc.dc.b = rls_b;
+  }
   /* one period ahead: this period's edge (header); not without signals
    * for POS_DFC_COAST periods (gates off: the state is held, not run away
    * on a stale torque and load) */
@@ -425,9 +433,6 @@ static void pdfc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sam
       s->dfc.trace[1] = s2;
       ok = dfc_ivd_from(&s->dfc.dc, &v, in->i_q, &c2, &s2, s->dfc.trace);
     } else {
-      if (s->dfc.rls_on) {
-        (void)rls_step(s, cfg, &v, fresh, NULL); /* the guarded a, b only */
-      }
       ok = dfc_vector2(&s->dfc.dc, s->dfc.sig.g, &v, in->i_q, &c2, &s2, s->dfc.trace);
     }
   }

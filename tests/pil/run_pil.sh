@@ -6,8 +6,8 @@
 # every ISR of both (--isrs all: the whole flux-weakening ramp, current
 # limit, voltage limit and MTPV included). Outputs must agree with this host
 # build's within the stated tolerance; the DB-DFVC worst case must stay
-# below 3000 instructions (measured 2781, whole ramp) and at or below 50 %
-# of the 10625-cycle budget in estimated Cortex-M4 cycles (measured 45.0 %;
+# below 3000 instructions (measured 2786, whole ramp) and at or below 50 %
+# of the 10625-cycle budget in estimated Cortex-M4 cycles (measured 45.1 %;
 # why 50 %: docs/pil.md, "Scenarios and checks"). Prints the report and writes its
 # markdown section to BUILD_DIR/benchmarks.md.
 # Usage: run_pil.sh SRC_DIR BUILD_DIR PYTHON FLUXDRIVE_SIL
@@ -33,8 +33,8 @@ export PYTHONPATH="$src/tools/src${PYTHONPATH:+:$PYTHONPATH}"
   --markdown "$build/benchmarks-map.md"
 # the decoupled DFVC of Varatharajan 2022 on the same map through MTPA,
 # flux weakening and the MTPV limit: agreement, and the issue's target of
-# fewer than 2500 instructions per ISR on average (measured 2489, worst
-# 2795: docs/benchmarks.md, "Decoupled DFVC")
+# fewer than 2500 instructions per ISR on average (measured 2461, worst
+# 2767: docs/benchmarks.md, "Decoupled DFVC")
 "$python" -m fluxdrive pil "$src/sil/scenarios/pil_dfvc_decoupled.json" --law dfvc_decoupled \
   --isrs all --check-mean 2500 --sil "$sil" --elf "$build/cross/pil/fluxdrive-pil.elf" \
   --out "$build/work" --markdown "$build/benchmarks-decoupled.md"
@@ -52,7 +52,7 @@ export PYTHONPATH="$src/tools/src${PYTHONPATH:+:$PYTHONPATH}"
 # standstill to 500 rpm: agreement, the issue's goals per call (KF: predict
 # + update <= 360, RLS <= 220; measured 158 and 146) and for the whole ISR
 # with the core's trigonometry on the STM32G474's CORDIC co-processor
-# (< 3000; measured 3125, over it: docs/benchmarks.md, "Sensorless: Kalman filter,
+# (< 3000; measured 2970: docs/benchmarks.md, "Sensorless: Kalman filter,
 # EKF, RLS"); then the EKF (<= 790; measured 251)
 "$python" -m fluxdrive pil "$src/sil/scenarios/pil_ivd_kf_rls.json" --law foc --isrs all \
   --functions --check-call kf_mech_predict=100 --check-call kf_mech_update=260 \

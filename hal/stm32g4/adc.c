@@ -8,10 +8,11 @@
  * single-ended), enable (21.4.9: ADRDY), injected group (21.4.21: JSQR with
  * JEXTSEL = TIM1_TRGO, JEXTEN = rising edge; JQDIS = 1, queue disabled).
  * The PWM-period interrupt is the end of the later of the two injected
- * sequences: ADC1 and ADC2 share one interrupt line (ADC1_2, RM0440 table
- * 97) and each raises it with its own JEOS (JEOSIE on every ADC in use);
- * the entry of the first end notes it and returns, the entry of the second
- * runs the period. No wait, whichever sequence is longer.
+ * sequences: ADC1 and ADC2 share one interrupt line (ADC1_2, vector 18,
+ * RM0440 section 16.3) and each raises it with its own JEOS (JEOSIE on
+ * every ADC in use); the entry of the first end notes it and returns, the
+ * entry of the second runs the period. No wait, whichever sequence is
+ * longer.
  * OPAMP PGA (RM0440 section 25.3.5) for boards that amplify the shunt
  * signal inside the MCU.
  */

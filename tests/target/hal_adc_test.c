@@ -5,8 +5,9 @@
  * static structs before adc.c is included. Built once per board
  * (tests/target/extra.cmake defines FD_BOARD_*).
  *
- * What is proven (RM0440 section 21.4.21 and 21.6.2, ADC_ISR / ADC_IER;
- * the two ADCs share the ADC1_2 line, RM0440 table 97): hal_adc_start arms
+ * What is proven (RM0440 section 21: the injected group, ADC_ISR's rc_w1
+ * flags, ADC_IER; the two ADCs share the ADC1_2 line, vector 18 of the
+ * vector table, section 16.3): hal_adc_start arms
  * the injected end-of-sequence interrupt (JEOSIE) and the conversions
  * (JADSTART) of every ADC with an injected sequence and enables IRQ 18 at
  * the highest priority; ADC1_2_IRQHandler runs the registered period body

@@ -97,7 +97,6 @@ FO_INLINE void fo_angles(flux_observer_t *o, float theta_r, float omega_r,
                          flux_observer_out_t *out) {
   const flux_observer_cfg_t *c = &o->cfg;
   out->theta_s = fd_atan2f(out->sc_s.s, out->sc_s.c);
-  out->theta_s_next = fd_atan2f(out->sc_s_next.s, out->sc_s_next.c);
   /* flux-frame speed: filtered derivative of theta_s */
   if (!o->angles_started) {
     o->omega_s = fd_isfinite(omega_r) ? omega_r : 0.0f;
@@ -129,7 +128,6 @@ void flux_observer_update_cm(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, ab
   fo_core(o, i, i_next, v, lcm, out);
   /* the angles: flux_observer_angles() */
   out->theta_s = 0.0f;
-  out->theta_s_next = 0.0f;
   out->omega_s = 0.0f;
   out->delta = 0.0f;
 }

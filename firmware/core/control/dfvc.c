@@ -11,7 +11,7 @@
 #define DFVC_2PI 6.28318530717959f
 #define DFVC_DEG 0.0174532925199433f
 
-void dfvc_cfg_defaults(dfvc_cfg_t *cfg, const machine_t *machine) {
+FD_COLD void dfvc_cfg_defaults(dfvc_cfg_t *cfg, const machine_t *machine) {
   memset(cfg, 0, sizeof(*cfg));
   cfg->machine = machine;
   cfg->ts = 62.5e-6f; /* Rubino 2020, section IV: 16 kHz */

@@ -17,7 +17,7 @@ static int dfvc_refs_pos(float x) {
   return fd_isfinite(x) && x > 0.0f;
 }
 
-int dfvc_refs_init(dfvc_refs_t *r, const dfvc_refs_cfg_t *cfg) {
+FD_COLD int dfvc_refs_init(dfvc_refs_t *r, const dfvc_refs_cfg_t *cfg) {
   memset(r, 0, sizeof(*r));
   const dfvc_refs_cfg_t *c = cfg;
   if (!(c->machine != NULL && dfvc_refs_pos(c->machine->lambda_m) && dfvc_refs_pos(c->i_max) &&

@@ -10,7 +10,7 @@
 #include "math/fast_trig.h"
 #include "math/fd_math.h"
 
-/* The integrator and its angles inlined into each entry point (as calls
+/* The integrator, its angles and the polar form inlined into each entry point (as calls
  * they cost the SPM laws 43 instructions a period, PIL). */
 #if defined(__GNUC__)
 #define FO_INLINE static inline __attribute__((always_inline))
@@ -20,7 +20,7 @@
 
 /* Amplitude and unit vector of a flux vector; a vanishing vector gets the
  * identity direction (theta = 0). */
-static float flux_observer_polar(ab_t x, sincos_t *sc) {
+FO_INLINE float flux_observer_polar(ab_t x, sincos_t *sc) {
   const float a = sqrtf(x.alpha * x.alpha + x.beta * x.beta);
   if (a > 1e-9f) {
     sc->c = x.alpha / a;

@@ -23,7 +23,7 @@ void spm_discrete_reset(spm_discrete_t *m) {
   m->b_ab = m->one_minus_k / m->rs;
 }
 
-int spm_discrete_init(spm_discrete_t *m, float rs, float ls, float ts) {
+FD_COLD int spm_discrete_init(spm_discrete_t *m, float rs, float ls, float ts) {
   memset(m, 0, sizeof(*m));
   if (!spm_discrete_valid(rs) || !spm_discrete_valid(ls) || !spm_discrete_valid(ts)) {
     return -1;

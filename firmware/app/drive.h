@@ -44,21 +44,18 @@
 #include "control/speed_ctrl.h"
 #include "ctrl.h"
 #include "drive_config.h"
-#include "drive_phase_check.h"
 #include "hal.h"
 #include "model/machine.h"
 #include "pos_source.h"
-
-/* Loss-of-control conditions (drive_telemetry_t.lc_cause). */
-enum {
-  DRIVE_LC_CURRENT = 1u << 0,  /* |i| above lc_current * i_max */
-  DRIVE_LC_DELTA = 1u << 1,    /* |load angle| beyond delta_max + lc_delta */
-  DRIVE_LC_TORQUE = 1u << 2,   /* torque off its (deliverable) reference */
-  DRIVE_LC_FLUX = 1u << 3,     /* flux off its reference */
-  DRIVE_LC_OBSERVER = 1u << 4, /* observer flux off the current model */
-  DRIVE_LC_RUNAWAY = 1u << 5   /* speed running away against the speed loop's torque */
-};
-#define DRIVE_LC_COUNT 5 /* the ISR's own conditions; the run-away is the speed loop's */
+/* the protections, each an owned part (docs/architecture.md, "Adding a
+ * protection"); lc_monitor.h defines the DRIVE_LC_* causes */
+#include "protect/drive_phase_check.h"
+#include "protect/drive_pos_check.h"
+#include "protect/drive_safe.h"
+#include "protect/isum.h"
+#include "protect/lc_monitor.h"
+#include "protect/overrun.h"
+#include "protect/runaway.h"
 
 /* Low-pass of the applied voltage for the main loop's voltage balance
  * (drive_telemetry_t.v_ab_filt): the share of each ISR's voltage. */
@@ -112,18 +109,6 @@ typedef struct {
   uint32_t fault_total;                    /* drive_request_fault() calls, all bits */
 } drive_cmd_t;
 
-/* The safe state while the gates do not modulate (idle, fault): all
- * switches off, or the active short circuit (drive_safe.c). ISR-owned. */
-typedef struct {
-  bool decide;     /* the gates just left modulation: choose at this ISR */
-  bool asc;        /* active short circuit engaged */
-  float w_i;       /* electrical speed from the current vector's rotation [rad/s] */
-  float i_prev[2]; /* the previous current vector (alpha, beta) [A] */
-  uint32_t n;      /* periods since the short began */
-  uint32_t n_low;  /* consecutive periods below the exit speed */
-  uint32_t n_high; /* consecutive periods above the entry speed (gates off) */
-} drive_safe_t;
-
 typedef struct drive_s {
   /* ===== owned by the ISR ===== */
   const hal_caps_t *caps;
@@ -162,11 +147,7 @@ typedef struct drive_s {
   bool speed_active;
   float speed_torque;                       /* torque reference from the speed loop [N m] */
   float torque_min_avail, torque_max_avail; /* what the law can deliver now */
-  uint32_t lc_n[DRIVE_LC_COUNT];            /* periods each condition has held */
-  uint32_t ra_n;                            /* speed-loop periods the run-away condition held */
-  float ra_w0, ra_w1; /* the speed's sums over the window's first and last quarter [rad/s] */
-  float torque_scale, flux_scale; /* torque and flux amplitude on MTPA at i_max */
-  float lc_n_fast, lc_n_track;    /* lc_time, lc_track_time in periods */
+  protect_lc_t lc;                          /* the loss-of-control monitor (every run period) */
   float inv_pole_pairs;
   float v_lin;            /* linear voltage range now [V] */
   float duty_lo, duty_hi; /* duty range: the board's, narrowed by a DFC window */
@@ -213,19 +194,18 @@ typedef struct drive_s {
   drive_law_t law_refused;   /* a law whose switch the ISR refused (DRIVE_LAW_COUNT: none) */
   uint32_t fault_total_seen; /* req.fault_total taken */
   uint32_t fault_seen[DRIVE_FAULT_COUNT];
-  int32_t i_sum_n;   /* the current-sensor check's leaky count (drive.c) */
-  drive_safe_t safe; /* the safe state with the gates not modulating (drive_safe.c) */
-  float psi_pm;      /* |flux linkage at zero current| of the model [Vs] */
-  dq_t psi0;         /* that flux linkage [Vs] */
-  float asc_psi_max; /* largest stator flux a short may trap (drive_safe_psi_max) [Vs] */
-  float i_sc;        /* |current at zero flux|: the steady short-circuit current at speed [A] */
-  int32_t pos_chk_n; /* the position plausibility check's leaky count (drive_pos_check.c) */
-  float pos_emf_res; /* its residual / tolerance at the last check (logs) */
-  dq_t pos_psi;      /* the model flux at the last check [Vs] */
-  bool pos_psi_ok;   /* ... taken in this run */
-  /* the ISR overrun check (drive_overrun.c), at the slow rate */
-  uint32_t overrun_seen; /* the board's overrun count at the last slow period */
-  uint32_t overrun_hist; /* bit j: overruns in the slow period j back */
+  /* the protections at the slow rate (drive.c's schedule table) or with
+   * the gates off, each an owned part in protect/ */
+  protect_isum_t isum;       /* the current-sum (current-sensor) check */
+  protect_ra_t ra;           /* the speed loop's run-away check */
+  protect_pos_t pos_chk;     /* the position plausibility check */
+  protect_overrun_t overrun; /* the ISR overrun check */
+  protect_safe_t safe;       /* the safe state with the gates not modulating */
+  float pos_emf_res;         /* pos_chk.res published for the logs (sil/runner/log_npy.c) */
+  float torque_scale;        /* torque on MTPA at i_max [N m] */
+  float flux_scale;          /* flux amplitude on MTPA at i_max [Vs] */
+  float psi_pm;              /* |flux linkage at zero current| of the model [Vs] */
+  dq_t psi0;                 /* that flux linkage [Vs] */
   /* the alignment's settling (drive_align; an encoder's: damped by its
    * speed, held until the rotor has settled) */
   uint32_t align_calm_n;     /* periods the encoder's speed has stayed below align_w_calm */

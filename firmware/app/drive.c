@@ -599,7 +599,7 @@ static void drive_overrun_row(drive_t *drv, bool due) {
 
 /* The position plausibility check (protect/drive_pos_check.h) on the
  * telemetry of the last period, before the source's update. */
-static FD_NOINLINE void drive_pos_check_row(drive_t *drv, bool due) {
+FD_COLD static FD_NOINLINE void drive_pos_check_row(drive_t *drv, bool due) {
   const drive_config_t *c = &drv->cfg;
   const drive_telemetry_t *tm = &drv->tm;
   const protect_pos_view_t v = {

@@ -38,6 +38,7 @@
 #define FLUXDRIVE_DRIVE_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "control/current_ctrl.h"
@@ -133,7 +134,6 @@ typedef struct drive_s {
 
   /* position */
   const pos_source_row_t *pos_src;
-  pos_state_t pos_st;
   pos_io_t pos;   /* the source's estimate (out), and its input (in): the last run
                      period's q current and torque (0 from a start) */
   float omega_m;  /* mechanical speed (source, per ISR) [rad/s] */
@@ -141,7 +141,6 @@ typedef struct drive_s {
   uint32_t rate_n;
 
   /* control */
-  ctrl_t ctrl;
   ab_t v_applied;     /* voltage applied over the period ending at this sample */
   speed_ctrl_t speed; /* run every slow_div ISRs */
   bool speed_active;
@@ -156,6 +155,12 @@ typedef struct drive_s {
   bool gated;             /* the position source measures through the DFC window */
   float win_m[3];         /* the window pattern in force: phase moments (dfc_window.h) */
   float win_k;            /* Ts / L of their current correction [s/H] */
+
+  /* the per-period parts the code reaches through a pointer (after the
+   * per-period scalars: they do not push those beyond the short load
+   * offsets: the asserts after the type) */
+  ctrl_t ctrl;        /* the control law in force and its state */
+  pos_state_t pos_st; /* the position source's state */
 
   /* the parameter set in force and its machine (after the per-period
    * state: a parameter added to the table does not move that state's
@@ -227,6 +232,31 @@ typedef struct drive_s {
     bool plain;              /* the pattern without the DFC window (a pulse's clean sample) */
   } hold;
 } drive_t;
+
+/* The layout rules the ISR's instruction counts depend on (docs/pil.md),
+ * on a 32-bit target (the Cortex-M; a host's pointers make it larger):
+ *  - the per-period scalars, up to win_k, within the reach of a single
+ *    VLDR/VSTR from the drive's base (8-bit word offset: 1020 bytes), so
+ *    that each float the ISR reads costs one instruction;
+ *  - the parts reached through a pointer (the law, the position source,
+ *    the parameter set in force) and the telemetry within one ADDW
+ *    (12-bit offset) of the base;
+ *  - the parameter set after the per-period state (a parameter added to
+ *    the table moves nothing the ISR reads every period), and the fields
+ *    used at the slow rate or on a command last, after the main loop's. */
+_Static_assert(sizeof(void *) != 4u || offsetof(drive_t, win_k) + sizeof(float) <= 1024u,
+               "drive_t: a per-period scalar beyond a VLDR's reach from the base");
+_Static_assert(sizeof(void *) != 4u || offsetof(drive_t, tm) + sizeof(drive_telemetry_t) <= 4095u,
+               "drive_t: the telemetry beyond an ADDW's reach from the base");
+_Static_assert(sizeof(void *) != 4u || offsetof(drive_t, cfg) <= 4095u,
+               "drive_t: the parameter set beyond an ADDW's reach from the base");
+_Static_assert(offsetof(drive_t, cfg) > offsetof(drive_t, win_k) &&
+                   offsetof(drive_t, ctrl) > offsetof(drive_t, win_k) &&
+                   offsetof(drive_t, pos_st) > offsetof(drive_t, win_k),
+               "drive_t: the parts reached through a pointer after the per-period scalars");
+_Static_assert(offsetof(drive_t, clear_seen) > offsetof(drive_t, host) &&
+                   offsetof(drive_t, hold) > offsetof(drive_t, clear_seen),
+               "drive_t: the slow-rate and command fields last");
 
 /* Validates cfg, initialises everything and latches DRIVE_FAULT_WATCHDOG
  * if the last reset was the watchdog's. 0, or -1 with *err naming the

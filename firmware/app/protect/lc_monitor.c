@@ -3,7 +3,7 @@
  */
 #include "protect/lc_monitor.h"
 
-void protect_lc_configure(protect_lc_t *p, const protect_lc_cfg_t *c) {
+FD_COLD void protect_lc_configure(protect_lc_t *p, const protect_lc_cfg_t *c) {
   const float i_lim = c->lc_current * c->i_max;
   p->i_lim2 = i_lim * i_lim;
   p->torque_tol = c->lc_track * c->torque_scale;
@@ -14,7 +14,7 @@ void protect_lc_configure(protect_lc_t *p, const protect_lc_cfg_t *c) {
   p->n_track = c->lc_track_time / c->ts;
 }
 
-void protect_lc_reset(protect_lc_t *p) {
+FD_COLD void protect_lc_reset(protect_lc_t *p) {
   for (unsigned k = 0; k < DRIVE_LC_COUNT; ++k) {
     p->n[k] = 0u;
   }

@@ -4,8 +4,9 @@
 #include "protect/overrun.h"
 
 #include "drive_enums.h"
+#include "math/fd_math.h"
 
-void protect_overrun_init(protect_overrun_t *p, uint32_t count) {
+FD_COLD void protect_overrun_init(protect_overrun_t *p, uint32_t count) {
   p->seen = count;
   p->hist = 0u;
 }

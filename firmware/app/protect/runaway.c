@@ -5,16 +5,17 @@
 
 #include <math.h>
 
+#include "math/fd_math.h"
 #include "protect/lc_monitor.h"
 
-void protect_ra_configure(protect_ra_t *p, float speed_max, float t_loop) {
+FD_COLD void protect_ra_configure(protect_ra_t *p, float speed_max, float t_loop) {
   p->floor = PROTECT_RA_FLOOR * speed_max;
   const float nf = PROTECT_RA_TIME / t_loop + 0.5f; /* periods in the window, rounded */
   p->n_win = nf >= 2.0f ? (uint32_t)nf : 1u;
   p->q = p->n_win >= 4u ? p->n_win / 4u : 1u;
 }
 
-void protect_ra_reset(protect_ra_t *p) {
+FD_COLD void protect_ra_reset(protect_ra_t *p) {
   p->n = 0u;
   p->w0 = 0.0f;
   p->w1 = 0.0f;

@@ -12,6 +12,7 @@
 #include "drive_hold.h"
 #include "drive_sync.h"
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -438,7 +439,48 @@ static FD_NOINLINE uint32_t drive_break_causes(void) {
   return f;
 }
 
+/* The checks that do not depend on the sample's values: the hardware
+ * break, and the position: usable before the gates go on, and plausible
+ * while they are. */
+static uint32_t drive_protect_rest(const drive_t *drv) {
+  uint32_t f = 0u;
+  if (hal_fault_hw_tripped()) {
+    f |= drive_break_causes();
+  }
+  const bool need = drv->gated ? drv->state == DRIVE_STATE_RUN : drive_state_enabled(drv->state);
+  if (need && (!drv->pos.out.valid ||
+               (drv->state == DRIVE_STATE_RUN && drv->pos.out.health > drv->cfg.pos_err_max))) {
+    f |= DRIVE_FAULT_POSITION;
+  }
+  return f;
+}
+
+static uint32_t drive_protect_values(const drive_t *drv, const hal_sample_t *s, const float i[3]);
+
+/* The per-period checks on the sample set. The usual period first: each
+ * comparison below is false for a NaN, and an infinity fails one of them
+ * too, so a sample that passes them all is finite, valid and trips none of
+ * the limits; anything else takes the full checks, which name the causes.
+ * What remains for the usual period is the break and the position. */
 static uint32_t drive_protect(const drive_t *drv, const hal_sample_t *s, const float i[3]) {
+  const drive_config_t *c = &drv->cfg;
+  const float v_lo = gates_on_state(drv->state) ? c->v_dc_min : -FLT_MAX;
+  const float t = c->i_trip;
+  uint32_t f = 0u;
+  if (!(s->valid && fabsf(i[0]) <= t && fabsf(i[1]) <= t && fabsf(i[2]) <= t &&
+        s->v_dc <= c->v_dc_max && s->v_dc >= v_lo && fabsf(drv->omega_m) <= c->speed_trip)) {
+    f = drive_protect_values(drv, s, i);
+    if (f == DRIVE_FAULT_SAMPLE) {
+      return f; /* nothing else is judged on a bad sample */
+    }
+  }
+  return f | drive_protect_rest(drv);
+}
+
+/* The sample's checks off the usual path (a trip, a bad sample): in flash.
+ * DRIVE_FAULT_SAMPLE alone for an invalid or non-finite sample set. */
+FD_COLD static FD_NOINLINE uint32_t drive_protect_values(const drive_t *drv, const hal_sample_t *s,
+                                                         const float i[3]) {
   const drive_config_t *c = &drv->cfg;
   if (!s->valid ||
       !(fd_isfinite(i[0]) && fd_isfinite(i[1]) && fd_isfinite(i[2]) && fd_isfinite(s->v_dc))) {
@@ -456,16 +498,6 @@ static uint32_t drive_protect(const drive_t *drv, const hal_sample_t *s, const f
   }
   if (fabsf(drv->omega_m) > c->speed_trip) {
     f |= DRIVE_FAULT_OVERSPEED;
-  }
-  if (hal_fault_hw_tripped()) {
-    f |= drive_break_causes();
-  }
-  /* the position must be usable before the gates go on, and plausible
-   * while they are */
-  const bool need = drv->gated ? drv->state == DRIVE_STATE_RUN : drive_state_enabled(drv->state);
-  if (need && (!drv->pos.out.valid ||
-               (drv->state == DRIVE_STATE_RUN && drv->pos.out.health > c->pos_err_max))) {
-    f |= DRIVE_FAULT_POSITION;
   }
   return f;
 }
@@ -526,7 +558,8 @@ static ab_t drive_write(drive_t *drv, const float duty[3], const float dtc[3], f
   /* the correction may not take a leg out of the board's range: the drive
    * asks only for what the board can do (the HAL would clamp the same) */
   float dc[3];
-  hal_pwm_t req; /* centred pulses (hal_pwm_centred), built in the same loop */
+  hal_pwm_t req;     /* centred pulses (hal_pwm_centred), built in the same loop */
+#pragma GCC unroll 3 /* -Os keeps loops: three legs straight through save their overhead */
   for (int x = 0; x < 3; ++x) {
     dc[x] = fd_clampf(duty[x] + dtc[x], drv->duty_lo, drv->duty_hi);
     req.on[x] = 0.5f - 0.5f * dc[x];
@@ -543,6 +576,7 @@ static ab_t drive_write(drive_t *drv, const float duty[3], const float dtc[3], f
   hal_pwm_t got;
   hal_pwm_write(&req, &got);
   float pole[3];
+#pragma GCC unroll 3
   for (int x = 0; x < 3; ++x) {
     const float d = got.off[x] - got.on[x];
     drv->tm.duty[x] = d;

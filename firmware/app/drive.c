@@ -709,7 +709,8 @@ static void drive_speed_row(drive_t *drv, bool due) {
 enum { DRIVE_PHASE_START, DRIVE_PHASE_MID };
 
 typedef struct {
-  const char *name; /* for docs and debuggers */
+  // cppcheck-suppress unusedStructMember
+  const char *name; /* for docs and debuggers (a row's name in a backtrace) */
   uint8_t phase;    /* DRIVE_PHASE_* */
   uint8_t divider;  /* due every divider-th slow period (1: each) */
   void (*run)(drive_t *drv, bool due);

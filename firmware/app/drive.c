@@ -25,6 +25,20 @@ static bool gates_on_state(drive_state_t s) {
   return s == DRIVE_STATE_RUN || s == DRIVE_STATE_ALIGN;
 }
 
+/* The mode in force (drive_t.mode): current mode only with a law that has
+ * it. Taken where either changes (a command block, a law's selection or
+ * initialisation), not every period. */
+FD_COLD static void drive_mode_refresh(drive_t *drv) {
+  const drive_mode_t m = drv->cmd.mode;
+  /* no law after a refused initialisation (ctrl_init): the set in force
+   * is configured again at once (take_config), or the drive not started */
+  const uint32_t caps = drv->ctrl.impl != NULL ? drv->ctrl.impl->caps : 0u;
+  drv->mode = ((unsigned)m >= (unsigned)DRIVE_MODE_COUNT ||
+               (m == DRIVE_MODE_CURRENT && (caps & CTRL_CAP_CURRENT) == 0u))
+                  ? DRIVE_MODE_TORQUE
+                  : m;
+}
+
 /* All gates off, the pattern back to the middle of the duty range (no
  * voltage when the gates come back). */
 static void drive_gates_off(const drive_t *drv) {
@@ -232,7 +246,10 @@ FD_COLD static int drive_configure(drive_t *drv, const drive_config_t *cfg, driv
   drive_machine_copy(&drv->machine, &drv->map, &m, &map);
   drive_derive(drv);
   const char *reason = "";
-  if (ctrl_init(&drv->ctrl, &drv->cfg, &drv->machine, drive_t_out(drv, cfg), law, &reason) != 0) {
+  const int law_err =
+      ctrl_init(&drv->ctrl, &drv->cfg, &drv->machine, drive_t_out(drv, cfg), law, &reason);
+  drive_mode_refresh(drv);
+  if (law_err != 0) {
     err->field = "law";
     err->reason = reason;
     return -1;
@@ -325,6 +342,7 @@ FD_COLD int drive_init(drive_t *drv, const drive_config_t *cfg, drive_config_err
   drv->state = DRIVE_STATE_IDLE;
   drv->cmd.law = cfg->law;
   drv->cmd.mode = cfg->mode;
+  drive_mode_refresh(drv);
   drv->armed = true;
   drv->tm.armed = 1u;
   drv->req.cmd = drv->cmd;
@@ -408,6 +426,7 @@ static void take_commands(drive_t *drv) {
   DRIVE_BARRIER();
   drv->cmd = drv->req.cmd;
   drv->cmd.seq = seq;
+  drive_mode_refresh(drv);
   if (drv->cmd.clear_count != drv->clear_seen) {
     drv->clear_seen = drv->cmd.clear_count;
     if (drv->state == DRIVE_STATE_FAULT) {
@@ -526,7 +545,9 @@ static void drive_monitor(drive_t *drv, const ctrl_in_t *in, const ctrl_out_t *o
  * stays exactly as it was (ctrl_select) and the refusal trips config once
  * (no retry until another law is commanded). */
 static FD_NOINLINE void drive_select_law(drive_t *drv) {
-  if (ctrl_select(&drv->ctrl, drv->cmd.law) != 0) {
+  const int refused = ctrl_select(&drv->ctrl, drv->cmd.law);
+  drive_mode_refresh(drv);
+  if (refused != 0) {
     drv->law_refused = drv->cmd.law;
     drive_trip(drv, DRIVE_FAULT_CONFIG);
   } else {
@@ -751,16 +772,6 @@ static void drive_schedule(drive_t *drv) {
   }
 }
 
-/* The mode in force: current mode only with a law that has it. */
-static drive_mode_t mode_in_force(const drive_t *drv) {
-  const drive_mode_t m = drv->cmd.mode;
-  if ((unsigned)m >= (unsigned)DRIVE_MODE_COUNT ||
-      (m == DRIVE_MODE_CURRENT && (drv->ctrl.impl->caps & CTRL_CAP_CURRENT) == 0u)) {
-    return DRIVE_MODE_TORQUE;
-  }
-  return m;
-}
-
 static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
   ctrl_in_t in;
   in.i_ab = frames_clarke((abc_t){i[0], i[1], i[2]});
@@ -769,7 +780,7 @@ static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
   in.theta_e = frames_wrap_pi(drv->pos.out.theta + drv->pos.out.omega * (s->t_i - drv->pos.out.t));
   in.omega_e = drv->pos.out.omega;
   in.v_lin = drv->v_lin;
-  in.mode = mode_in_force(drv);
+  in.mode = drv->mode;
   in.torque_ref = in.mode == DRIVE_MODE_SPEED ? drv->speed_torque : drv->cmd.torque;
   in.id_ref = drv->cmd.id;
   in.iq_ref = drv->cmd.iq;

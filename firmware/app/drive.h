@@ -121,6 +121,7 @@ typedef struct drive_s {
   bool cfg_pending;  /* a parameter set waits for the gates to go off (or
                         for the fault and the short to end) */
   bool armed;        /* an enable command posted since the last disarm (arm_mark) */
+  drive_mode_t mode; /* the mode in force: cmd.mode unless the law lacks it (drive_mode_refresh) */
 
   /* offset calibration */
   float offset[3];
@@ -156,6 +157,11 @@ typedef struct drive_s {
   float win_m[3];         /* the window pattern in force: phase moments (dfc_window.h) */
   float win_k;            /* Ts / L of their current correction [s/H] */
 
+  /* telemetry, under a sequence lock: written every period, right after
+   * the per-period scalars (its floats within a VSTR's reach too) */
+  volatile uint32_t tm_seq;
+  drive_telemetry_t tm;
+
   /* the per-period parts the code reaches through a pointer (after the
    * per-period scalars: they do not push those beyond the short load
    * offsets: the asserts after the type) */
@@ -169,10 +175,6 @@ typedef struct drive_s {
   drive_config_t cfg; /* in force */
   machine_t machine;
   flux_map_t map; /* cfg's flux map, parsed (machine.map points here) */
-
-  /* telemetry, under a sequence lock */
-  volatile uint32_t tm_seq;
-  drive_telemetry_t tm;
 
   /* ===== written by the main loop only ===== */
   struct {

@@ -1,6 +1,8 @@
 /*
- * drive.c - the drive: state machine, ISR body, protections, loss-of-control
- * monitor (drive.h).
+ * drive.c - the drive: state machine, ISR body, the per-period checks of
+ * the sample set, and the views through which the protections (owned parts
+ * in protect/) see the drive, with the slow-rate schedule that runs them
+ * (drive.h).
  *
  * idle -> offset calibration -> [align] -> run -> (fault). The ISR takes the
  * main loop's requests at its start, evaluates the protections on the

@@ -8,7 +8,8 @@
 #include "drive_enums.h"
 #include "math/fd_math.h"
 
-uint32_t protect_isum_step(protect_isum_t *p, const protect_isum_view_t *v) {
+/* In flash (FD_COLD): once per slow period, as protect_ra_step. */
+FD_COLD uint32_t protect_isum_step(protect_isum_t *p, const protect_isum_view_t *v) {
   if (!v->active) {
     p->n = 0;
     return 0u;

@@ -11,7 +11,9 @@ FD_COLD void protect_overrun_init(protect_overrun_t *p, uint32_t count) {
   p->hist = 0u;
 }
 
-uint32_t protect_overrun_window(protect_overrun_t *p, const protect_overrun_view_t *v) {
+/* In flash (FD_COLD): only while overruns are in the window (the inline
+ * step's usual case does not call it). */
+FD_COLD uint32_t protect_overrun_window(protect_overrun_t *p, const protect_overrun_view_t *v) {
   const uint32_t any = v->count != p->seen ? 1u : 0u;
   p->seen = v->count;
   const uint32_t n = v->n; /* 1..32 (parameter range) */

@@ -21,7 +21,10 @@ FD_COLD void protect_ra_reset(protect_ra_t *p) {
   p->w1 = 0.0f;
 }
 
-uint32_t protect_ra_step(protect_ra_t *p, const protect_ra_view_t *v) {
+/* In flash (FD_COLD) with the other slow-rate parts: once per speed-loop
+ * period, a few flops; the G474's CCM holds the every-period path and has
+ * no room left for these with the DFC window (hal/stm32g4/stm32g474re.ld). */
+FD_COLD uint32_t protect_ra_step(protect_ra_t *p, const protect_ra_view_t *v) {
   const float e = v->w - v->w_ref;
   const float ae = fabsf(e);
   if (!(ae > PROTECT_RA_MARGIN * fabsf(v->w_ref) + p->floor && v->torque * e < 0.0f)) {

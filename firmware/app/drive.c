@@ -39,6 +39,12 @@ FD_COLD static void drive_mode_refresh(drive_t *drv) {
                (m == DRIVE_MODE_CURRENT && (caps & CTRL_CAP_CURRENT) == 0u))
                   ? DRIVE_MODE_TORQUE
                   : m;
+  /* the loss-of-control conditions that apply with this law and mode */
+  drv->lc_checks =
+      (drv->mode != DRIVE_MODE_CURRENT ? PROTECT_LC_CHECK_TORQUE : 0u) |
+      ((caps & CTRL_CAP_FLUX) != 0u
+           ? PROTECT_LC_CHECK_FLUX | ((caps & CTRL_CAP_DELTA) != 0u ? PROTECT_LC_CHECK_DELTA : 0u)
+           : 0u);
 }
 
 /* All gates off, the pattern back to the middle of the duty range (no
@@ -526,12 +532,7 @@ FD_COLD static FD_NOINLINE uint32_t drive_protect_values(const drive_t *drv, con
 /* Loss of control (protect/lc_monitor.h): each condition must hold for its
  * time before the trip. */
 static void drive_monitor(drive_t *drv, const ctrl_in_t *in, const ctrl_out_t *out) {
-  const uint32_t caps = drv->ctrl.impl->caps;
-  const uint32_t checks =
-      (in->mode != DRIVE_MODE_CURRENT ? PROTECT_LC_CHECK_TORQUE : 0u) |
-      ((caps & CTRL_CAP_FLUX) != 0u
-           ? PROTECT_LC_CHECK_FLUX | ((caps & CTRL_CAP_DELTA) != 0u ? PROTECT_LC_CHECK_DELTA : 0u)
-           : 0u);
+  const uint32_t checks = drv->lc_checks; /* in.mode is drv->mode (drive_mode_refresh) */
   const protect_lc_view_t v = {out->i_dq.d,      out->i_dq.q,     out->tm.torque, in->torque_ref,
                                out->torque_min,  out->torque_max, out->tm.delta,  out->tm.flux,
                                out->tm.flux_ref, out->tm.obs_err, checks};

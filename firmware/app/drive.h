@@ -116,12 +116,13 @@ typedef struct drive_s {
   drive_state_t state;
   uint32_t faults;
   uint32_t isr_count;
-  drive_cmd_t cmd;   /* the commands in force (the ISR's copy of req) */
-  uint32_t cfg_seen; /* creq.seq taken */
-  bool cfg_pending;  /* a parameter set waits for the gates to go off (or
-                        for the fault and the short to end) */
-  bool armed;        /* an enable command posted since the last disarm (arm_mark) */
-  drive_mode_t mode; /* the mode in force: cmd.mode unless the law lacks it (drive_mode_refresh) */
+  drive_cmd_t cmd;    /* the commands in force (the ISR's copy of req) */
+  uint32_t cfg_seen;  /* creq.seq taken */
+  bool cfg_pending;   /* a parameter set waits for the gates to go off (or
+                         for the fault and the short to end) */
+  bool armed;         /* an enable command posted since the last disarm (arm_mark) */
+  drive_mode_t mode;  /* the mode in force: cmd.mode unless the law lacks it (drive_mode_refresh) */
+  uint32_t lc_checks; /* PROTECT_LC_CHECK_* with this law and mode (drive_mode_refresh) */
 
   /* offset calibration */
   float offset[3];

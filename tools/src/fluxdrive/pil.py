@@ -83,7 +83,9 @@ IN_SIZE = 240
 #: Blocks of the per-function share: the first pattern that a function name
 #: starts with (or equals) names its block.
 BLOCKS = [
-    ("drive (ISR body, commands, protections, offsets)", ("drive_", "hal_pwm_centred")),
+    # protect_: the protections, owned parts of the drive (firmware/app/protect)
+    ("drive (ISR body, commands, protections, offsets)", ("drive_", "protect_",
+                                                          "hal_pwm_centred")),
     ("speed loop (speed_ctrl, every slow_div ISRs)", ("speed_ctrl_",)),
     ("position source (encoder, star point, PLL)", ("enc_", "pdfc_", "nearest_branch",
                                                     "pos_source", "angle_pll_", "trk_",

@@ -282,13 +282,12 @@ FD_COLD static int drive_configure(drive_t *drv, const drive_config_t *cfg, driv
   drv->psi_pm = sqrtf(l_pm.d * l_pm.d + l_pm.q * l_pm.q);
   drv->psi0 = l_pm;
   const dq_t i_sc = machine_current(&drv->machine, (dq_t){0.0f, 0.0f});
-  /* flux_scale as it stood before this set (0 at start-up): the bisection's
-   * upper bound as the drive has always taken it (before the protections
-   * became parts, drive_safe_psi_max read drv->flux_scale before it was
-   * updated here) */
+  drv->flux_scale = sqrtf(l_rated.d * l_rated.d + l_rated.q * l_rated.q);
+  /* this set's flux scale bounds the short's bisection (the previous set's,
+   * 0 at start-up, bounded a reluctance machine's trapped flux at 0: every
+   * short refused until a second set was taken) */
   protect_safe_configure(&drv->safe, &drv->machine, drv->psi_pm,
                          sqrtf(i_sc.d * i_sc.d + i_sc.q * i_sc.q), drv->flux_scale, cfg->i_trip);
-  drv->flux_scale = sqrtf(l_rated.d * l_rated.d + l_rated.q * l_rated.q);
   drive_protect_configure(drv);
   return 0;
 }

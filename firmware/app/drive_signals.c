@@ -10,7 +10,7 @@
 #include "math/fd_math.h"
 
 #define DRIVE_SIG_GETTER(name, type, unit, value, can, scale, can_unit, doc)                       \
-  FD_COLD static double sig_##name(const void *owner) {                                                    \
+  FD_COLD static double sig_##name(const void *owner) {                                            \
     const drive_signal_src_t *s = owner;                                                           \
     return (double)(value);                                                                        \
   }

@@ -113,11 +113,8 @@ static const signal_row_t sat_signals[] = {
      sig_mtpv_angle},
 };
 
-const ctrl_law_t ctrl_law_dfvc_decoupled = {"dfvc_decoupled",
-                                            CTRL_CAP_FLUX,
-                                            dfvc_sat_check,
-                                            dfvc_sat_law_init,
-                                            dfvc_sat_law_reset,
-                                            dfvc_sat_law_step,
-                                            sat_signals,
-                                            sizeof sat_signals / sizeof sat_signals[0]};
+const ctrl_law_t ctrl_law_dfvc_decoupled = {
+    "dfvc_decoupled",   CTRL_CAP_FLUX,
+    dfvc_sat_check,     dfvc_sat_law_init,
+    dfvc_sat_law_reset, dfvc_sat_law_step,
+    sat_signals,        sizeof sat_signals / sizeof sat_signals[0]};

@@ -13,10 +13,18 @@
 
 #define DFC_STATE(owner) (&((const pos_state_t *)(owner))->dfc)
 
-FD_COLD static double sig_t(const void *o) { return (double)DFC_STATE(o)->t; }
-FD_COLD static double sig_ga(const void *o) { return (double)DFC_STATE(o)->sig.g[0]; }
-FD_COLD static double sig_gb(const void *o) { return (double)DFC_STATE(o)->sig.g[1]; }
-FD_COLD static double sig_gc(const void *o) { return (double)DFC_STATE(o)->sig.g[2]; }
+FD_COLD static double sig_t(const void *o) {
+  return (double)DFC_STATE(o)->t;
+}
+FD_COLD static double sig_ga(const void *o) {
+  return (double)DFC_STATE(o)->sig.g[0];
+}
+FD_COLD static double sig_gb(const void *o) {
+  return (double)DFC_STATE(o)->sig.g[1];
+}
+FD_COLD static double sig_gc(const void *o) {
+  return (double)DFC_STATE(o)->sig.g[2];
+}
 
 /* 2 theta after IVD step k, from its unit vector (cos, sin) in the trace */
 #define DFC_K(k)                                                                                   \
@@ -43,13 +51,15 @@ FD_COLD static double sig_rls_a(const void *o) {
 FD_COLD static double sig_rls_b(const void *o) {
   return (double)(DFC_STATE(o)->rls_on ? DFC_STATE(o)->dc.b : 0.0f);
 }
-FD_COLD static double sig_kf_r(const void *o) { return (double)DFC_STATE(o)->r; }
+FD_COLD static double sig_kf_r(const void *o) {
+  return (double)DFC_STATE(o)->r;
+}
 
 #define K_ROW(k)                                                                                   \
-  {"dfc_k" #k, SIGNAL_F32, "rad",                                                                  \
-   "2 theta_e after IVD step " #k " (k = 0: the standard DFC (3.8), or the inverse DFC; steps "    \
-   "beyond dfc_iter are stale)",                                                                   \
-   sig_k##k}
+  {                                                                                                \
+    "dfc_k" #k, SIGNAL_F32, "rad", "2 theta_e after IVD step " #k " (stale beyond dfc_iter)",      \
+        sig_k##k                                                                                   \
+  }
 
 const signal_row_t pos_dfc_signals[POS_DFC_N_SIGNALS] = {
     {"dfc_t", SIGNAL_F32, "s",
@@ -59,7 +69,8 @@ const signal_row_t pos_dfc_signals[POS_DFC_N_SIGNALS] = {
     {"dfc_ga", SIGNAL_F32, "1", "the DFC signal Gamma_a / v_dc held by the source (2.101)", sig_ga},
     {"dfc_gb", SIGNAL_F32, "1", "the DFC signal Gamma_b / v_dc", sig_gb},
     {"dfc_gc", SIGNAL_F32, "1", "the DFC signal Gamma_c / v_dc", sig_gc},
-    K_ROW(0),
+    {"dfc_k0", SIGNAL_F32, "rad",
+     "2 theta_e of the standard DFC (3.8), or of the inverse DFC (IVD step 0)", sig_k0},
     K_ROW(1),
     K_ROW(2),
     K_ROW(3),

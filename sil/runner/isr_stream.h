@@ -113,7 +113,7 @@ typedef struct {
 enum { ISR_STREAM_OUT_FIELDS(ISR_OUT_INDEX) ISR_OUT_FIELD_COUNT };
 #undef ISR_OUT_INDEX
 #define ISR_OUT_AT(n, t, m)                                                                        \
-  _Static_assert(offsetof(isr_stream_out_t, m) == 4u * (unsigned)ISR_OUT_FIELD_##n,               \
+  _Static_assert(offsetof(isr_stream_out_t, m) == 4u * (unsigned)ISR_OUT_FIELD_##n,                \
                  "isr_stream_out_t: the field of " #n);
 ISR_STREAM_OUT_FIELDS(ISR_OUT_AT)
 #undef ISR_OUT_AT

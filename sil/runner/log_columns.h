@@ -12,8 +12,8 @@
 #include "drive_signals.h"
 #include "sil_run.h"
 
-#define LOG_COLUMNS_MAX  128
-#define LOG_HOOK_MAX     32 /* signals of one law or one source */
+#define LOG_COLUMNS_MAX 128
+#define LOG_HOOK_MAX    32 /* signals of one law or one source */
 
 typedef enum { LOG_COL_SIL = 0, LOG_COL_DRIVE, LOG_COL_LAW, LOG_COL_POS } log_col_kind_t;
 

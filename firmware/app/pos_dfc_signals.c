@@ -8,6 +8,7 @@
 #include "pos_dfc_signals.h"
 
 #include <math.h>
+#include <stddef.h>
 
 #include "math/fd_math.h"
 
@@ -30,7 +31,7 @@ FD_COLD static double sig_gc(const void *o) {
 #define DFC_K(k)                                                                                   \
   FD_COLD static double sig_k##k(const void *o) {                                                  \
     const float *tr = DFC_STATE(o)->trace;                                                         \
-    return atan2((double)tr[2u * (k) + 1u], (double)tr[2u * (k)]);                                 \
+    return atan2((double)tr[(size_t)2 * (k) + 1u], (double)tr[(size_t)2 * (k)]);                   \
   }
 DFC_K(0)
 DFC_K(1)

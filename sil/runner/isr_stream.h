@@ -113,14 +113,14 @@ typedef struct {
 enum { ISR_STREAM_OUT_FIELDS(ISR_OUT_INDEX) ISR_OUT_FIELD_COUNT };
 #undef ISR_OUT_INDEX
 #define ISR_OUT_AT(n, t, m)                                                                        \
-  _Static_assert(offsetof(isr_stream_out_t, m) == 4u * (unsigned)ISR_OUT_FIELD_##n,                \
+  _Static_assert(offsetof(isr_stream_out_t, m) == sizeof(uint32_t) * (size_t)ISR_OUT_FIELD_##n,    \
                  "isr_stream_out_t: the field of " #n);
 ISR_STREAM_OUT_FIELDS(ISR_OUT_AT)
 #undef ISR_OUT_AT
 
 _Static_assert(sizeof(isr_stream_header_t) == 36, "isr_stream_header_t layout");
 _Static_assert(sizeof(isr_stream_in_t) == 240, "isr_stream_in_t layout");
-_Static_assert(sizeof(isr_stream_out_t) == 4u * (unsigned)ISR_OUT_FIELD_COUNT,
+_Static_assert(sizeof(isr_stream_out_t) == sizeof(uint32_t) * (size_t)ISR_OUT_FIELD_COUNT,
                "isr_stream_out_t layout: ISR_STREAM_OUT_FIELDS");
 _Static_assert(DRIVE_FAULT_COUNT <= ISR_STREAM_FAULT_WORDS, "fault counters");
 

@@ -88,5 +88,5 @@ FD_COLD static const char *enc_check(const drive_config_t *cfg, const char **fie
 }
 
 /* no angle at standstill: no held start */
-const pos_source_row_t pos_source_encoder = {POS_CAP_ALIGN, enc_init,  enc_reset, enc_update,
-                                             enc_align,     enc_check, NULL};
+const pos_source_row_t pos_source_encoder = {
+    POS_CAP_ALIGN, enc_init, enc_reset, enc_update, enc_align, enc_check, NULL, NULL, 0u};

@@ -105,6 +105,15 @@ FD_COLD static void align_publish(const proc_state_t *st, proc_telemetry_t *tm) 
   tm->result[2] = 0.0f;
 }
 
-const proc_row_t proc_align = {"align", PROC_ALIGN,   DRIVE_STATE_ALIGN, PROC_CAP_GATES,
-                               NULL,    align_wanted, align_init,        align_step,
-                               NULL,    align_publish};
+const proc_row_t proc_align = {
+    .name = "align",
+    .id = PROC_ALIGN,
+    .state = DRIVE_STATE_ALIGN,
+    .caps = PROC_CAP_GATES,
+    .check = NULL,
+    .wanted = align_wanted,
+    .init = align_init,
+    .step = align_step,
+    .abort = NULL,
+    .publish = align_publish,
+};

@@ -27,14 +27,14 @@
 /* Periods of each phase: the acquisition, then per pulse n_pulse + N_AVG +
  * 1 and n_zero; 39 periods in all, 2.44 ms at 16 kHz, on fabbri2022_t51
  * (n_pulse 3), up to 8 + 2 (8 + 2 + 12) = 52, 3.25 ms */
-#define HOLD_N_ACQ       8u /* zero current: three DFC components, then five updates */
-#define HOLD_N_PULSE_MIN 2u /* voltage pulse, periods (pulse_periods) */
-#define HOLD_N_PULSE_MAX 8u
-#define HOLD_N_AVG       1u   /* samples of its current averaged */
-#define HOLD_N_ZERO      10u  /* at least, the current back to zero (deadbeat) */
-#define HOLD_K_DB        0.8f /* of the deadbeat step: margin for R, L errors */
+#define PROC_HOLD_N_ACQ       8u /* zero current: three DFC components, then five updates */
+#define PROC_HOLD_N_PULSE_MIN 2u /* voltage pulse, periods (pulse_periods) */
+#define PROC_HOLD_N_PULSE_MAX 8u
+#define PROC_HOLD_N_AVG       1u   /* samples of its current averaged */
+#define PROC_HOLD_N_ZERO      10u  /* at least, the current back to zero (deadbeat) */
+#define PROC_HOLD_K_DB        0.8f /* of the deadbeat step: margin for R, L errors */
 /* the pulses' currents must differ by this fraction of their mean */
-#define HOLD_EVIDENCE_MIN 0.02f
+#define PROC_HOLD_EVIDENCE_MIN 0.02f
 
 enum { PH_ACQ = 0, PH_PULSE0, PH_ZERO0, PH_PULSE1, PH_ZERO1 };
 
@@ -42,13 +42,13 @@ enum { PH_ACQ = 0, PH_PULSE0, PH_ZERO0, PH_PULSE1, PH_ZERO1 };
  * linear R-L model reaches i_max, i(t) = v_max / R (1 - exp(-t R / Ld)),
  * but no longer than tau = Ld / R (beyond it the current is set by R, no
  * longer by the inductance that carries the evidence: on fabbri2022_t51
- * tau is 2.9 periods), within HOLD_N_PULSE_MIN .. _MAX. */
+ * tau is 2.9 periods), within PROC_HOLD_N_PULSE_MIN .. _MAX. */
 FD_COLD static unsigned pulse_periods(const drive_config_t *c, float v_max) {
   const float tau = c->ld / c->rs;
   const float r = c->i_max * c->rs / v_max;
   const float t = r < 1.0f ? fd_minf(tau, -tau * logf(1.0f - r)) : tau;
   const float n = ceilf(t / c->ts);
-  return (unsigned)fd_clampf(n, (float)HOLD_N_PULSE_MIN, (float)HOLD_N_PULSE_MAX);
+  return (unsigned)fd_clampf(n, (float)PROC_HOLD_N_PULSE_MIN, (float)PROC_HOLD_N_PULSE_MAX);
 }
 
 /* Wanted with start_mode 1; able only with a source that has an angle at
@@ -79,21 +79,22 @@ FD_COLD static void hold_init(proc_state_t *st, const proc_setup_t *su) {
   h->di[1] = 0.0f;
   h->v_prev = (dq_t){0.0f, 0.0f};
   h->plain = false;
-  h->n_pulse = HOLD_N_PULSE_MIN;
-  h->n_zero = HOLD_N_ZERO;
+  h->n_pulse = PROC_HOLD_N_PULSE_MIN;
+  h->n_zero = PROC_HOLD_N_ZERO;
 }
 
 /* The current back to zero in the estimate's frame, deadbeat on the
  * controller's R-L model with the one-period delay: the current the last
  * voltage will have built by the next sample (v_prev), then the voltage
- * that takes HOLD_K_DB of it away over the period after. */
+ * that takes PROC_HOLD_K_DB of it away over the period after. */
 FD_COLD static ab_t zero_current(proc_hold_t *h, const drive_config_t *c, ab_t i_ab, float v_max) {
   const sincos_t sc = frames_sincos(h->theta);
   const dq_t i = frames_park(i_ab, sc);
   const dq_t vp = h->v_prev;
   const dq_t ip = {i.d + (vp.d - c->rs * i.d) * c->ts / c->ld,
                    i.q + (vp.q - c->rs * i.q) * c->ts / c->lq};
-  dq_t v = {(c->rs - HOLD_K_DB * c->ld / c->ts) * ip.d, (c->rs - HOLD_K_DB * c->lq / c->ts) * ip.q};
+  dq_t v = {(c->rs - PROC_HOLD_K_DB * c->ld / c->ts) * ip.d,
+            (c->rs - PROC_HOLD_K_DB * c->lq / c->ts) * ip.q};
   const float m = sqrtf(v.d * v.d + v.q * v.q);
   if (m > v_max) {
     v.d *= v_max / m;
@@ -104,8 +105,8 @@ FD_COLD static ab_t zero_current(proc_hold_t *h, const drive_config_t *c, ab_t i
 }
 
 /* A pulse of sign sgn along the estimate: n = 0 .. N-1 the voltage, then
- * none for HOLD_N_AVG periods; the current it built is the mean of the
- * samples n = N + 1 .. N + HOLD_N_AVG (the voltage written in a period acts
+ * none for PROC_HOLD_N_AVG periods; the current it built is the mean of the
+ * samples n = N + 1 .. N + PROC_HOLD_N_AVG (the voltage written in a period acts
  * over the next; hal.h). The pattern is written without the DFC window
  * meanwhile (plain): a window shifts the valley sample by some 0.1 .. 0.3
  * A, by the leg and the direction, which its correction
@@ -124,7 +125,7 @@ FD_COLD static bool pulse(proc_hold_t *h, ab_t i_ab, float v_max, float sgn, uns
     h->i0 = i_d; /* before the pulse acts, the first sample after a plain period */
   }
   const unsigned np = h->n_pulse;
-  h->plain = n < np + HOLD_N_AVG;
+  h->plain = n < np + PROC_HOLD_N_AVG;
   if (n < np) {
     const float v = sgn * v_max;
     *v_ab = (ab_t){v * sc.c, v * sc.s};
@@ -136,8 +137,8 @@ FD_COLD static bool pulse(proc_hold_t *h, ab_t i_ab, float v_max, float sgn, uns
   if (n < np + 1u) {
     return false;
   }
-  h->di[k] += sgn * (i_d - h->i0) * (1.0f / (float)HOLD_N_AVG);
-  return n >= np + HOLD_N_AVG;
+  h->di[k] += sgn * (i_d - h->i0) * (1.0f / (float)PROC_HOLD_N_AVG);
+  return n >= np + PROC_HOLD_N_AVG;
 }
 
 /* One period: PROC_RUNNING, PROC_DONE (the source takes the north pole's
@@ -155,14 +156,14 @@ FD_COLD static int hold_step(proc_state_t *st, const proc_setup_t *su, const pro
   int r = PROC_RUNNING;
   h->n_all++;
   if (ph == PH_ACQ) {
-    if (h->n >= HOLD_N_ACQ && in->pos->valid) {
+    if (h->n >= PROC_HOLD_N_ACQ && in->pos->valid) {
       h->theta = in->pos->theta;
       const unsigned np = pulse_periods(su->cfg, v_max);
       h->n_pulse = (uint8_t)np;
       /* the way back takes as long as the way up at the voltage limit */
-      h->n_zero = (uint8_t)(np + 4u > HOLD_N_ZERO ? np + 4u : HOLD_N_ZERO);
+      h->n_zero = (uint8_t)(np + 4u > PROC_HOLD_N_ZERO ? np + 4u : PROC_HOLD_N_ZERO);
       next = true;
-    } else if (h->n >= 4u * HOLD_N_ACQ) {
+    } else if (h->n >= 4u * PROC_HOLD_N_ACQ) {
       r = PROC_FAILED; /* no angle at standstill */
     }
   } else if (ph == PH_PULSE0 || ph == PH_PULSE1) {
@@ -178,7 +179,7 @@ FD_COLD static int hold_step(proc_state_t *st, const proc_setup_t *su, const pro
         /* the pulse along the north pole built the larger current */
         const float d0 = h->di[0], d1 = h->di[1];
         const float mean = 0.5f * (d0 + d1);
-        if (!(mean > 0.0f) || !(fabsf(d0 - d1) > HOLD_EVIDENCE_MIN * mean)) {
+        if (!(mean > 0.0f) || !(fabsf(d0 - d1) > PROC_HOLD_EVIDENCE_MIN * mean)) {
           r = PROC_FAILED; /* no saturation to show the pole */
         } else {
           h->theta_out = d0 > d1 ? h->theta : frames_wrap_pi(h->theta + FRAMES_PI);
@@ -217,6 +218,15 @@ FD_COLD static void hold_publish(const proc_state_t *st, proc_telemetry_t *tm) {
   tm->result[2] = mean > 0.0f ? (h->di[0] - h->di[1]) / mean : 0.0f;
 }
 
-const proc_row_t proc_hold = {"hold",     PROC_HOLD,   DRIVE_STATE_ALIGN, PROC_CAP_GATES,
-                              hold_check, hold_wanted, hold_init,         hold_step,
-                              hold_abort, hold_publish};
+const proc_row_t proc_hold = {
+    .name = "hold",
+    .id = PROC_HOLD,
+    .state = DRIVE_STATE_ALIGN,
+    .caps = PROC_CAP_GATES,
+    .check = hold_check,
+    .wanted = hold_wanted,
+    .init = hold_init,
+    .step = hold_step,
+    .abort = hold_abort,
+    .publish = hold_publish,
+};

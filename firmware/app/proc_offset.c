@@ -52,5 +52,14 @@ FD_COLD static void offset_publish(const proc_state_t *st, proc_telemetry_t *tm)
 }
 
 const proc_row_t proc_offset = {
-    "offset",    PROC_OFFSET, DRIVE_STATE_OFFSET_CAL, 0u, NULL, NULL, offset_init,
-    offset_step, NULL,        offset_publish};
+    .name = "offset",
+    .id = PROC_OFFSET,
+    .state = DRIVE_STATE_OFFSET_CAL,
+    .caps = 0u,
+    .check = NULL,
+    .wanted = NULL,
+    .init = offset_init,
+    .step = offset_step,
+    .abort = NULL,
+    .publish = offset_publish,
+};

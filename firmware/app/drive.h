@@ -141,6 +141,15 @@ typedef struct drive_s {
   /* the current offsets in force (the offset procedure's, proc_offset.c) */
   float offset[3];
 
+  /* the procedure in force (proc.h: offset calibration, alignment, held
+   * start), its place in the start sequence and its state: 84 B on the
+   * Cortex-M, what the offset calibration's and the alignment's fields took
+   * here before, so the periodic path's fields after them keep their
+   * offsets (and the PIL counts; a larger union moves them) */
+  const proc_row_t *proc; /* NULL: none (idle, run, fault) */
+  uint32_t proc_k;        /* its index in proc_start_sequence() */
+  proc_state_t proc_st;
+
   /* position */
   const pos_source_row_t *pos_src;
   pos_state_t pos_st;
@@ -223,11 +232,6 @@ typedef struct drive_s {
   /* the ISR overrun check (drive_overrun.c), at the slow rate */
   uint32_t overrun_seen; /* the board's overrun count at the last slow period */
   uint32_t overrun_hist; /* bit j: overruns in the slow period j back */
-  /* the procedure in force (proc.h: offset calibration, alignment, held
-   * start), its place in the start sequence and its state */
-  const proc_row_t *proc; /* NULL: none (idle, run, fault) */
-  uint32_t proc_k;        /* its index in proc_start_sequence() */
-  proc_state_t proc_st;
 } drive_t;
 
 /* Validates cfg, initialises everything and latches DRIVE_FAULT_WATCHDOG

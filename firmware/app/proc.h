@@ -124,12 +124,14 @@ typedef struct {
   uint32_t n_timeout;  /* not settled after this many periods: position fault */
 } proc_align_timing_t;
 
+/* The alignment's state: its timing (proc_align_timing) is derived from
+ * the parameter set at each step, not kept (a start's few ms in flash; the
+ * union stays at the size the drive's layout keeps, drive.h). */
 typedef struct {
   current_ctrl_t cc; /* the d current's loop (alpha-beta frame at theta = 0) */
-  proc_align_timing_t tmg;
-  uint32_t n;      /* periods since it began */
-  uint32_t calm_n; /* periods the encoder's speed has stayed below w_calm */
-  float phi;       /* the current's angle last period [rad] */
+  uint32_t n;        /* periods since it began */
+  uint32_t calm_n;   /* periods the encoder's speed has stayed below w_calm */
+  float phi;         /* the current's angle last period [rad] */
 } proc_align_t;
 
 typedef struct {

@@ -60,7 +60,6 @@ FD_COLD static void align_init(proc_state_t *st, const proc_setup_t *su) {
   proc_align_t *a = &st->align;
   const current_ctrl_cfg_t acfg = {su->machine, su->cfg->current_bw, su->cfg->ts};
   current_ctrl_init(&a->cc, &acfg);
-  proc_align_timing(su->cfg, &a->tmg);
   a->n = 0u;
   a->calm_n = 0u;
   a->phi = 0.0f;
@@ -70,26 +69,28 @@ FD_COLD static int align_step(proc_state_t *st, const proc_setup_t *su, const pr
                               proc_out_t *out) {
   proc_align_t *a = &st->align;
   const drive_config_t *c = su->cfg;
-  const bool enc = !su->gated && a->tmg.kd > 0.0f;
+  proc_align_timing_t tmg;
+  proc_align_timing(c, &tmg);
+  const bool enc = !su->gated && tmg.kd > 0.0f;
   const float w = in->pos->omega;
-  const float phi = enc ? fd_clampf(-a->tmg.kd * w, -0.25f * FRAMES_PI, 0.25f * FRAMES_PI) : 0.0f;
+  const float phi = enc ? fd_clampf(-tmg.kd * w, -0.25f * FRAMES_PI, 0.25f * FRAMES_PI) : 0.0f;
   a->phi = phi;
   const sincos_t sc = frames_sincos(phi);
   const dq_t v =
       current_ctrl_update(&a->cc, (dq_t){c->align_current * sc.c, c->align_current * sc.s},
                           (dq_t){in->i_ab.alpha, in->i_ab.beta}, 0.0f, in->v_max);
   *out = (proc_out_t){{v.d, v.q}, true, false, 0u};
-  a->calm_n = fabsf(w) < a->tmg.w_calm ? a->calm_n + 1u : 0u;
+  a->calm_n = fabsf(w) < tmg.w_calm ? a->calm_n + 1u : 0u;
   const uint32_t n = ++a->n;
   /* calm for 2 / w_n, or from the start on for 1 / w_n (a rotor that never
    * moved: started at the axis, or held) */
   const bool settled =
-      !enc || a->calm_n >= a->tmg.calm_need || (a->calm_n == n && n >= a->tmg.still_need);
+      !enc || a->calm_n >= tmg.calm_need || (a->calm_n == n && n >= tmg.still_need);
   if ((float)n * c->ts >= c->align_time && settled) {
     su->pos_src->align(su->pos_st, c, in->s, phi);
     return PROC_DONE;
   }
-  if (enc && a->n >= a->tmg.n_timeout) {
+  if (enc && a->n >= tmg.n_timeout) {
     out->fault = DRIVE_FAULT_POSITION; /* the rotor did not settle */
     return PROC_FAILED;
   }

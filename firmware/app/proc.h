@@ -4,9 +4,10 @@
  * beside the law table (ctrl.h), as ODrive makes its calibrations control
  * laws (PhaseControlLaw, ResistanceMeasurementControlLaw).
  *
- * A procedure is a row {name, id, state shown, capabilities, check, init,
- * step, abort, publish} (proc_row_t): check says whether a parameter set
- * and position source can run it (the main loop's validation), init starts
+ * A procedure is a row {name, id, state shown, capabilities, check, wanted,
+ * init, step, abort, publish} (proc_row_t): check says whether a parameter
+ * set and position source can run it (the main loop's validation), wanted
+ * whether the start wants it with that set, init starts
  * it, step runs one PWM period in the ISR and returns running, done or
  * failed (with the fault bits), abort stops it (disable, trip), publish
  * writes its progress and results into the procedure telemetry. Its state
@@ -23,12 +24,13 @@
  * position source's reference), when its step returns PROC_DONE.
  *
  * The start sequence (proc_start_sequence) is a list of ids: the drive runs
- * each row that applies (its check passes and it is wanted: proc_wanted)
- * in turn, then the law. Adding a procedure: its module (proc_<name>.c with
- * its row), its state in proc_state_t, one line in PROC_LIST
- * (docs/architecture.md, "Adding a procedure"). Every function of a
- * procedure is FD_COLD (flash on the board): the ISR runs it only while it
- * is in force, never in the run.
+ * each row that applies (wanted, and its check passes: proc_applies) in
+ * turn, the gates coming on before the first that modulates, then the
+ * law; the sequence lists the gates-off procedures first. Adding a procedure: its module
+ * (proc_<name>.c with its row), its state in proc_state_t, one line in PROC_LIST and its id in the
+ * sequence if the start runs it (proc.c; docs/architecture.md, "Adding a procedure"). Every
+ * function of a procedure is FD_COLD (flash on the board): the ISR runs it only while it is in
+ * force, never in the run.
  */
 #ifndef FLUXDRIVE_PROC_H
 #define FLUXDRIVE_PROC_H

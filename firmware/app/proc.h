@@ -23,14 +23,16 @@
  * used, through its setup's sinks (the current offsets in force, the
  * position source's reference), when its step returns PROC_DONE.
  *
- * The start sequence (proc_start_sequence) is a list of ids: the drive runs
- * each row that applies (wanted, and its check passes: proc_applies) in
- * turn, the gates coming on before the first that modulates, then the
- * law; the sequence lists the gates-off procedures first. Adding a procedure: its module
- * (proc_<name>.c with its row), its state in proc_state_t, one line in PROC_LIST and its id in the
- * sequence if the start runs it (proc.c; docs/architecture.md, "Adding a procedure"). Every
- * function of a procedure is FD_COLD (flash on the board): the ISR runs it only while it is in
- * force, never in the run.
+ * The start sequence (proc_start_sequence) is a list of ids: the drive
+ * runs each row that applies (wanted, and its check passes: proc_applies)
+ * in turn, the gates coming on before the first that modulates, then the
+ * law; the sequence lists the gates-off procedures first.
+ *
+ * Adding a procedure: its module (proc_<name>.c with its row), its state
+ * in proc_state_t, one line in PROC_LIST, and its id in the sequence if
+ * the start runs it (proc.c; docs/architecture.md, "Adding a procedure").
+ * Every function of a procedure is FD_COLD (flash on the board): the ISR
+ * runs it only while it is in force, never in the run.
  */
 #ifndef FLUXDRIVE_PROC_H
 #define FLUXDRIVE_PROC_H

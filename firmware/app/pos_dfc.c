@@ -529,7 +529,7 @@ FD_COLD static void pdfc_align(pos_state_t *s, const drive_config_t *cfg, const 
   warm_gain(s); /* the warm start's, at the a, b in force */
 }
 
-/* The held start (drive_hold.c): the estimate's branch nearest theta, the
+/* The held start (proc_hold.c): the estimate's branch nearest theta, the
  * polarity resolved; the evidence of an alignment is not used (the rotor
  * was held, a load may have moved it a little). */
 static void pdfc_hold(pos_state_t *s, float theta) {

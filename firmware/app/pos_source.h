@@ -109,7 +109,7 @@ typedef struct {
   /* Whether cfg can run this source: NULL, or the reason with *field set
    * to the parameter (NULL: nothing to check). */
   const char *(*check)(const drive_config_t *cfg, const char **field);
-  /* The held start (start_mode 1, drive_hold.c) knows the rotor is at
+  /* The held start (start_mode 1, proc_hold.c) knows the rotor is at
    * electrical angle theta to within a quarter turn (the polarity from the
    * d-axis saturation pulses): take the branch of the estimate nearest it.
    * NULL: the source cannot start held (it has no angle at standstill). */

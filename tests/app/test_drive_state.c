@@ -721,7 +721,7 @@ static void watchdog_needs_both_contexts(void **state) {
 
 /* Alignment: gates on with d current along theta = 0 for align_time and
  * until the encoder's speed has stayed calm: a rotor that never moved for
- * align_still_need periods (1 / w_n: 13 ms with the default machine, w_n =
+ * still_need periods (1 / w_n: 13 ms with the default machine, w_n =
  * 77 rad/s at 1 A), then the encoder's offset is what it reads there. */
 static void alignment_sets_the_encoder_offset(void **state) {
   (void)state;
@@ -736,7 +736,9 @@ static void alignment_sets_the_encoder_offset(void **state) {
   run_isrs(drv.cfg.offset_samples + 1);
   assert_int_equal(drv.state, DRIVE_STATE_ALIGN);
   assert_true(hal.gates_on);
-  const int need = (int)drv.align_still_need;
+  proc_align_timing_t tmg; /* the alignment procedure's (proc_align.c) */
+  proc_align_timing(&drv.cfg, &tmg);
+  const int need = (int)tmg.still_need;
   assert_true(need > (int)(0.01f / drv.cfg.ts) + 1); /* the calm outlasts align_time here */
   run_isrs(need - 2);
   assert_int_equal(drv.state, DRIVE_STATE_ALIGN); /* not yet settled */
@@ -749,7 +751,7 @@ static void alignment_sets_the_encoder_offset(void **state) {
 
 /* A rotor that keeps swinging through the encoder's alignment (issue 23,
  * point 18): no offset is taken; the position fault after
- * DRIVE_ALIGN_SWINGS swings more (align_n_timeout), gates off. */
+ * PROC_ALIGN_SWINGS swings more (n_timeout), gates off. */
 static void swinging_rotor_never_aligns(void **state) {
   (void)state;
   drive_config_t cfg;
@@ -760,7 +762,9 @@ static void swinging_rotor_never_aligns(void **state) {
   sample(0.0f, 0.0f, 0.0f, 310.0f);
   drive_cmd_enable(&drv, true);
   const float off0 = drv.pos_st.enc.offset;
-  for (int k = 0; k < (int)drv.cfg.offset_samples + (int)drv.align_n_timeout + 2; ++k) {
+  proc_align_timing_t tmg; /* the alignment procedure's (proc_align.c) */
+  proc_align_timing(&drv.cfg, &tmg);
+  for (int k = 0; k < (int)drv.cfg.offset_samples + (int)tmg.n_timeout + 2; ++k) {
     /* 0.1 rad mechanical at 5 Hz: 2 x 10 x 2 pi rad/s electrical peak */
     hal.sample.enc_angle = 1.0f + 0.1f * sinf(31.4159f * (float)k * drv.cfg.ts);
     drive_isr(&drv);

@@ -95,6 +95,7 @@ static int parse_long(const char *opt, const char *s, long lo, long hi, long *ou
 
 int main(int argc, char **argv) {
   const char *scenario = NULL, *log_path = NULL, *summary_path = NULL, *record_path = NULL;
+  const char *dump_path = NULL;
   int decimate = 0, bench = 0, print_config = 0, print_params = 0, realtime = 0;
   const char *can = NULL;
   long preempt_n = 0;
@@ -116,6 +117,8 @@ int main(int argc, char **argv) {
       decimate = (int)v;
     } else if (strcmp(argv[i], "--record-isr") == 0 && i + 1 < argc) {
       record_path = argv[++i];
+    } else if (strcmp(argv[i], "--dump-scenario") == 0 && i + 1 < argc) {
+      dump_path = argv[++i];
     } else if (strcmp(argv[i], "--bench") == 0) {
       bench = 1;
     } else if (strcmp(argv[i], "--realtime") == 0) {
@@ -171,6 +174,13 @@ int main(int argc, char **argv) {
   if (scenario_load_file(scenario, &sc, err, sizeof err) != 0) {
     fprintf(stderr, "fluxdrive-sil: %s\n", err);
     return 2;
+  }
+  if (dump_path != NULL) {
+    if (scenario_dump(&sc, dump_path) != 0) {
+      fprintf(stderr, "fluxdrive-sil: %s: cannot write the dump\n", dump_path);
+      return 1;
+    }
+    return 0;
   }
   if (print_config) {
     char *js = config_json(&sc);

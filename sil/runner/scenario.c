@@ -1602,3 +1602,16 @@ int scenario_load_file(const char *path, scenario_t *sc, char *err, size_t errle
   free(buf);
   return r;
 }
+
+int scenario_dump(const scenario_t *sc, const char *path) {
+  static scenario_t d;
+  memcpy(&d, sc, sizeof d);
+  d.plant.machine.map = NULL;
+  d.drive.machine_map = NULL;
+  FILE *f = fopen(path, "wb");
+  if (f == NULL) {
+    return -1;
+  }
+  const int ok = fwrite(&d, sizeof d, 1, f) == 1;
+  return (fclose(f) == 0 && ok) ? 0 : -1;
+}

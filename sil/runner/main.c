@@ -22,6 +22,7 @@
  * 1 I/O error, 2 bad scenario or usage.
  */
 #include <signal.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -83,132 +84,69 @@ static int parse_long(const char *opt, const char *s, long lo, long hi, long *ou
 /* What the command line asks for. */
 typedef struct {
   const char *scenario, *log_path, *summary_path, *record_path, *dump_path, *can;
-  const char *keys_doc;
-  int decimate, bench, print_config, print_params, realtime, keys, keys_doc_write, help;
-  long preempt_n, seed, node, can_timeout;
-  double max_gap_us;
+  const char *keys_doc, *keys_doc_write;
+  int bench, print_config, print_params, realtime, keys, help;
+  long decimate, preempt_n, seed, node, can_timeout, max_gap_us;
 } cli_t;
 
-typedef struct {
+/* An option: its handler stores into the cli_t field at `at` (a path, a
+ * flag set to 1, or an integer in [lo, hi]). */
+typedef struct option option_t;
+struct option {
   const char *name;
   const char *arg; /* the argument's name, NULL for a flag */
   const char *help;
-  int (*handler)(cli_t *o, const char *arg); /* 0, or -1: a usage error (reported) */
-} option_t;
+  int (*handler)(cli_t *o, const option_t *op, const char *arg); /* 0, or -1: usage error */
+  size_t at;
+  long lo, hi;
+};
 
-static int opt_log(cli_t *o, const char *a) {
-  o->log_path = a;
-  return 0;
-}
-static int opt_summary(cli_t *o, const char *a) {
-  o->summary_path = a;
-  return 0;
-}
-static int opt_decimate(cli_t *o, const char *a) {
-  long v;
-  if (parse_long("--decimate", a, 1, 1000000, &v) != 0) {
-    return -1;
-  }
-  o->decimate = (int)v;
-  return 0;
-}
-static int opt_record(cli_t *o, const char *a) {
-  o->record_path = a;
-  return 0;
-}
-static int opt_bench(cli_t *o, const char *a) {
-  (void)a;
-  o->bench = 1;
-  return 0;
-}
-static int opt_realtime(cli_t *o, const char *a) {
-  (void)a;
-  o->realtime = 1;
-  return 0;
-}
-static int opt_can(cli_t *o, const char *a) {
-  o->can = a;
-  return 0;
-}
-static int opt_node(cli_t *o, const char *a) {
-  return parse_long("--node", a, 0, CAN_NODE_MAX, &o->node);
-}
-static int opt_can_timeout(cli_t *o, const char *a) {
-  return parse_long("--can-timeout", a, 0, 60000, &o->can_timeout);
-}
-static int opt_print_config(cli_t *o, const char *a) {
-  (void)a;
-  o->print_config = 1;
-  return 0;
-}
-static int opt_print_params(cli_t *o, const char *a) {
-  (void)a;
-  o->print_params = 1;
-  return 0;
-}
-static int opt_preempt(cli_t *o, const char *a) {
-  return parse_long("--preempt", a, 1, 100000000, &o->preempt_n);
-}
-static int opt_seed(cli_t *o, const char *a) {
-  return parse_long("--seed", a, 0, 0x7fffffff, &o->seed);
-}
-static int opt_max_gap(cli_t *o, const char *a) {
-  long g;
-  if (parse_long("--max-gap-us", a, 1, 100000, &g) != 0) {
-    return -1;
-  }
-  o->max_gap_us = (double)g;
-  return 0;
-}
-static int opt_dump(cli_t *o, const char *a) {
-  o->dump_path = a;
-  return 0;
-}
-static int opt_keys(cli_t *o, const char *a) {
-  (void)a;
-  o->keys = 1;
-  return 0;
-}
-static int opt_keys_doc(cli_t *o, const char *a) {
-  o->keys_doc = a;
-  return 0;
-}
-static int opt_keys_doc_write(cli_t *o, const char *a) {
-  o->keys_doc = a;
-  o->keys_doc_write = 1;
-  return 0;
-}
-static int opt_help(cli_t *o, const char *a) {
-  (void)a;
-  o->help = 1;
+static int set_path(cli_t *o, const option_t *op, const char *arg) {
+  *(const char **)(void *)((char *)o + op->at) = arg;
   return 0;
 }
 
+static int set_flag(cli_t *o, const option_t *op, const char *arg) {
+  (void)arg;
+  *(int *)(void *)((char *)o + op->at) = 1;
+  return 0;
+}
+
+static int set_long(cli_t *o, const option_t *op, const char *arg) {
+  return parse_long(op->name, arg, op->lo, op->hi, (long *)(void *)((char *)o + op->at));
+}
+
+#define PATH(f)         set_path, offsetof(cli_t, f), 0, 0
+#define FLAG(f)         set_flag, offsetof(cli_t, f), 0, 0
+#define LONG(f, lo, hi) set_long, offsetof(cli_t, f), (lo), (hi)
 static const option_t options[] = {
-    {"--log", "PATH.npy", "write the log (docs/log-format.md)", opt_log},
-    {"--summary", "PATH.json", "write the summary too (it is printed)", opt_summary},
-    {"--decimate", "N", "log every N-th period (overrides log.decimation)", opt_decimate},
-    {"--bench", NULL, "no log; print steps, wall time and the real-time factor", opt_bench},
-    {"--print-config", NULL, "print the resolved parameters (JSON) and exit", opt_print_config},
+    {"--log", "PATH.npy", "write the log (docs/log-format.md)", PATH(log_path)},
+    {"--summary", "PATH.json", "write the summary too (it is printed)", PATH(summary_path)},
+    {"--decimate", "N", "log every N-th period (overrides log.decimation)",
+     LONG(decimate, 1, 1000000)},
+    {"--bench", NULL, "no log; print steps, wall time and the real-time factor", FLAG(bench)},
+    {"--print-config", NULL, "print the resolved parameters (JSON) and exit", FLAG(print_config)},
     {"--print-params", NULL, "print the parameter table (JSON; no scenario needed) and exit",
-     opt_print_params},
+     FLAG(print_params)},
     {"--dump-scenario", "PATH", "write the parsed scenario's bytes (scripts/scenario_equiv.py)",
-     opt_dump},
-    {"--record-isr", "PATH.bin", "record every ISR for the PIL replay (docs/pil.md)", opt_record},
-    {"--realtime", NULL, "pace the simulation to the wall clock", opt_realtime},
+     PATH(dump_path)},
+    {"--record-isr", "PATH.bin", "record every ISR for the PIL replay (docs/pil.md)",
+     PATH(record_path)},
+    {"--realtime", NULL, "pace the simulation to the wall clock", FLAG(realtime)},
     {"--preempt", "PERIODS", "race check: the ISR preempts the main loop at random points",
-     opt_preempt},
-    {"--seed", "N", "--preempt: the interrupt times' seed", opt_seed},
-    {"--max-gap-us", "U", "--preempt: at most U us between interrupts", opt_max_gap},
+     LONG(preempt_n, 1, 100000000)},
+    {"--seed", "N", "--preempt: the interrupt times' seed", LONG(seed, 0, 0x7fffffff)},
+    {"--max-gap-us", "U", "--preempt: at most U us between interrupts",
+     LONG(max_gap_us, 1, 100000)},
     {"--can", "SPEC", "socketcand:PORT or socketcan:IFACE: the drive over CAN (docs/can.md)",
-     opt_can},
-    {"--node", "N", "--can: the drive's node id", opt_node},
-    {"--can-timeout", "MS", "--can: the command timeout", opt_can_timeout},
-    {"--keys", NULL, "print the scenario key reference (Markdown) and exit", opt_keys},
+     PATH(can)},
+    {"--node", "N", "--can: the drive's node id", LONG(node, 0, CAN_NODE_MAX)},
+    {"--can-timeout", "MS", "--can: the command timeout", LONG(can_timeout, 0, 60000)},
+    {"--keys", NULL, "print the scenario key reference (Markdown) and exit", FLAG(keys)},
     {"--keys-doc", "DOC.md", "check DOC.md's scenario key reference against the table",
-     opt_keys_doc},
-    {"--keys-doc-write", "DOC.md", "write it into DOC.md", opt_keys_doc_write},
-    {"--help", NULL, "this help", opt_help},
+     PATH(keys_doc)},
+    {"--keys-doc-write", "DOC.md", "write it into DOC.md", PATH(keys_doc_write)},
+    {"--help", NULL, "this help", FLAG(help)},
 };
 
 static int usage(FILE *f, int code) {
@@ -230,7 +168,7 @@ static int parse_cli(int argc, char **argv, cli_t *o) {
       op = strcmp(argv[i], options[k].name) == 0 ? &options[k] : NULL;
     }
     if (op != NULL && (op->arg == NULL || i + 1 < argc)) {
-      if (op->handler(o, op->arg != NULL ? argv[++i] : NULL) != 0) {
+      if (op->handler(o, op, op->arg != NULL ? argv[++i] : NULL) != 0) {
         return -1;
       }
     } else if (argv[i][0] == '-' || o->scenario != NULL) {
@@ -244,7 +182,7 @@ static int parse_cli(int argc, char **argv, cli_t *o) {
 }
 
 int main(int argc, char **argv) {
-  cli_t cli = {.max_gap_us = 20.0, .seed = 1, .node = -1, .can_timeout = -1};
+  cli_t cli = {.max_gap_us = 20, .seed = 1, .node = -1, .can_timeout = -1};
   if (parse_cli(argc, argv, &cli) != 0) {
     return 2;
   }
@@ -260,9 +198,10 @@ int main(int argc, char **argv) {
     free(md);
     return 0;
   }
-  if (cli.keys_doc != NULL) {
+  if (cli.keys_doc != NULL || cli.keys_doc_write != NULL) {
     char msg[600];
-    const int r = scenario_keys_doc(cli.keys_doc, cli.keys_doc_write, msg, sizeof msg);
+    const int w = cli.keys_doc_write != NULL;
+    const int r = scenario_keys_doc(w ? cli.keys_doc_write : cli.keys_doc, w, msg, sizeof msg);
     if (r != 0) {
       fprintf(stderr, "fluxdrive-sil: %s\n", msg);
     }
@@ -307,7 +246,7 @@ int main(int argc, char **argv) {
   }
   if (cli.preempt_n > 0) {
     const sil_preempt_opts_t po = {(uint64_t)cli.preempt_n, 600.0, (uint32_t)cli.seed,
-                                   cli.max_gap_us};
+                                   (double)cli.max_gap_us};
     static sil_preempt_result_t pr;
     if (sil_preempt_run(&sc, &po, &pr, err, sizeof err) != 0) {
       fprintf(stderr, "fluxdrive-sil: %s\n", err);
@@ -322,7 +261,7 @@ int main(int argc, char **argv) {
     return pr.violations != 0u || pr.tm_torn != 0u ? 3 : 0;
   }
   if (cli.decimate > 0) {
-    sc.log_decimation = cli.decimate;
+    sc.log_decimation = (int)cli.decimate;
   }
   sil_opts_t opts = {0};
   can_proto_cfg_t pcfg;

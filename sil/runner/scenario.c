@@ -2,10 +2,11 @@
  * scenario.c - JSON scenario loading (schema: docs/scenarios.md).
  *
  * The keys are a table (scenario_keys.h, scenario_key_table.h) the parser
- * walks: every object is checked for unknown keys, every number for type,
- * finiteness and range; the first error is reported as "<file>: <field path>: <reason>".
- * The parameter sets are then validated as a whole by plant_check() and
- * drive_config_check(), whose field names are reported the same way.
+ * walks: every object is checked for unknown keys, every value for its
+ * row's type and range (numbers also for finiteness); the first error is
+ * reported as "<file>: <field path>: <reason>". The rules between keys are
+ * the object rows' hooks (the section "the hooks" below). The parameter sets are then validated as
+ * a whole by plant_check() and drive_config_check(), whose field names are reported the same way.
  */
 #include "scenario.h"
 
@@ -417,7 +418,6 @@ _Static_assert(sizeof(plant_inverter_model_t) == sizeof(int) &&
                    sizeof(sil_adc_kind_t) == sizeof(int),
                "an enumeration the key table stores as int is not int-sized");
 
-typedef int (*sk_fn)(ctx_t *c, scenario_t *sc, const sk_val_t *v);
 static int root_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v);
 static int set_name(ctx_t *c, scenario_t *sc, const sk_val_t *v);
 static int machine_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v);

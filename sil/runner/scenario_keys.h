@@ -10,9 +10,9 @@
  * key reference of docs/scenarios.md is printed from it
  * (`fluxdrive-sil --keys`, checked by CTest `sil/scenario_keys_doc`).
  *
- * Adding a key: one row here (under its object's row, in the order it is
- * read), its field in scenario_t (or a setter in scenario.c), then
- * `fluxdrive-sil --keys-doc docs/scenarios.md --write`.
+ * Adding a key: one row in scenario_key_table.h (under its object's row,
+ * in the order it is read), its field in scenario_t (or a setter in
+ * scenario.c), then `fluxdrive-sil --keys-doc-write docs/scenarios.md`.
  */
 #ifndef FD_SIL_SCENARIO_KEYS_H
 #define FD_SIL_SCENARIO_KEYS_H

@@ -16,27 +16,31 @@
 #define DEF(v)               .has_def = 1, .def = (v)
 #define PARAM(name)          .range = SK_RANGE_PARAM, .param = (name)
 
-/* a power-stage fault: {SEL: one of NAMES, "active": profile} (inject) */
+/* a power-stage fault: {SEL: one of NAMES, "active": profile} (inject);
+ * SEL also inside a string, FIELD a member designator */
+/* NOLINTBEGIN(bugprone-macro-parentheses) */
 #define POWER_FAULT(X, ID, KEY, SEL, NAMES, HINT, DOC)                                             \
-  X(ID, .parent = K_INJECT, .key = KEY, .type = SK_OBJECT, .doc = DOC)                             \
-  X(ID##_SEL, .parent = ID, .key = SEL, .type = SK_ENUM, .names = NAMES, .req = HINT,              \
+  X(ID, .parent = K_INJECT, .key = (KEY), .type = SK_OBJECT, .doc = (DOC))                         \
+  X(ID##_SEL, .parent = (ID), .key = (SEL), .type = SK_ENUM, .names = (NAMES), .req = (HINT),      \
     AT(INT, ID##_FIELD.target), .doc = "the " SEL " it acts on")                                   \
-  X(ID##_ACTIVE, .parent = ID, .key = "active", .type = SK_PROFILE,                                \
+  X(ID##_ACTIVE, .parent = (ID), .key = "active", .type = SK_PROFILE,                              \
     .req = "a profile: the fault acts while it is > 0.5", AT(PROFILE, ID##_FIELD.active),          \
     .doc = "acts while > 0.5")
 
 /* a CAN direction of inject.can (socketcand) */
 #define CAN_DIR(X, ID, KEY, FIELD, DOC)                                                            \
-  X(ID, .parent = K_I_CAN, .key = KEY, .type = SK_OBJECT, .post = can_dir_post,                    \
-    .offset = offsetof(scenario_t, FIELD), .doc = DOC)                                             \
-  X(ID##_LOSS, .parent = ID, .key = "loss", .type = SK_BOUNDED, RANGE(0.0, 1.0),                   \
+  X(ID, .parent = K_I_CAN, .key = (KEY), .type = SK_OBJECT, .post = can_dir_post,                  \
+    .offset = offsetof(scenario_t, FIELD), .doc = (DOC))                                           \
+  X(ID##_LOSS, .parent = (ID), .key = "loss", .type = SK_BOUNDED, RANGE(0.0, 1.0),                 \
     AT(PROFILE, FIELD.loss), .dflt = "0", .doc = "probability that a frame is lost")               \
-  X(ID##_EVERY, .parent = ID, .key = "every", .type = SK_INT, RANGE(0.0, 1e6),                     \
+  X(ID##_EVERY, .parent = (ID), .key = "every", .type = SK_INT, RANGE(0.0, 1e6),                   \
     AT(U32, FIELD.every), DEF(0.0), .doc = "every n-th frame lost (0 none, n >= 2)")               \
-  X(ID##_DELAY, .parent = ID, .key = "delay", .type = SK_BOUNDED, RANGE(0.0, SIL_CAN_DELAY_MAX),   \
+  X(ID##_DELAY, .parent = (ID), .key = "delay", .type = SK_BOUNDED, RANGE(0.0, SIL_CAN_DELAY_MAX), \
     AT(PROFILE, FIELD.delay), .dflt = "0", .doc = "latency [s]")                                   \
-  X(ID##_JITTER, .parent = ID, .key = "jitter", .type = SK_BOUNDED, RANGE(0.0, SIL_CAN_DELAY_MAX), \
-    AT(PROFILE, FIELD.jitter), .dflt = "0", .doc = "extra latency, uniform in [0, jitter] [s]")
+  X(ID##_JITTER, .parent = (ID), .key = "jitter", .type = SK_BOUNDED,                              \
+    RANGE(0.0, SIL_CAN_DELAY_MAX), AT(PROFILE, FIELD.jitter), .dflt = "0",                         \
+    .doc = "extra latency, uniform in [0, jitter] [s]")
+/* NOLINTEND(bugprone-macro-parentheses) */
 
 #define K_I_SWITCH_OPEN_FIELD   switch_open
 #define K_I_SWITCH_CLOSED_FIELD switch_closed
@@ -45,7 +49,7 @@
 #define K_I_PHASE_SHORT_FIELD   phase_short
 #define K_I_GROUND_SHORT_FIELD  ground_short
 
-#define SK_PROFILE_DOC(what) .type = SK_PROFILE, .dflt = "none", .doc = what
+#define SK_PROFILE_DOC(what) .type = SK_PROFILE, .dflt = "none", .doc = (what)
 
 /* clang-format off */
 #define SCENARIO_KEYS(X)                                                                           \

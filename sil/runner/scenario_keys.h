@@ -73,30 +73,30 @@ typedef struct {
 } sk_val_t;
 
 typedef struct scenario_key {
-  int parent; /* row id of the enclosing object; -1 for the root */
   const char *key;
-  sk_type_t type;
-  double lo, hi;
-  int lo_open;
-  sk_range_t range;
   const char *param;                 /* SK_RANGE_PARAM*: the drive parameter */
   const char *const *names;          /* SK_ENUM: NULL-terminated */
   const char *(*name_of)(int index); /* SK_ENUM, instead of names */
-  sk_at_t at;
-  size_t offset;
-  size_t stride; /* SK_OBJECTS: bytes between elements */
-  int max;       /* SK_OBJECTS: elements */
   /* values: called instead of the store; objects: before their keys */
   int (*set)(struct sk_ctx *c, scenario_t *sc, const sk_val_t *v);
   int (*post)(struct sk_ctx *c, scenario_t *sc, const sk_val_t *v); /* objects: after */
-  int has_def;
-  double def;       /* stored when the enclosing object is read (top-level sections: always) */
-  int by_hook;      /* read by its object's hook (rules between keys) */
-  int params;       /* objects: the drive parameters "<path>.<name>" are keys too */
-  const char *req;  /* required: what to give */
-  const char *dflt; /* the default, documented, when not a number */
+  const char *req;                                                  /* required: what to give */
+  const char *dflt;        /* the default, documented, when not a number */
   const char *plant_field; /* the name plant_check() reports, when not the key's */
   const char *doc;
+  double lo, hi;
+  double def;    /* stored when the enclosing object is read (top-level sections: always) */
+  size_t offset; /* in scenario_t (or ctx_t: SK_AT_CTX_*) */
+  size_t stride; /* SK_OBJECTS: bytes between elements */
+  int parent;    /* row id of the enclosing object; -1 for the root */
+  sk_type_t type;
+  sk_range_t range;
+  sk_at_t at;
+  int lo_open; /* the range is (lo, hi] */
+  int max;     /* SK_OBJECTS: elements */
+  int has_def;
+  int by_hook; /* read by its object's hook (rules between keys) */
+  int params;  /* objects: the drive parameters "<path>.<name>" are keys too */
 } scenario_key_t;
 
 /* The table (scenario.c), indexed by row id; rows in reading order. */

@@ -12,7 +12,6 @@
 
 #include <cjson/cJSON.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,299 +22,13 @@
 #include "presets.h"
 #include "scenario_key_table.h"
 #include "scenario_keys.h"
+#include "scenario_read.h"
 
-#define PI 3.14159265358979323846
 /* the load grid (0 .. i_trip) Theorem 1 is checked on (check_star) */
 #define STAR_LOAD_STEPS 256
 /* star_tau at most this share of the sample's settling time (dfc_t_meas -
  * dead time): measured on the fabbri2022 presets, docs/dfc.md */
 #define STAR_TAU_SHARE 0.2
-
-typedef struct sk_ctx {
-  char *err;
-  size_t errlen;
-  const char *origin;
-  int failed;
-  int ls_given; /* machine.ls set both inductances (for the error's key) */
-  /* the machine key that set the star point's p = b/a (3.7) the drive's
-   * dfc_b follows, when controller.dfc_b is not given ("" otherwise) */
-  char p_key[32];
-  /* values the hooks combine (the table's AT_CTX rows) */
-  double ls, star_phi_iq, star_p;
-  double est[5]; /* controller.estimates: rs, ls, ld, lq, lambda_m scales */
-  int cause;     /* inject.trip_cause's index, -1 none */
-} ctx_t;
-
-static void utf8_clean(char *s);
-
-/* The first error, as "<origin>: <path>: <reason>", made valid UTF-8 (a key
- * or a string from the file may carry any bytes; the summary is JSON). */
-static int fail(ctx_t *c, const char *path, const char *fmt, ...) {
-  if (c->failed) {
-    return -1;
-  }
-  c->failed = 1;
-  char reason[400];
-  va_list ap;
-  va_start(ap, fmt);
-  /* the analyzer misses va_start on this path (LLVM 14) */
-  vsnprintf(reason, sizeof reason, fmt, ap); // NOLINT(clang-analyzer-valist.Uninitialized)
-  va_end(ap);
-  snprintf(c->err, c->errlen, "%s: %s: %s", c->origin, path, reason);
-  utf8_clean(c->err);
-  return -1;
-}
-
-static void join(char *out, size_t n, const char *path, const char *key) {
-  int r = path[0] == '\0' ? snprintf(out, n, "%s", key) : snprintf(out, n, "%s.%s", path, key);
-  if (r < 0 || (size_t)r >= n) {
-    out[n - 1] = '\0';
-  }
-}
-
-/* A key given twice in one object (JSON leaves it open; cJSON keeps both and
- * the lookups see the first): refused, with its path, anywhere in the
- * tree. Depth is bounded by cJSON's nesting limit. */
-static int check_duplicates(ctx_t *c, const cJSON *node, const char *path) {
-  for (const cJSON *it = node->child; it != NULL; it = it->next) {
-    char p[160];
-    if (cJSON_IsObject(node)) {
-      for (const cJSON *jt = it->next; jt != NULL; jt = jt->next) {
-        if (strcmp(it->string, jt->string) == 0) {
-          join(p, sizeof p, path, it->string);
-          return fail(c, p, "given twice (a key may appear once)");
-        }
-      }
-      join(p, sizeof p, path, it->string);
-    } else {
-      int k = 0;
-      for (const cJSON *jt = node->child; jt != it; jt = jt->next) {
-        ++k;
-      }
-      snprintf(p, sizeof p, "%s[%d]", path, k);
-    }
-    if ((cJSON_IsObject(it) || cJSON_IsArray(it)) && check_duplicates(c, it, p) != 0) {
-      return -1;
-    }
-  }
-  return 0;
-}
-
-/* s made valid UTF-8 in place: a sequence cut by a truncation at the end is
- * dropped, any other invalid byte becomes '?' (the summary is JSON, and
- * JSON is UTF-8). */
-static void utf8_clean(char *s) {
-  size_t i = 0;
-  const size_t n = strlen(s);
-  while (i < n) {
-    const unsigned char b = (unsigned char)s[i];
-    size_t len = b < 0x80u                    ? 1u
-                 : (b >= 0xC2u && b <= 0xDFu) ? 2u
-                 : (b >= 0xE0u && b <= 0xEFu) ? 3u
-                 : (b >= 0xF0u && b <= 0xF4u) ? 4u
-                                              : 0u;
-    /* the second byte's range: no overlong forms, no surrogates, nothing
-     * beyond U+10FFFF (RFC 3629) */
-    const unsigned char lo = b == 0xE0u ? 0xA0u : (b == 0xF0u ? 0x90u : 0x80u);
-    const unsigned char hi = b == 0xEDu ? 0x9Fu : (b == 0xF4u ? 0x8Fu : 0xBFu);
-    size_t k = 1u;
-    while (len > 1u && k < len && i + k < n) {
-      const unsigned char x = (unsigned char)s[i + k];
-      if (k == 1u ? (x < lo || x > hi) : (x & 0xC0u) != 0x80u) {
-        break;
-      }
-      ++k;
-    }
-    if (len > 1u && k < len && i + k == n) {
-      s[i] = '\0'; /* cut at the end: drop the partial sequence */
-      return;
-    }
-    if (len == 0u || k < len) {
-      s[i] = '?';
-      len = 1u;
-    }
-    i += len;
-  }
-}
-
-/* Rejects keys of obj that are not in the NULL-terminated list (profiles). */
-static int check_list(ctx_t *c, const cJSON *obj, const char *path, const char *const *allowed) {
-  if (!cJSON_IsObject(obj)) {
-    return fail(c, path[0] ? path : "(top level)", "must be an object");
-  }
-  for (const cJSON *it = obj->child; it != NULL; it = it->next) {
-    int ok = 0;
-    for (const char *const *a = allowed; *a != NULL; ++a) {
-      ok |= strcmp(*a, it->string) == 0;
-    }
-    if (!ok) {
-      char p[160];
-      join(p, sizeof p, path, it->string);
-      return fail(c, p, "unknown field");
-    }
-  }
-  return 0;
-}
-
-/* Optional number in [lo, hi]; leaves *out unchanged when absent. */
-static int get_num(ctx_t *c, const cJSON *obj, const char *path, const char *key, double lo,
-                   double hi, double *out) {
-  const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
-  if (it == NULL) {
-    return 0;
-  }
-  char p[160];
-  join(p, sizeof p, path, key);
-  if (!cJSON_IsNumber(it)) {
-    return fail(c, p, "must be a number");
-  }
-  double v = it->valuedouble;
-  if (!isfinite(v) || v < lo || v > hi) {
-    return fail(c, p, "must be in [%g, %g] (got %g)", lo, hi, v);
-  }
-  *out = v;
-  return 0;
-}
-
-/* Optional string from a list; returns its index in *out. */
-static int get_enum(ctx_t *c, const cJSON *obj, const char *path, const char *key,
-                    const char *const *names, int *out) {
-  const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
-  if (it == NULL) {
-    return 0;
-  }
-  char p[160];
-  join(p, sizeof p, path, key);
-  char list[200] = "";
-  for (int i = 0; names[i] != NULL; ++i) {
-    if (cJSON_IsString(it) && strcmp(it->valuestring, names[i]) == 0) {
-      *out = i;
-      return 0;
-    }
-    strncat(list, i ? ", " : "", sizeof list - strlen(list) - 1);
-    strncat(list, names[i], sizeof list - strlen(list) - 1);
-  }
-  return fail(c, p, "must be one of: %s", list);
-}
-
-/* ---- profiles ---------------------------------------------------------- */
-
-static int parse_term(ctx_t *c, const cJSON *t, const char *path, double scale, profile_t *pr) {
-  static const char *const kinds[] = {"const", "step", "ramp", "sine", NULL};
-  static const char *const keys[] = {"type", "value", "t",         "t0", "t1",
-                                     "freq", "phase", "amplitude", NULL};
-  if (check_list(c, t, path, keys) != 0) {
-    return -1;
-  }
-  int kind = -1;
-  if (get_enum(c, t, path, "type", kinds, &kind) != 0) {
-    return -1;
-  }
-  if (kind < 0) {
-    char p[160];
-    join(p, sizeof p, path, "type");
-    return fail(c, p, "missing (const, step, ramp or sine)");
-  }
-  profile_term_t term = {.kind = (profile_kind_t)kind};
-  const double big = 1e9;
-  if (get_num(c, t, path, kind == PROFILE_SINE ? "amplitude" : "value", -big, big, &term.value) ||
-      get_num(c, t, path, kind == PROFILE_STEP ? "t" : "t0", 0.0, big, &term.t0) ||
-      get_num(c, t, path, "t1", 0.0, big, &term.t1) ||
-      get_num(c, t, path, "freq", 0.0, 1e6, &term.freq) ||
-      get_num(c, t, path, "phase", -1e3, 1e3, &term.phase)) {
-    return -1;
-  }
-  if (kind == PROFILE_RAMP && !(term.t1 > term.t0)) {
-    char p[160];
-    join(p, sizeof p, path, "t1");
-    return fail(c, p, "a ramp needs t1 > t0");
-  }
-  if (kind == PROFILE_SINE && !(term.freq > 0.0)) {
-    char p[160];
-    join(p, sizeof p, path, "freq");
-    return fail(c, p, "a sine needs freq > 0");
-  }
-  term.value *= scale;
-  if (profile_add(pr, term) != 0) {
-    return fail(c, path, "too many terms (at most %d)", PROFILE_MAX_TERMS);
-  }
-  return 0;
-}
-
-/* A profile: a number (constant), an array of terms, or
- * {"unit": "...", "terms": [...]} with unit conversion to SI. */
-static int get_profile(ctx_t *c, const cJSON *obj, const char *path, const char *key,
-                       profile_t *pr) {
-  const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
-  if (it == NULL) {
-    return 0;
-  }
-  char p[160];
-  join(p, sizeof p, path, key);
-  *pr = (profile_t){0};
-  double scale = 1.0;
-  if (cJSON_IsNumber(it)) {
-    if (!isfinite(it->valuedouble)) {
-      return fail(c, p, "must be finite");
-    }
-    return profile_add(pr, (profile_term_t){.kind = PROFILE_CONST, .value = it->valuedouble});
-  }
-  const cJSON *terms = it;
-  if (cJSON_IsObject(it)) {
-    static const char *const keys[] = {"unit", "terms", NULL};
-    static const char *const units[] = {"si", "rpm", "deg", NULL};
-    if (check_list(c, it, p, keys) != 0) {
-      return -1;
-    }
-    int u = 0;
-    if (get_enum(c, it, p, "unit", units, &u) != 0) {
-      return -1;
-    }
-    scale = u == 1 ? PI / 30.0 : (u == 2 ? PI / 180.0 : 1.0);
-    terms = cJSON_GetObjectItemCaseSensitive(it, "terms");
-    char tp[160];
-    join(tp, sizeof tp, p, "terms");
-    if (!cJSON_IsArray(terms)) {
-      return fail(c, tp, "must be an array of profile terms");
-    }
-    memcpy(p, tp, sizeof p);
-  }
-  if (!cJSON_IsArray(terms)) {
-    return fail(c, p, "must be a number, an array of terms or {\"unit\", \"terms\"}");
-  }
-  int i = 0;
-  for (const cJSON *t = terms->child; t != NULL; t = t->next, ++i) {
-    char tp[176];
-    if (snprintf(tp, sizeof tp, "%s[%d]", p, i) >= (int)sizeof tp) {
-      tp[sizeof tp - 1] = '\0';
-    }
-    if (parse_term(c, t, tp, scale, pr) != 0) {
-      return -1;
-    }
-  }
-  return 0;
-}
-
-/* A profile whose every value (its terms' bounds, profile_bounds) lies in
- * [lo, hi] ((lo, hi] with lo_open). */
-static int get_bounded_profile(ctx_t *c, const cJSON *o, const char *path, const char *key,
-                               double lo, int lo_open, double hi, profile_t *pr) {
-  if (get_profile(c, o, path, key, pr) != 0) {
-    return -1;
-  }
-  if (cJSON_GetObjectItemCaseSensitive(o, key) == NULL) {
-    return 0;
-  }
-  double l, h;
-  profile_bounds(pr, &l, &h);
-  if ((lo_open ? !(l > lo) : !(l >= lo)) || !(h <= hi)) {
-    char p[160];
-    join(p, sizeof p, path, key);
-    return fail(c, p, "must stay in %s%g, %g] at all times (its terms reach [%g, %g])",
-                lo_open ? "(" : "[", lo, hi, l, h);
-  }
-  return 0;
-}
 
 /* ---- machines ---------------------------------------------------------- */
 
@@ -327,14 +40,14 @@ static int use_map(ctx_t *c, const char *key, const char *file, int pp, scenario
   const map_load_t *e = map_load(file, c->origin, pp, why, sizeof why);
   if (e == NULL) {
     if (strstr(why, ": pole pairs: ") != NULL) { /* the map tool's check (fluxmap/io.py) */
-      return pp > 0 ? fail(c, "machine.pole_pairs", "%d: %s", pp, why)
-                    : fail(c, "machine.pole_pairs", "required: %s", why);
+      return pp > 0 ? scn_fail(c, "machine.pole_pairs", "%d: %s", pp, why)
+                    : scn_fail(c, "machine.pole_pairs", "required: %s", why);
     }
-    return fail(c, key, "%s", why);
+    return scn_fail(c, key, "%s", why);
   }
   if (pp > 0 && e->map.pole_pairs != (float)pp) {
-    return fail(c, "machine.pole_pairs", "%d, but the map file %s has %g", pp, file,
-                (double)e->map.pole_pairs);
+    return scn_fail(c, "machine.pole_pairs", "%d, but the map file %s has %g", pp, file,
+                    (double)e->map.pole_pairs);
   }
   sc->plant.machine.map = e->plant;
   snprintf(sc->map_file, sizeof sc->map_file, "%s", e->path);
@@ -381,18 +94,18 @@ static int get_param(ctx_t *c, const cJSON *o, const drive_param_t *p, drive_con
                                                  : drive_pos_source_name(v);
     }
     names[n] = NULL;
-    if (get_enum(c, o, "controller", key, names, &idx) != 0) {
+    if (scn_get_enum(c, o, "controller", key, names, &idx) != 0) {
       return -1;
     }
     drive_param_set(d, p, (float)idx);
     return 0;
   }
   double v = (double)drive_param_get(d, p);
-  if (get_num(c, o, "controller", key, (double)p->min, (double)p->max, &v) != 0) {
+  if (scn_get_num(c, o, "controller", key, (double)p->min, (double)p->max, &v) != 0) {
     return -1;
   }
   if (p->type != DRIVE_PARAM_F32 && floor(v) != v) {
-    return fail(c, p->scenario, "must be an integer (got %g)", v);
+    return scn_fail(c, p->scenario, "must be an integer (got %g)", v);
   }
   drive_param_set(d, p, (float)v);
   return 0;
@@ -456,7 +169,7 @@ void scenario_key_path(unsigned id, char *out, size_t n) {
       strncat(up, "[]", sizeof up - strlen(up) - 1);
     }
   }
-  join(out, n, up, k->key);
+  scn_join(out, n, up, k->key);
 }
 
 void scenario_key_range(const scenario_key_t *k, double *lo, double *hi) {
@@ -522,13 +235,13 @@ static int read_num(ctx_t *c, const cJSON *obj, const char *path, unsigned id, d
   const scenario_key_t *k = &rows[id];
   double lo, hi;
   scenario_key_range(k, &lo, &hi);
-  if (get_num(c, obj, path, k->key, lo, hi, out) != 0) {
+  if (scn_get_num(c, obj, path, k->key, lo, hi, out) != 0) {
     return -1;
   }
   if (k->type == SK_INT && floor(*out) != *out) {
     char p[160];
-    join(p, sizeof p, path, k->key);
-    return fail(c, p, "must be an integer (got %g)", *out);
+    scn_join(p, sizeof p, path, k->key);
+    return scn_fail(c, p, "must be an integer (got %g)", *out);
   }
   return 0;
 }
@@ -537,13 +250,13 @@ static int read_num(ctx_t *c, const cJSON *obj, const char *path, unsigned id, d
 static int read_array3(ctx_t *c, const cJSON *arr, const char *p, const scenario_key_t *k,
                        double *dst) {
   if (!cJSON_IsArray(arr) || cJSON_GetArraySize(arr) != 3) {
-    return fail(c, p, "must be an array of 3 numbers (phases a, b, c)");
+    return scn_fail(c, p, "must be an array of 3 numbers (phases a, b, c)");
   }
   for (int i = 0; i < 3; ++i) {
     const cJSON *v = cJSON_GetArrayItem(arr, i);
     if (!cJSON_IsNumber(v) || !isfinite(v->valuedouble) || v->valuedouble < k->lo ||
         v->valuedouble > k->hi) {
-      return fail(c, p, "element %d must be a finite number", i);
+      return scn_fail(c, p, "element %d must be a finite number", i);
     }
     dst[i] = v->valuedouble;
   }
@@ -562,7 +275,7 @@ static int check_keys(ctx_t *c, const cJSON *obj, const char *path, unsigned id)
       }
     }
     strncat(list, list[0] ? ")" : "", sizeof list - strlen(list) - 1);
-    return fail(c, path[0] ? path : "(top level)", "must be an object%s", list);
+    return scn_fail(c, path[0] ? path : "(top level)", "must be an object%s", list);
   }
   for (const cJSON *it = obj->child; it != NULL; it = it->next) {
     int ok = 0;
@@ -571,7 +284,7 @@ static int check_keys(ctx_t *c, const cJSON *obj, const char *path, unsigned id)
     }
     if (!ok && rows[id].params) {
       char p[160];
-      join(p, sizeof p, path, it->string);
+      scn_join(p, sizeof p, path, it->string);
       unsigned n;
       const drive_param_t *t = drive_params_table(&n);
       for (unsigned i = 0; i < n && !ok; ++i) {
@@ -580,8 +293,8 @@ static int check_keys(ctx_t *c, const cJSON *obj, const char *path, unsigned id)
     }
     if (!ok) {
       char p[160];
-      join(p, sizeof p, path, it->string);
-      return fail(c, p, "unknown field");
+      scn_join(p, sizeof p, path, it->string);
+      return scn_fail(c, p, "unknown field");
     }
   }
   return 0;
@@ -596,9 +309,9 @@ static int read_key(ctx_t *c, scenario_t *sc, const cJSON *o, const char *path, 
   const scenario_key_t *k = &rows[kid];
   const cJSON *it = cJSON_GetObjectItemCaseSensitive(o, k->key);
   char p[160];
-  join(p, sizeof p, path, k->key);
+  scn_join(p, sizeof p, path, k->key);
   if (it == NULL) {
-    return k->req != NULL ? fail(c, p, "required (%s)", k->req) : 0;
+    return k->req != NULL ? scn_fail(c, p, "required (%s)", k->req) : 0;
   }
   if (k->by_hook) {
     return 0;
@@ -612,20 +325,20 @@ static int read_key(ctx_t *c, scenario_t *sc, const cJSON *o, const char *path, 
   case SK_ENUM: {
     const char *buf[20];
     int idx = -1;
-    if (get_enum(c, o, path, k->key, enum_names(k, buf, 20), &idx) != 0) {
+    if (scn_get_enum(c, o, path, k->key, enum_names(k, buf, 20), &idx) != 0) {
       return -1;
     }
     v.num = idx;
     return store(c, sc, k, &v);
   }
   case SK_PROFILE:
-    return get_profile(c, o, path, k->key, (profile_t *)(void *)base);
+    return scn_get_profile(c, o, path, k->key, (profile_t *)(void *)base);
   case SK_BOUNDED:
-    return get_bounded_profile(c, o, path, k->key, k->lo, k->lo_open, k->hi,
-                               (profile_t *)(void *)base);
+    return scn_get_bounded_profile(c, o, path, k->key, k->lo, k->lo_open, k->hi,
+                                   (profile_t *)(void *)base);
   case SK_STRING:
     if (!cJSON_IsString(it)) {
-      return fail(c, p, "must be a string");
+      return scn_fail(c, p, "must be a string");
     }
     return k->set != NULL ? k->set(c, sc, &v) : 0;
   case SK_ARRAY3:
@@ -634,7 +347,7 @@ static int read_key(ctx_t *c, scenario_t *sc, const cJSON *o, const char *path, 
     return walk(c, sc, it, p, kid, shift, index);
   case SK_OBJECTS: {
     if (!cJSON_IsArray(it)) {
-      return fail(c, p, "must be an array of %s", k->doc);
+      return scn_fail(c, p, "must be an array of %s", k->doc);
     }
     int i = 0;
     for (const cJSON *e = it->child; e != NULL; e = e->next, ++i) {
@@ -685,13 +398,13 @@ static int walk(ctx_t *c, scenario_t *sc, const cJSON *o, const char *path, unsi
 
 static int root_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
   (void)sc;
-  return check_duplicates(c, v->it, "");
+  return scn_check_duplicates(c, v->it, "");
 }
 
 static int set_name(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
   (void)c;
   snprintf(sc->name, sizeof sc->name, "%s", ((const cJSON *)v->it)->valuestring);
-  utf8_clean(sc->name);
+  scn_utf8_clean(sc->name);
   return 0;
 }
 
@@ -707,7 +420,7 @@ static int machine_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
   if (pre != NULL) {
     const machine_preset_t *p = cJSON_IsString(pre) ? preset_find(pre->valuestring) : NULL;
     if (p == NULL) {
-      return fail(c, "machine.preset", "unknown preset (known: %s)", preset_names());
+      return scn_fail(c, "machine.preset", "unknown preset (known: %s)", preset_names());
     }
     preset_apply(p, &sc->plant, &sc->drive);
     if (p->map != NULL && use_map(c, "machine.preset", p->map, (int)pp_given, sc) != 0) {
@@ -717,7 +430,7 @@ static int machine_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
   const cJSON *map = cJSON_GetObjectItemCaseSensitive(m, "map");
   if (map != NULL) {
     if (!cJSON_IsString(map) || map->valuestring[0] == '\0') {
-      return fail(c, "machine.map", "must be a file name (.fdmap, .npz, .csv)");
+      return scn_fail(c, "machine.map", "must be a file name (.fdmap, .npz, .csv)");
     }
     if (use_map(c, "machine.map", map->valuestring, (int)pp_given, sc) != 0) {
       return -1;
@@ -730,14 +443,15 @@ static int machine_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
       if (cJSON_GetObjectItemCaseSensitive(m, linear_only[k]) != NULL) {
         char key[32];
         snprintf(key, sizeof key, "machine.%s", linear_only[k]);
-        return fail(c, key, "a flux-map machine takes its inductances and PM flux from the map");
+        return scn_fail(c, key,
+                        "a flux-map machine takes its inductances and PM flux from the map");
       }
     }
   }
   /* the star point's inductance matrix (3.3), plant.h */
   const char *star = star_key_given(m);
   if (star != NULL && sc->plant.machine.map != NULL) {
-    return fail(c, star, "the star-point model needs a linear machine (no map)");
+    return scn_fail(c, star, "the star-point model needs a linear machine (no map)");
   }
   c->ls = -1.0;
   return 0;
@@ -750,22 +464,22 @@ static int machine_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
   plant_machine_t *pm = &sc->plant.machine;
   if (c->ls > 0.0) {
     if (cJSON_GetObjectItemCaseSensitive(m, "ld") || cJSON_GetObjectItemCaseSensitive(m, "lq")) {
-      return fail(c, "machine.ls", "give either ls (SPM) or ld and lq, not both");
+      return scn_fail(c, "machine.ls", "give either ls (SPM) or ld and lq, not both");
     }
     pm->ld = pm->lq = c->ls;
     c->ls_given = 1;
   }
   /* the magnet's d-axis saturation (plant.h, plant_magnetics.h) */
   if (pm->ld_sat > 0.0 && !(pm->i_sat > 0.0)) {
-    return fail(c, "machine.i_sat", "must be given (> 0 A) with machine.ld_sat > 0");
+    return scn_fail(c, "machine.i_sat", "must be given (> 0 A) with machine.ld_sat > 0");
   }
   /* star_phi_iq: both terms' shift (a turned saliency axis: phi_a = phi_iq,
    * phi_b = 2 phi_iq of (3.97)), an alias of the pair */
   if (cJSON_GetObjectItemCaseSensitive(m, "star_phi_iq") != NULL) {
     if (cJSON_GetObjectItemCaseSensitive(m, "star_phi_self") ||
         cJSON_GetObjectItemCaseSensitive(m, "star_phi_mutual")) {
-      return fail(c, "machine.star_phi_iq",
-                  "sets star_phi_self and star_phi_mutual both: give either it or them");
+      return scn_fail(c, "machine.star_phi_iq",
+                      "sets star_phi_self and star_phi_mutual both: give either it or them");
     }
     pm->aniso.phi_self = c->star_phi_iq;
     pm->aniso.phi_mut = pm->aniso.phi_self;
@@ -776,7 +490,7 @@ static int machine_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
     const double p = c->star_p;
     if (cJSON_GetObjectItemCaseSensitive(m, "ld") || cJSON_GetObjectItemCaseSensitive(m, "lq") ||
         cJSON_GetObjectItemCaseSensitive(m, "star_m2")) {
-      return fail(c, "machine.star_p", "sets ld, lq and star_m2: give none of them with it");
+      return scn_fail(c, "machine.star_p", "sets ld, lq and star_m2: give none of them with it");
     }
     const double l0 = 0.5 * (pm->ld + pm->lq) + pm->aniso.m0;
     const double l2 = (pm->ld - pm->lq) - 2.0 * pm->aniso.m2;
@@ -819,7 +533,7 @@ static int inverter_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
 static int mechanics_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
   plant_mech_t *m = &sc->plant.mech;
   if (m->mode == PLANT_MECH_IMPOSED && !cJSON_GetObjectItemCaseSensitive(v->it, "speed")) {
-    return fail(c, "mechanics.speed", "required when mode is \"imposed\"");
+    return scn_fail(c, "mechanics.speed", "required when mode is \"imposed\"");
   }
   sc->drive.inertia = (float)m->j;
   sc->drive.friction = (float)m->b;
@@ -855,8 +569,8 @@ static int estimates_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
     for (unsigned k = K_C_E_LS; k <= K_C_E_LAMBDA_M; ++k) {
       if (cJSON_GetObjectItemCaseSensitive(v->it, rows[k].key) != NULL) {
         char key[64];
-        join(key, sizeof key, v->path, rows[k].key);
-        return fail(c, key, "a flux-map machine's model is its map (only rs_scale applies)");
+        scn_join(key, sizeof key, v->path, rows[k].key);
+        return scn_fail(c, key, "a flux-map machine's model is its map (only rs_scale applies)");
       }
     }
   }
@@ -874,16 +588,16 @@ static int inject_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
   const plant_faults_t *pf = &sc->plant.faults;
   const int cause = c->cause;
   if ((cause >= 0) != (sc->trip_at > 0.0)) {
-    return fail(c, cause >= 0 ? "inject.trip_at" : "inject.trip_cause",
-                "trip_at (> 0) and trip_cause go together");
+    return scn_fail(c, cause >= 0 ? "inject.trip_at" : "inject.trip_cause",
+                    "trip_at (> 0) and trip_cause go together");
   }
   sc->trip_cause = cause >= 0 ? 1u << (unsigned)cause : 0u;
   if (cJSON_GetObjectItemCaseSensitive(o, "phase_short") != NULL &&
       cJSON_GetObjectItemCaseSensitive(o, "phase_open") != NULL &&
       (sc->phase_open.target == sc->phase_short.target ||
        sc->phase_open.target == (sc->phase_short.target + 1) % 3)) {
-    return fail(c, "inject.phase_short",
-                "shares a lead with inject.phase_open (an open lead cannot be shorted)");
+    return scn_fail(c, "inject.phase_short",
+                    "shares a lead with inject.phase_open (an open lead cannot be shorted)");
   }
   static const unsigned power[] = {K_I_SWITCH_OPEN, K_I_SWITCH_CLOSED, K_I_PHASE_LOST,
                                    K_I_PHASE_OPEN,  K_I_PHASE_SHORT,   K_I_GROUND_SHORT};
@@ -894,22 +608,23 @@ static int inject_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
     sc->power_faults = 1;
     if (sc->plant.inverter.model != PLANT_INV_SWITCHING) {
       char p[160];
-      join(p, sizeof p, v->path, rows[power[k]].key);
-      return fail(c, p, "needs inverter.model: switching (a fault of the switch-level circuit)");
+      scn_join(p, sizeof p, v->path, rows[power[k]].key);
+      return scn_fail(c, p,
+                      "needs inverter.model: switching (a fault of the switch-level circuit)");
     }
   }
   if (pf->lambda_m_scale.n > 0 && sc->plant.machine.map != NULL) {
-    return fail(c, "inject.lambda_m_scale",
-                "a flux-map machine's PM flux is inside its map (saturated with the currents): "
-                "give the demagnetised machine as its own map (machine.map)");
+    return scn_fail(c, "inject.lambda_m_scale",
+                    "a flux-map machine's PM flux is inside its map (saturated with the currents): "
+                    "give the demagnetised machine as its own map (machine.map)");
   }
   if (pf->star_shift.n > 0 && !sc->plant.machine.aniso.enabled) {
-    return fail(c, "inject.star_shift",
-                "needs a star-point machine (machine.star_m0, star_m2 or a star-point preset)");
+    return scn_fail(c, "inject.star_shift",
+                    "needs a star-point machine (machine.star_m0, star_m2 or a star-point preset)");
   }
   if (pf->c_scale.n > 0 && sc->plant.dclink.kind == PLANT_DC_IDEAL) {
-    return fail(c, "inject.c_scale",
-                "needs dc_link.kind \"rc\" or \"rectifier\" (an ideal link has no capacitor)");
+    return scn_fail(c, "inject.c_scale",
+                    "needs dc_link.kind \"rc\" or \"rectifier\" (an ideal link has no capacitor)");
   }
   return 0;
 }
@@ -917,7 +632,7 @@ static int inject_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
 /* inject.current[i]: at most SIL_ADC_FAULTS_MAX, each from a clean slate. */
 static int current_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
   if (v->index >= SIL_ADC_FAULTS_MAX) {
-    return fail(c, v->path, "too many channel faults (at most %d)", SIL_ADC_FAULTS_MAX);
+    return scn_fail(c, v->path, "too many channel faults (at most %d)", SIL_ADC_FAULTS_MAX);
   }
   sc->current_faults.f[v->index] = (sil_adc_fault_t){.channel = -1, .kind = SIL_ADC_KIND_COUNT};
   return 0;
@@ -929,16 +644,16 @@ static int current_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
   sil_adc_fault_t *f = &sc->current_faults.f[v->index];
   const bool has = cJSON_GetObjectItemCaseSensitive(v->it, "value") != NULL;
   char q[190];
-  join(q, sizeof q, v->path, "value");
+  scn_join(q, sizeof q, v->path, "value");
   if (sil_adc_kind_has_value(f->kind) != has) {
-    return fail(c, q, has ? "not taken by kind \"%s\"" : "required for kind \"%s\"",
-                sil_adc_kind_name((int)f->kind));
+    return scn_fail(c, q, has ? "not taken by kind \"%s\"" : "required for kind \"%s\"",
+                    sil_adc_kind_name((int)f->kind));
   }
   if (has) {
     const bool gain = f->kind == SIL_ADC_GAIN;
     const double fsc = sc->plant.sensors.i_full_scale;
-    if (get_bounded_profile(c, v->it, v->path, "value", gain ? -1.0 : -fsc, 0, gain ? 9.0 : fsc,
-                            &f->value) != 0) {
+    if (scn_get_bounded_profile(c, v->it, v->path, "value", gain ? -1.0 : -fsc, 0, gain ? 9.0 : fsc,
+                                &f->value) != 0) {
       return -1;
     }
   }
@@ -949,8 +664,8 @@ static int current_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
 static int encoder_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
   (void)v;
   if (sc->encoder_faults.missing > 0.0 && sc->plant.sensors.encoder_cpr <= 0) {
-    return fail(c, "inject.encoder.missing",
-                "needs counts to lose: sensors.encoder_cpr > 0 (0 is an ideal encoder)");
+    return scn_fail(c, "inject.encoder.missing",
+                    "needs counts to lose: sensors.encoder_cpr > 0 (0 is an ideal encoder)");
   }
   return 0;
 }
@@ -966,15 +681,15 @@ static int can_dir_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
   const sil_can_dir_t *d = (const sil_can_dir_t *)(const void *)((char *)sc + v->row->offset);
   if (d->every == 1u) {
     char p[160];
-    join(p, sizeof p, v->path, "every");
-    return fail(c, p, "must be 0 (none) or at least 2 (1 would lose every frame: use loss 1)");
+    scn_join(p, sizeof p, v->path, "every");
+    return scn_fail(c, p, "must be 0 (none) or at least 2 (1 would lose every frame: use loss 1)");
   }
   return 0;
 }
 
 static int passive_load_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
   if (sc->plant.mech.mode != PLANT_MECH_FREE) {
-    return fail(c, v->path, "needs mechanics.mode \"free\" (a dynamometer imposes the speed)");
+    return scn_fail(c, v->path, "needs mechanics.mode \"free\" (a dynamometer imposes the speed)");
   }
   return 0;
 }
@@ -988,7 +703,7 @@ static int board_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
       pre == NULL ? sil_board_find(DEFAULT_BOARD)
                   : (cJSON_IsString(pre) ? sil_board_find(pre->valuestring) : NULL);
   if (bp == NULL) {
-    return fail(c, "board.preset", "unknown board (known: %s)", sil_board_names());
+    return scn_fail(c, "board.preset", "unknown board (known: %s)", sil_board_names());
   }
   sil_board_apply(bp, sc->plant.ts, sc->plant.inverter.dead_time, &sc->board);
   return 0;
@@ -1036,11 +751,12 @@ static int resolve_substeps(ctx_t *c, scenario_t *sc) {
                           : (p->machine.ld < p->machine.lq ? p->machine.ld : p->machine.lq);
   if (p->inverter.substeps == 0) {
     if (need > PLANT_SUBSTEPS_MAX && plant_substeps_link(p) >= need) {
-      return fail(c, p->faults.c_scale.n > 0 ? "inject.c_scale" : "dc_link.c",
-                  "the plant cannot integrate this DC link at this PWM period: its time constant "
-                  "R C (at the smallest capacitance) needs %d integration steps per period, at "
-                  "most %d",
-                  need, PLANT_SUBSTEPS_MAX);
+      return scn_fail(
+          c, p->faults.c_scale.n > 0 ? "inject.c_scale" : "dc_link.c",
+          "the plant cannot integrate this DC link at this PWM period: its time constant "
+          "R C (at the smallest capacitance) needs %d integration steps per period, at "
+          "most %d",
+          need, PLANT_SUBSTEPS_MAX);
     }
     if (need > PLANT_SUBSTEPS_MAX && plant_substeps_mech(p) >= need) {
       /* the inertia the mechanical share allows with PLANT_SUBSTEPS_MAX
@@ -1051,30 +767,32 @@ static int resolve_substeps(ctx_t *c, scenario_t *sc) {
         j_min *= 1.1;
         q.mech.j = j_min;
       }
-      return fail(c, "mechanics.j",
-                  "the plant cannot integrate this inertia at this PWM period: the rotor against "
-                  "the PM flux (and the friction) needs %d integration steps per period, at most "
-                  "%d: at least %.3g kg m^2 (got %.3g)",
-                  need, PLANT_SUBSTEPS_MAX, j_min, p->mech.j);
+      return scn_fail(
+          c, "mechanics.j",
+          "the plant cannot integrate this inertia at this PWM period: the rotor against "
+          "the PM flux (and the friction) needs %d integration steps per period, at most "
+          "%d: at least %.3g kg m^2 (got %.3g)",
+          need, PLANT_SUBSTEPS_MAX, j_min, p->mech.j);
     }
     if (need > PLANT_SUBSTEPS_MAX) {
       const char *key = p->machine.map != NULL           ? "machine.map"
                         : c->ls_given                    ? "machine.ls"
                         : p->machine.ld <= p->machine.lq ? "machine.ld"
                                                          : "machine.lq";
-      return fail(c, key,
-                  "the plant cannot integrate this machine at this PWM period: its electrical "
-                  "time constant L/R_s (%.3g s with L = %.3g H) needs %d integration steps per "
-                  "period, at most %d",
-                  lmin / p->machine.rs, lmin, need, PLANT_SUBSTEPS_MAX);
+      return scn_fail(c, key,
+                      "the plant cannot integrate this machine at this PWM period: its electrical "
+                      "time constant L/R_s (%.3g s with L = %.3g H) needs %d integration steps per "
+                      "period, at most %d",
+                      lmin / p->machine.rs, lmin, need, PLANT_SUBSTEPS_MAX);
     }
     p->inverter.substeps = need;
   } else if (p->inverter.substeps < need) {
-    return fail(c, "inverter.substeps",
-                "%d steps per period are unstable for this machine (h R_s / L_min = %.2f > %g): "
-                "at least %d, or leave it out (chosen automatically)",
-                p->inverter.substeps, p->ts / p->inverter.substeps * p->machine.rs / lmin,
-                PLANT_HR_MAX, need);
+    return scn_fail(
+        c, "inverter.substeps",
+        "%d steps per period are unstable for this machine (h R_s / L_min = %.2f > %g): "
+        "at least %d, or leave it out (chosen automatically)",
+        p->inverter.substeps, p->ts / p->inverter.substeps * p->machine.rs / lmin, PLANT_HR_MAX,
+        need);
   }
   return 0;
 }
@@ -1152,31 +870,33 @@ static int check_star(ctx_t *c, const cJSON *root, scenario_t *sc) {
    * 3.3's machine: 1.15) */
   if (!(lz > 0.0 && lz <= 2.0 * g0)) {
     static const char *const k0[] = {"star_m0", NULL};
-    return fail(c, machine_key(m, k0),
-                "%g H gives the zero-sequence inductance L0 + 2 M0 = (ld + lq)/2 + 3 M0 = %.4g H, "
-                "%.3g times (ld + lq)/2 (%.4g H): a star winding's is leakage and harmonics only, "
-                "in (0, 2] times (M0 in (%.4g, %.4g] H; a unit error?)",
-                m0, lz, lz / g0, g0, -g0 / 3.0, g0 / 3.0);
+    return scn_fail(
+        c, machine_key(m, k0),
+        "%g H gives the zero-sequence inductance L0 + 2 M0 = (ld + lq)/2 + 3 M0 = %.4g H, "
+        "%.3g times (ld + lq)/2 (%.4g H): a star winding's is leakage and harmonics only, "
+        "in (0, 2] times (M0 in (%.4g, %.4g] H; a unit error?)",
+        m0, lz, lz / g0, g0, -g0 / 3.0, g0 / 3.0);
   }
   plant_machine_t q = *pm;
   q.aniso.amp_iq = 0.0;
   if (!(fabs(l2 - m2) > 1e-9 * l0)) {
     static const char *const k2[] = {"star_p", "star_m2", "ld", "lq", NULL};
-    return fail(c, machine_key(m, k2),
-                "the (3.3) matrix carries no position: L2 = M2 (%.4g H) makes a = b = 0 in (3.7)",
-                m2);
+    return scn_fail(
+        c, machine_key(m, k2),
+        "the (3.3) matrix carries no position: L2 = M2 (%.4g H) makes a = b = 0 in (3.7)", m2);
   }
   if (!plant_aniso_ok(&q)) {
     double lo, hi;
     if (star_p && star_p_range(pm, l2, &lo, &hi)) {
-      return fail(c, "machine.star_p",
-                  "%.3g: with L0 %.4g, M0 %.4g, L2 %.4g H kept (Fig. 3.3's split) the (3.3) matrix "
-                  "is not positive definite at every angle (no inductance matrix): star_p in "
-                  "(%.3f, %.3f) with these",
-                  (pm->ld - pm->lq) / (pm->ld + pm->lq), l0, m0, l2, lo, hi);
+      return scn_fail(
+          c, "machine.star_p",
+          "%.3g: with L0 %.4g, M0 %.4g, L2 %.4g H kept (Fig. 3.3's split) the (3.3) matrix "
+          "is not positive definite at every angle (no inductance matrix): star_p in "
+          "(%.3f, %.3f) with these",
+          (pm->ld - pm->lq) / (pm->ld + pm->lq), l0, m0, l2, lo, hi);
     }
     static const char *const km[] = {"star_p", "star_m2", "star_m0", "ld", "lq", "ls", NULL};
-    return fail(
+    return scn_fail(
         c, machine_key(m, km),
         "the (3.3) matrix of ld %.4g, lq %.4g, star_m0 %.4g, star_m2 %.4g H is not positive "
         "definite at every angle (no inductance matrix)",
@@ -1201,11 +921,12 @@ static int check_star(ctx_t *c, const cJSON *root, scenario_t *sc) {
         bad = i_q;
       }
     }
-    return fail(c, "machine.star_amp_iq",
-                "%g 1/A scales L2 and M2 by 1 + %g |i_q|: the (3.3) matrix stops being positive "
-                "definite at |i_q| = %.3g A, below controller.i_trip (%g A), the current the plant "
-                "may carry before the drive trips: lower star_amp_iq or i_trip",
-                amp, amp, ok, i_lim);
+    return scn_fail(
+        c, "machine.star_amp_iq",
+        "%g 1/A scales L2 and M2 by 1 + %g |i_q|: the (3.3) matrix stops being positive "
+        "definite at |i_q| = %.3g A, below controller.i_trip (%g A), the current the plant "
+        "may carry before the drive trips: lower star_amp_iq or i_trip",
+        amp, amp, ok, i_lim);
   }
   /* the self and mutual terms turned apart by the load: an inductance
    * matrix at every load up to i_trip */
@@ -1214,12 +935,12 @@ static int check_star(ctx_t *c, const cJSON *root, scenario_t *sc) {
       const double i_q = i_lim * k / STAR_LOAD_STEPS;
       if (!plant_aniso_ok_at(pm, i_q)) {
         static const char *const ks[] = {"star_phi_self", "star_phi_mutual", NULL};
-        return fail(c, machine_key(m, ks),
-                    "star_phi_self %g, star_phi_mutual %g rad/A turn the self and mutual terms "
-                    "apart by %.3g rad at |i_q| = %.3g A, within controller.i_trip (%g A): the "
-                    "(3.3) matrix is not positive definite there (no inductance matrix)",
-                    pm->aniso.phi_self, pm->aniso.phi_mut,
-                    (pm->aniso.phi_self - pm->aniso.phi_mut) * i_q, i_q, i_lim);
+        return scn_fail(c, machine_key(m, ks),
+                        "star_phi_self %g, star_phi_mutual %g rad/A turn the self and mutual terms "
+                        "apart by %.3g rad at |i_q| = %.3g A, within controller.i_trip (%g A): the "
+                        "(3.3) matrix is not positive definite there (no inductance matrix)",
+                        pm->aniso.phi_self, pm->aniso.phi_mut,
+                        (pm->aniso.phi_self - pm->aniso.phi_mut) * i_q, i_q, i_lim);
       }
     }
   }
@@ -1251,13 +972,13 @@ static int check_star(ctx_t *c, const cJSON *root, scenario_t *sc) {
     if (fabs(p0) < 0.5 && !(fabs(p_max) < 0.5)) {
       static const char *const kl[] = {"star_amp_iq", "star_phi_self", "star_phi_mutual",
                                        "star_phi_iq", NULL};
-      return fail(c, machine_key(m, kl),
-                  "the star point's p = b/a reaches %.3g (3.7) at |i_q| = %.3g A (load scale "
-                  "%.3g, phase shifts phi_a %.3g, phi_b %.3g rad of (3.97)), |p| >= 1/2 from "
-                  "%.3g A, within controller.i_trip (%g A): the IVD needs |p| < 1/2 at every "
-                  "load (Theorem 1: no convergence otherwise; the drive's dfc_b holds the "
-                  "unloaded p %.3g): lower the load's scale or i_trip",
-                  p_max, i_at, k_at, pa_at, pb_at, i_half, i_lim, p0);
+      return scn_fail(c, machine_key(m, kl),
+                      "the star point's p = b/a reaches %.3g (3.7) at |i_q| = %.3g A (load scale "
+                      "%.3g, phase shifts phi_a %.3g, phi_b %.3g rad of (3.97)), |p| >= 1/2 from "
+                      "%.3g A, within controller.i_trip (%g A): the IVD needs |p| < 1/2 at every "
+                      "load (Theorem 1: no convergence otherwise; the drive's dfc_b holds the "
+                      "unloaded p %.3g): lower the load's scale or i_trip",
+                      p_max, i_at, k_at, pa_at, pb_at, i_half, i_lim, p0);
     }
   }
   /* the drive's a against the matrix's: a's sign is L2 - M2's (3.7); the
@@ -1267,10 +988,11 @@ static int check_star(ctx_t *c, const cJSON *root, scenario_t *sc) {
   plant_aniso_ab(pm, &a, &b);
   const double da = (double)sc->drive.dfc_a;
   if (ctl != NULL && cJSON_GetObjectItemCaseSensitive(ctl, "dfc_a") != NULL && da * a <= 0.0) {
-    return fail(c, "controller.dfc_a",
-                "%g has the opposite sign of the machine's star-point a = %.4g ((3.7): the sign of "
-                "L2 - M2 = %.4g H): the angle would be 90 degrees (electrical) off with no fault",
-                da, a, l2 - m2);
+    return scn_fail(
+        c, "controller.dfc_a",
+        "%g has the opposite sign of the machine's star-point a = %.4g ((3.7): the sign of "
+        "L2 - M2 = %.4g H): the angle would be 90 degrees (electrical) off with no fault",
+        da, a, l2 - m2);
   }
   if (ctl == NULL || cJSON_GetObjectItemCaseSensitive(ctl, "dfc_b") == NULL) {
     static const char *const kp[] = {"star_p", "star_m2", "ld", "lq", "star_m0", NULL};
@@ -1297,22 +1019,24 @@ static int check_map_range(ctx_t *c, const scenario_t *sc, const char *map_key) 
   const double id_lo = (double)fm.id0, id_hi = (double)fm.id0 + (double)fm.did * (fm.nd - 1u);
   const double iq_lo = (double)fm.iq0, iq_hi = (double)fm.iq0 + (double)fm.diq * (fm.nq - 1u);
   if (id_lo > -i_max + tol || id_hi < -tol || iq_lo > -i_max + tol || iq_hi < i_max - tol) {
-    return fail(c, "controller.i_max",
-                "%g A reaches beyond the flux map %s (i_d %g .. %g A, i_q %g .. %g A): the drive "
-                "needs i_d from -i_max to 0 and i_q from -i_max to i_max inside it (the tables "
-                "would be extrapolated): at most %g A with this map%s",
-                i_max, map_key, id_lo, id_hi, iq_lo, iq_hi, fmin(fmin(-id_lo, -iq_lo), iq_hi),
-                id_hi < -tol ? " (and the map must reach i_d = 0)" : "");
+    return scn_fail(
+        c, "controller.i_max",
+        "%g A reaches beyond the flux map %s (i_d %g .. %g A, i_q %g .. %g A): the drive "
+        "needs i_d from -i_max to 0 and i_q from -i_max to i_max inside it (the tables "
+        "would be extrapolated): at most %g A with this map%s",
+        i_max, map_key, id_lo, id_hi, iq_lo, iq_hi, fmin(fmin(-id_lo, -iq_lo), iq_hi),
+        id_hi < -tol ? " (and the map must reach i_d = 0)" : "");
   }
   /* the unit check of `fluxdrive map check --i-max` (docs/flux-maps.md): a
    * grid a hundred times beyond the current limit is a unit error (mA) */
   const double i_grid = fmax(fmax(-id_lo, id_hi), fmax(-iq_lo, iq_hi));
   if (i_grid > 100.0 * i_max) {
-    return fail(c, map_key,
-                "currents implausible (unit?): the grid reaches %g A, %g times controller.i_max "
-                "(%g A): currents in mA? state current_unit \"mA\" in the file (or convert it "
-                "with fluxdrive map convert --current-unit mA)",
-                i_grid, i_grid / i_max, i_max);
+    return scn_fail(
+        c, map_key,
+        "currents implausible (unit?): the grid reaches %g A, %g times controller.i_max "
+        "(%g A): currents in mA? state current_unit \"mA\" in the file (or convert it "
+        "with fluxdrive map convert --current-unit mA)",
+        i_grid, i_grid / i_max, i_max);
   }
   return 0;
 }
@@ -1330,7 +1054,7 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
     }
     snprintf(err, errlen, "%s: line %d: not valid JSON (or text after the top-level object)",
              origin, line);
-    utf8_clean(err);
+    scn_utf8_clean(err);
     return -1;
   }
   /* the table's walk from its root: the top-level keys, then the sections
@@ -1354,17 +1078,19 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
   sc->plant.dclink.v_source = profile_eval(&sc->v_source, 0.0);
   /* the drive's protection range (v_dc_max at most 1e4 V) bounds the link */
   if (!(sc->plant.dclink.v_source > 0.0 && sc->plant.dclink.v_source <= 1e4)) {
-    return fail(&c, "dc_link.voltage", "must be in (0, 10000] V at t = 0 (got %g)",
-                sc->plant.dclink.v_source);
+    return scn_fail(&c, "dc_link.voltage", "must be in (0, 10000] V at t = 0 (got %g)",
+                    sc->plant.dclink.v_source);
   }
   const pos_source_row_t *ps = pos_source(sc->drive.pos_source);
   if (ps != NULL && (ps->caps & POS_CAP_GATED) != 0u &&
       sc->plant.inverter.model != PLANT_INV_SWITCHING) {
-    return fail(&c, "inverter.model",
-                "a star-point position source needs the switching model (the DFC window's edges)");
+    return scn_fail(
+        &c, "inverter.model",
+        "a star-point position source needs the switching model (the DFC window's edges)");
   }
   if (ps != NULL && (ps->caps & POS_CAP_GATED) != 0u && !sc->board.asym_edges) {
-    return fail(&c, "board", "a star-point position source needs a board with asymmetric edges");
+    return scn_fail(&c, "board",
+                    "a star-point position source needs a board with asymmetric edges");
   }
   /* the star-point circuit settles within the sample's delay after the
    * edge (issue 23: the fabbri2022 presets trip `position` from a settling
@@ -1374,35 +1100,37 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
    * (controller.dfc_t_meas: drive_config_check), named there */
   if (ps != NULL && (ps->caps & POS_CAP_GATED) != 0u && settle > 0.0 &&
       sc->plant.sensors.star_tau > STAR_TAU_SHARE * settle * (1.0 + 1e-6)) {
-    return fail(&c, "sensors.star_tau",
-                "%g s: the star-point sample at controller.dfc_t_meas (%g s) after the edge, less "
-                "the dead time (%g s), leaves the circuit %.2g time constants to settle: at "
-                "least %g (star_tau <= %g s; the position trips from 4 on)",
-                sc->plant.sensors.star_tau, (double)sc->drive.dfc_t_meas,
-                sc->plant.inverter.dead_time, settle / sc->plant.sensors.star_tau,
-                1.0 / STAR_TAU_SHARE, STAR_TAU_SHARE * settle);
+    return scn_fail(
+        &c, "sensors.star_tau",
+        "%g s: the star-point sample at controller.dfc_t_meas (%g s) after the edge, less "
+        "the dead time (%g s), leaves the circuit %.2g time constants to settle: at "
+        "least %g (star_tau <= %g s; the position trips from 4 on)",
+        sc->plant.sensors.star_tau, (double)sc->drive.dfc_t_meas, sc->plant.inverter.dead_time,
+        settle / sc->plant.sensors.star_tau, 1.0 / STAR_TAU_SHARE, STAR_TAU_SHARE * settle);
   }
   if (resolve_substeps(&c, sc) != 0) {
     return -1;
   }
   const char *field = "";
   if (plant_check(&sc->plant, &field) != 0) {
-    return fail(&c, scenario_key_of(field), "invalid plant parameter (see docs/scenarios.md)");
+    return scn_fail(&c, scenario_key_of(field), "invalid plant parameter (see docs/scenarios.md)");
   }
   /* the ADC ranges the drive's HAL reports (hal_caps_t): the sensors' */
   sc->board.i_full_scale = (float)sc->plant.sensors.i_full_scale;
   sc->board.v_full_scale = (float)sc->plant.sensors.v_full_scale;
   if (!(sc->drive.i_trip < sc->board.i_full_scale)) {
-    return fail(&c, "controller.i_trip",
-                "must be below the current ADC's full scale sensors.i_full_scale (%g A): a current "
-                "beyond it reads as the full scale and would never trip (got %g A)",
-                sc->plant.sensors.i_full_scale, (double)sc->drive.i_trip);
+    return scn_fail(
+        &c, "controller.i_trip",
+        "must be below the current ADC's full scale sensors.i_full_scale (%g A): a current "
+        "beyond it reads as the full scale and would never trip (got %g A)",
+        sc->plant.sensors.i_full_scale, (double)sc->drive.i_trip);
   }
   if (!(sc->drive.v_dc_max < sc->board.v_full_scale)) {
-    return fail(&c, "controller.v_dc_max",
-                "must be below the DC-link ADC's full scale sensors.v_full_scale (%g V): a voltage "
-                "beyond it reads as the full scale and would never trip (got %g V)",
-                sc->plant.sensors.v_full_scale, (double)sc->drive.v_dc_max);
+    return scn_fail(
+        &c, "controller.v_dc_max",
+        "must be below the DC-link ADC's full scale sensors.v_full_scale (%g V): a voltage "
+        "beyond it reads as the full scale and would never trip (got %g V)",
+        sc->plant.sensors.v_full_scale, (double)sc->drive.v_dc_max);
   }
   /* the set as a whole, reported under the scenario key that sets the
    * field (drive_param_table.h) */
@@ -1414,14 +1142,14 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
     const char *key = p != NULL ? p->scenario : e.field;
     if (strcmp(e.field, "dfc_b") == 0 && c.p_key[0] != '\0') {
       /* the drive's b follows the machine's star point: name what set it */
-      return fail(&c, c.p_key, "the star point's p = b/a = %.3g (3.7), the drive's dfc_b: %s",
-                  (double)(sc->drive.dfc_b / sc->drive.dfc_a), e.reason);
+      return scn_fail(&c, c.p_key, "the star point's p = b/a = %.3g (3.7), the drive's dfc_b: %s",
+                      (double)(sc->drive.dfc_b / sc->drive.dfc_a), e.reason);
     }
     if (p != NULL && strcmp(e.reason, "outside its range") == 0) {
-      return fail(&c, key, "must be in [%g, %g] (got %g)", (double)p->min, (double)p->max,
-                  (double)drive_param_get(&sc->drive, p));
+      return scn_fail(&c, key, "must be in [%g, %g] (got %g)", (double)p->min, (double)p->max,
+                      (double)drive_param_get(&sc->drive, p));
     }
-    return fail(&c, key, "%s", e.reason);
+    return scn_fail(&c, key, "%s", e.reason);
   }
   return 0;
 }

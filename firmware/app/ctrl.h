@@ -2,9 +2,10 @@
  * ctrl.h - the control laws behind one table. A law is a row
  * {name, capabilities, check, init, reset, step} (ctrl_law_t); its state
  * lives in a union (one law runs at a time, RAM of the smallest board); the
- * table (ctrl_laws.c) has one row per entry of DRIVE_LAW_LIST
- * (drive_enums.h). Adding a law: its module (law_*.c with its row), one
- * line in DRIVE_LAW_LIST and one in ctrl_laws.c (docs/architecture.md).
+ * table (ctrl.c, `laws`) is generated from DRIVE_LAW_LIST (drive_enums.h):
+ * one row ctrl_law_<name> per entry (declared in ctrl_laws.h). Adding a
+ * law: its module (law_*.c defining its row) and one line in
+ * DRIVE_LAW_LIST (docs/architecture.md).
  *
  * The drive hands a law one sample (currents, angle, speed, the voltage
  * available, references) and gets the alpha-beta voltage for the next
@@ -25,6 +26,7 @@
 #include "math/fast_trig.h"
 #include "math/frames.h"
 #include "model/machine.h"
+#include "signal_row.h"
 
 /* Law-specific telemetry (zero where a law has no such quantity). */
 typedef struct {
@@ -111,6 +113,10 @@ typedef struct {
   void (*reset)(ctrl_state_t *s); /* on enable: observers and integrators restart */
   /* one period; writes every field of *out */
   void (*step)(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *in, ctrl_out_t *out);
+  /* the law's own signals beyond ctrl_telemetry_t (logs, docs/log-format.md):
+   * getters on its ctrl_state_t, read after the ISR; NULL, 0: none */
+  const signal_row_t *signals;
+  unsigned n_signals;
 } ctrl_law_t;
 
 typedef struct {

@@ -62,6 +62,7 @@
 #include "math/cordic_q31.h"
 #include "math/fd_math.h"
 #include "math/frames.h"
+#include "pos_dfc_signals.h"
 #include "pos_source.h"
 
 enum { TRACK_PLL = 0, TRACK_KF = 1, TRACK_EKF = 2 };
@@ -585,7 +586,9 @@ FD_COLD static const char *pdfc_check_cfg(const drive_config_t *cfg, const char 
                                            pdfc_update,                                            \
                                            pdfc_align,                                             \
                                            pdfc_check_cfg,                                         \
-                                           pdfc_hold}
+                                           pdfc_hold,                                              \
+                                           pos_dfc_signals,                                        \
+                                           POS_DFC_N_SIGNALS}
 POS_DFC_ROW(dfc);
 POS_DFC_ROW(dfc_inv);
 POS_DFC_ROW(ivd);

@@ -57,8 +57,10 @@ static void enc_update(pos_state_t *s, const drive_config_t *cfg, const hal_samp
     angle_pll_reset(pll, th, 0.0f);
     s->enc.started = true;
   }
-  out->health = fabsf(frames_wrap_pi(th - pll->theta)); /* measured - predicted */
-  angle_pll_update(pll, th);
+  /* th is finite (frames_wrap_pi): angle_pll_update's error, taken once */
+  const float e = frames_wrap_pi(th - pll->theta);
+  out->health = fabsf(e); /* measured - predicted */
+  angle_pll_update_err(pll, e);
   out->theta = th;
   out->omega = pll->omega;
   out->rate = pll->omega_rate;
@@ -86,5 +88,5 @@ FD_COLD static const char *enc_check(const drive_config_t *cfg, const char **fie
 }
 
 /* no angle at standstill: no held start */
-const pos_source_row_t pos_source_encoder = {POS_CAP_ALIGN, enc_init,  enc_reset, enc_update,
-                                             enc_align,     enc_check, NULL};
+const pos_source_row_t pos_source_encoder = {
+    POS_CAP_ALIGN, enc_init, enc_reset, enc_update, enc_align, enc_check, NULL, NULL, 0u};

@@ -25,6 +25,7 @@
 #include "estimation/kf_mech.h"
 #include "estimation/rls_ab.h"
 #include "hal.h"
+#include "signal_row.h"
 
 typedef struct {
   float theta;  /* electrical angle at t [rad], (-pi, pi] */
@@ -113,6 +114,10 @@ typedef struct {
    * d-axis saturation pulses): take the branch of the estimate nearest it.
    * NULL: the source cannot start held (it has no angle at standstill). */
   void (*hold)(pos_state_t *s, float theta);
+  /* the source's own signals (logs, docs/log-format.md): getters on its
+   * pos_state_t, read after the ISR; NULL, 0: none */
+  const signal_row_t *signals;
+  unsigned n_signals;
 } pos_source_row_t;
 
 /* The row of a source (NULL out of range). */

@@ -35,6 +35,7 @@
 #include "scenario.h"
 #include "scenario_keys.h"
 #include "sil_preempt.h"
+#include "signals_json.h"
 #include "sil_run.h"
 #include "summary.h"
 
@@ -85,7 +86,7 @@ static int parse_long(const char *opt, const char *s, long lo, long hi, long *ou
 typedef struct {
   const char *scenario, *log_path, *summary_path, *record_path, *dump_path, *can;
   const char *keys_doc, *keys_doc_write;
-  int bench, print_config, print_params, realtime, keys, help;
+  int bench, print_config, print_params, print_signals, realtime, keys, help;
   long decimate, preempt_n, seed, node, can_timeout, max_gap_us;
 } cli_t;
 
@@ -128,6 +129,10 @@ static const option_t options[] = {
     {"--print-config", NULL, "print the resolved parameters (JSON) and exit", FLAG(print_config)},
     {"--print-params", NULL, "print the parameter table (JSON; no scenario needed) and exit",
      FLAG(print_params)},
+    {"--print-signals", NULL,
+     "print the signal tables (log columns, CAN signals, PIL fields: JSON; no scenario needed, "
+     "signals_json.h) and exit",
+     FLAG(print_signals)},
     {"--dump-scenario", "PATH", "write the parsed scenario's bytes (scripts/scenario_equiv.py)",
      PATH(dump_path)},
     {"--record-isr", "PATH.bin", "record every ISR for the PIL replay (docs/pil.md)",
@@ -210,8 +215,8 @@ int main(int argc, char **argv) {
   const char *const scenario = cli.scenario, *const log_path = cli.log_path;
   const char *const summary_path = cli.summary_path, *const record_path = cli.record_path;
   const char *const can = cli.can;
-  if (cli.print_params) {
-    char *js = params_json();
+  if (cli.print_params || cli.print_signals) {
+    char *js = cli.print_params ? params_json() : signals_json();
     if (js == NULL) {
       return 1;
     }

@@ -640,6 +640,32 @@ static void syr_machine_runs_foc_only(void **state) {
   assert_non_null(strstr(err.reason, "PM machine"));
 }
 
+/* The short's flux bound of a reluctance machine (no magnet) at start-up:
+ * the same as from a second configuration of the same set, and not 0 (it
+ * was 0 at start-up: the bisection took the previous set's flux scale, and
+ * every short was refused until a second set was taken). */
+static void syr_short_bound_from_its_own_set(void **state) {
+  (void)state;
+  drive_config_t cfg;
+  drive_config_default(&cfg);
+  cfg.pole_pairs = 2.0f;
+  cfg.rs = 6.8f;
+  cfg.ld = 0.05f;
+  cfg.lq = 0.25f;
+  cfg.lambda_m = 0.0f;
+  cfg.flux_min = 0.0f;
+  cfg.law = DRIVE_LAW_FOC;
+  setup_with(&cfg);
+  const float first = drv.safe.psi_max;
+  assert_true(first > 0.1f * drv.flux_scale);
+  drive_config_err_t err;
+  cfg.speed_max *= 0.99f; /* a new set of the same machine, taken with the gates off */
+  assert_int_equal(drive_request_config(&drv, &cfg, &err), 0);
+  run_isrs(2);
+  assert_float_equal(drv.cfg.speed_max, cfg.speed_max, 0.0f);
+  assert_float_equal(drv.safe.psi_max, first, 1e-6f * first);
+}
+
 /* Parameter requests: applied by the ISR; an IDLE parameter is refused
  * while running, a LIVE one applied at the next ISR. */
 static void parameter_requests_are_applied_by_the_isr(void **state) {
@@ -856,6 +882,7 @@ int main(void) {
                                      cmocka_unit_test(refused_law_switch_leaves_the_law_as_it_was),
                                      cmocka_unit_test(law_switch_waits_for_the_pending_set),
                                      cmocka_unit_test(syr_machine_runs_foc_only),
+                                     cmocka_unit_test(syr_short_bound_from_its_own_set),
                                      cmocka_unit_test(parameter_requests_are_applied_by_the_isr),
                                      cmocka_unit_test(watchdog_needs_both_contexts),
                                      cmocka_unit_test(alignment_sets_the_encoder_offset),

@@ -267,7 +267,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--check-cycles", type=_percent, metavar="PCT",
                    help="fail when the DB-DFVC worst case's estimated cycles exceed PCT %% of "
                    "the 10625-cycle budget (170 MHz / 16 kHz)")
-    p.add_argument("--board-elf", metavar="PATH", help="board image (e.g. build/stm32g474/hal/"
+    p.add_argument("--board-elf", metavar="PATH", help="board image (e.g. build/stm32g474/boards/"
                    "stm32g4/fluxdrive-g474.elf): add the ISR wrapper, exception and board HAL "
                    "(fluxdrive cycles-board) to a board estimate")
     p.add_argument("--cpi", type=float, default=None, help="legacy: also show the worst case at "
@@ -285,11 +285,18 @@ def build_parser() -> argparse.ArgumentParser:
     mx.add_argument("--write", action="store_true", help="regenerate the files that differ")
     mx.add_argument("--check", action="store_true", help="exit 1 when a file differs")
     p.set_defaults(func=lambda a: __import__("fluxdrive.params").params.main(a))
+    p = sub.add_parser("signals", help="the signal tables into docs/log-format.md, the DBC's "
+                       "signal comments and the tools' signal table")
+    p.add_argument("--sil", metavar="PATH", help=sil_help)
+    mx = p.add_mutually_exclusive_group()
+    mx.add_argument("--write", action="store_true", help="regenerate the files that differ")
+    mx.add_argument("--check", action="store_true", help="exit 1 when a file differs")
+    p.set_defaults(func=lambda a: __import__("fluxdrive.signals").signals.main(a))
 
     p = sub.add_parser("cycles-board", help="cycle bound of the board's ISR path outside "
                        "drive_isr (wrapper, exception, register HAL)")
     p.add_argument("elf", metavar="ELF", help="board image, e.g. "
-                   "build/stm32g474/hal/stm32g4/fluxdrive-g474.elf")
+                   "build/stm32g474/boards/stm32g4/fluxdrive-g474.elf")
     p.set_defaults(func=lambda a: __import__("fluxdrive.cm4_cycles").cm4_cycles.main_board(a))
     from fluxdrive.can.cli import add_parser as add_can_parser  # fluxdrive can ...
     from fluxdrive.fluxmap.cli import add_parser as add_map_parser  # fluxdrive map ...

@@ -435,12 +435,24 @@ static void sw_integrate(plant_t *pl, sw_cfg_t *cf, double *t, double *x, double
   const double hmax = pl->p.ts / pl->aux.steps; /* more at speed (plant.h) */
   const int nsub = (int)ceil(len / hmax - 1e-9);
   const double h = len / (nsub > 0 ? nsub : 1);
+  /* the event functions and the star point at the end of a step without
+   * event are those at the start of the next one (same t, x and leg
+   * configuration) */
+  double z_next[EV_N], vs_next = 0.0;
+  int z_known = 0;
   for (int k = 0; k < (nsub > 0 ? nsub : 1); k++) {
     double rem = h;
     for (int guard = 0; rem > 1e-12 * pl->p.ts; guard++) {
       double x1[X_N], z0[EV_N], z1[EV_N];
-      const double vs0 = star ? sw_star(pl, cf, *t, x) : 0.0;
-      sw_events(pl, cf, *t, x, z0);
+      double vs0 = 0.0;
+      if (z_known) {
+        memcpy(z0, z_next, sizeof z0);
+        vs0 = vs_next;
+      } else {
+        sw_events(pl, cf, *t, x, z0);
+        vs0 = star ? sw_star(pl, cf, *t, x) : 0.0;
+      }
+      z_known = 0;
       sw_rk4(pl, cf, *t, x, rem, x1);
       sw_events(pl, cf, *t + rem, x1, z1);
       int best = -1;
@@ -456,9 +468,12 @@ static void sw_integrate(plant_t *pl, sw_cfg_t *cf, double *t, double *x, double
       }
       if (best < 0) {
         memcpy(x, x1, sizeof x1);
+        memcpy(z_next, z1, sizeof z1);
+        z_known = 1;
         *t += rem;
         if (star) {
-          plant_star_filter(pl, vs0, sw_star(pl, cf, *t, x), rem);
+          vs_next = sw_star(pl, cf, *t, x);
+          plant_star_filter(pl, vs0, vs_next, rem);
         }
         break;
       }

@@ -142,7 +142,7 @@ int plant_check(const plant_params_t *p, const char **field) {
 }
 
 static double wrap_2pi(double a) {
-  a -= PLANT_TWO_PI * floor(a * (1.0 / PLANT_TWO_PI));
+  a -= PLANT_TWO_PI * plant_floor(a * (1.0 / PLANT_TWO_PI));
   return a >= PLANT_TWO_PI ? 0.0 : a;
 }
 

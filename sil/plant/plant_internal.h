@@ -45,6 +45,19 @@ static inline void plant_cos_sin_near(double th_ref, double c_ref, double s_ref,
   *s = s_ref * cd + c_ref * sd;
 }
 
+/* floor(y), bit for bit, without the libm call (x86-64 without SSE4.1 has no
+ * rounding instruction: floor is a call on every period's wraps, ADC codes
+ * and encoder count): the truncation, one lower for a negative fraction;
+ * libm for |y| >= 2^52 (already an integer) and NaN; -0.0 gives +0.0, which
+ * every caller adds to or scales. */
+static inline double plant_floor(double y) {
+  if (!(y > -4503599627370496.0 && y < 4503599627370496.0)) {
+    return floor(y);
+  }
+  const double t = (double)(long long)y;
+  return t > y ? t - 1.0 : t;
+}
+
 /* Integration state vector. The last four entries are integrals over the
  * period (reset to 0 at its start) from which the period averages are taken. */
 enum {

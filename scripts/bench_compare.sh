@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Side-by-side SIL real-time factor: this tree against another revision.
 #
-#   scripts/bench_compare.sh [-n ROUNDS] REV [SCENARIO...]
+#   scripts/bench_compare.sh [-n ROUNDS] [-i] REV [SCENARIO...]
 #
 # Builds REV's release runner (git archive of REV into
 # ${TMPDIR:-/tmp}/fluxdrive-bench/<commit>, cmake preset host-release, kept
@@ -14,17 +14,25 @@
 # A scenario is given as a path in this tree; REV runs its own file at the
 # same path when it has one (the schema may differ), else this tree's.
 # Default scenarios: default.json, foc_speed_load.json.
+# -i adds the deterministic figure: instructions per simulated period of
+# each runner (valgrind --tool=callgrind, total Ir / steps), the same on any
+# load; a run of 15-25 ms is at the mercy of a loaded machine's scheduler,
+# the instruction count is not.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
 
 rounds=9
-if [[ "${1:-}" == "-n" ]]; then
-  rounds=$2
-  shift 2
-fi
+instr=0
+while [[ "${1:-}" == -* ]]; do
+  case $1 in
+    -n) rounds=$2; shift 2 ;;
+    -i) instr=1; shift ;;
+    *) echo "unknown option $1" >&2; exit 2 ;;
+  esac
+done
 if [[ $# -lt 1 ]]; then
-  sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'
+  awk 'NR > 1 && !/^#/ {exit} NR > 1 {sub(/^# ?/, ""); print}' "$0"
   exit 2
 fi
 rev=$1
@@ -55,6 +63,12 @@ rtf_of() { # runner scenario -> real-time factor
   "$1" "$2" --bench | awk '/real-time factor/ {print $NF}'
 }
 
+ir_per_period() { # runner scenario -> instructions per simulated period
+  local out
+  out=$(valgrind --tool=callgrind --callgrind-out-file=/dev/null "$1" "$2" --bench 2>&1)
+  awk '/Collected :/ {ir = $NF} /^steps:/ {n = $2} END {printf "%.0f", ir / n}' <<<"$out"
+}
+
 best() { # the larger of two numbers (awk: floats)
   awk -v a="$1" -v b="$2" 'BEGIN {print (b > a ? b : a)}'
 }
@@ -73,4 +87,10 @@ for scen in "${scenarios[@]}"; do
   done
   printf '%-40s %10.2f %10.2f %6.2fx\n' "$(basename "$scen")" "$b" "$t" \
     "$(awk -v a="$b" -v c="$t" 'BEGIN {print (a > 0 ? c / a : 0)}')"
+  if [[ $instr == 1 ]]; then
+    bi=$(ir_per_period "$base_sil" "$base_scen")
+    ti=$(ir_per_period "$this_sil" "$ROOT/$scen")
+    printf '%-40s %10d %10d %6.2fx  (instructions per period, callgrind)\n' "" "$bi" "$ti" \
+      "$(awk -v a="$bi" -v c="$ti" 'BEGIN {print (c > 0 ? a / c : 0)}')"
+  fi
 done

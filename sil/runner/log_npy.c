@@ -84,14 +84,14 @@ static void fill_row(const sil_step_t *st, double *r) {
   /* the star-point source's last estimate (pos_dfc.c; zeros otherwise):
    * 2 theta after IVD step k, from its unit vector */
   const bool dfc = (st->drive->pos_src->caps & POS_CAP_GATED) != 0u;
-  const float *tr = st->drive->pos_st.dfc.trace;
+  const float *tr = st->drive->pos_st.star.meas.trace;
   double k2[DFC_ITER_MAX + 1u];
   for (unsigned k = 0u; k <= DFC_ITER_MAX; ++k) {
     k2[k] = dfc ? atan2((double)tr[(size_t)2 * k + 1u], (double)tr[(size_t)2 * k]) : 0.0;
   }
-  const float *g = st->drive->pos_st.dfc.sig.g;
+  const float *g = st->drive->pos_st.star.meas.sig.g;
   /* the a, b the IVD used (identified: ivd+kf+rls) */
-  const bool rls = dfc && st->drive->pos_st.dfc.rls_on;
+  const bool rls = dfc && st->drive->pos_st.star.ident != NULL;
   double ld = p->lambda_dq[0], lq = p->lambda_dq[1];
   double flux = hypot(ld, lq);
   /* True stator-flux frame currents: projection of i on lambda_s and its
@@ -140,7 +140,7 @@ static void fill_row(const sil_step_t *st, double *r) {
                     sat.mtpa_angle,
                     sat.mtpv_angle,
                     st->scenario->plant.machine.pole_pairs * (double)st->adc->enc_angle,
-                    dfc ? (double)st->drive->pos_st.dfc.t : 0.0,
+                    dfc ? (double)st->drive->pos_st.star.meas.t : 0.0,
                     dfc ? (double)g[0] : 0.0,
                     dfc ? (double)g[1] : 0.0,
                     dfc ? (double)g[2] : 0.0,
@@ -157,9 +157,9 @@ static void fill_row(const sil_step_t *st, double *r) {
                     p->i_dq_avg[0],
                     p->i_dq_avg[1],
                     tm->load_est,
-                    rls ? (double)st->drive->pos_st.dfc.dc.a : 0.0,
-                    rls ? (double)st->drive->pos_st.dfc.dc.b : 0.0,
-                    dfc ? (double)st->drive->pos_st.dfc.r : 0.0,
+                    rls ? (double)st->drive->pos_st.star.meas.dc.a : 0.0,
+                    rls ? (double)st->drive->pos_st.star.meas.dc.b : 0.0,
+                    dfc ? (double)st->drive->pos_st.star.trk.r : 0.0,
                     st->drive->pos_emf_res,
                     tm->rls_ok ? 1.0 : 0.0};
   memcpy(r, v, sizeof v);

@@ -173,9 +173,7 @@ void pos_star_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample
     dfc_signals_vector(&m->sig, 2.0f * pos_track_omega(s), &v);
     if (warm) {
       const sincos_t w = frames_sincos(2.0f * pos_track_theta(s)); /* the prediction */
-      if (id->step(s, cfg, &v, &w)) {
-        out->rls_ok = id->settled(s, cfg);
-      }
+      id->step(s, cfg, &v, &w, out);
       c2 = w.c;
       s2 = w.s;
       m->trace[0] = c2; /* the start, for logs */

@@ -63,8 +63,8 @@ static void warm_gain(pos_state_t *s) {
  * update per refresh of the whole vector (when component a is the newest:
  * every third period, 5.3 kHz, the thesis's DFC rate): successive updates
  * then share no sample, as the RLS's independent noise assumes. */
-static bool rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v,
-                     const sincos_t *u) {
+static bool rls_update(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v,
+                       const sincos_t *u) {
   rls_ab_t *r = &s->star.id.rls;
   bool upd = false;
   if (s->star.meas.miss == 0u && s->star.meas.sig.last == 0u && s->star.pol.aligned &&
@@ -110,6 +110,14 @@ static bool rls_health(pos_state_t *s, const drive_config_t *cfg) {
   return ok && am > 0.25f * a0 && am < 4.0f * a0 && fabsf(r->x[1]) < POS_DFC_P_MAX * am;
 }
 
+/* One period: the update, and after one the health (rls_ok) */
+static void rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v,
+                     const sincos_t *u, pos_estimate_t *out) {
+  if (rls_update(s, cfg, v, u)) {
+    out->rls_ok = rls_health(s, cfg);
+  }
+}
+
 /* the warm start's gain at the a, b in force (pos_star_align: once per start) */
 FD_COLD static void rls_aligned(pos_state_t *s) {
   warm_gain(s);
@@ -123,4 +131,4 @@ FD_COLD static const char *rls_check(const drive_config_t *cfg, const char **fie
   return NULL;
 }
 
-const pos_ident_t pos_ident_rls = {true, rls_init, rls_step, rls_health, rls_aligned, rls_check};
+const pos_ident_t pos_ident_rls = {true, rls_init, rls_step, rls_aligned, rls_check};

@@ -19,6 +19,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "math/fd_math.h"
 #include "math/frames.h"
 #include "pos_source.h"
 
@@ -68,11 +69,10 @@ struct pos_ident_s {
   bool warm;
   /* the identification's a, b into s->star.meas.dc, and its state */
   void (*init)(pos_state_t *s, const drive_config_t *cfg);
-  /* one period on the vector v at the prediction w (e^{j 2 theta}): true
-   * when a, b moved */
-  bool (*step)(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v, const sincos_t *w);
-  /* after a step that moved them: whether a, b have settled (rls_ok) */
-  bool (*settled)(pos_state_t *s, const drive_config_t *cfg);
+  /* one period on the vector v at the prediction w (e^{j 2 theta}); when
+   * a, b moved, whether they have settled into out->rls_ok */
+  void (*step)(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v, const sincos_t *w,
+               pos_estimate_t *out);
   /* the alignment has ended (the warm start's gain) */
   void (*aligned)(pos_state_t *s);
   const char *(*check)(const drive_config_t *cfg, const char **field);
@@ -91,8 +91,18 @@ static inline float pos_track_omega(const pos_state_t *s) {
   return s->star.trk.u.f[s->star.tracker->omega];
 }
 
-/* The method's configuration from cfg (its a, b: dfc_a, dfc_b) */
-dfc_cfg_t pos_method_cfg(const pos_method_t *m, const drive_config_t *cfg);
+/* The method's configuration from cfg (its a, b: dfc_a, dfc_b); every
+ * period (the live parameters), inlined */
+static inline dfc_cfg_t pos_method_cfg(const pos_method_t *m, const drive_config_t *cfg) {
+  const bool shifted = fabsf(cfg->dfc_phi_a) > 0.0f || fabsf(cfg->dfc_phi_b) > 0.0f;
+  const dfc_cfg_t d = {shifted ? m->shifted : m->plain,
+                       cfg->dfc_a,
+                       cfg->dfc_b,
+                       cfg->dfc_phi_a,
+                       cfg->dfc_phi_b,
+                       cfg->dfc_iter};
+  return d;
+}
 
 /* The star point's functions, for the rows (pos_dfc.c) */
 void pos_star_init(pos_state_t *s, const drive_config_t *cfg);

@@ -132,7 +132,7 @@ void pos_star_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample
     m->dc.a = id_a;
     m->dc.b = id_b;
   }
-  /* one period ahead: this period's edge (header); not without signals
+  /* one period ahead: this period's edge (pos_track.c); not without signals
    * for POS_DFC_COAST periods (gates off: the state is held, not run away
    * on a stale torque and load) */
   if (trk->predict != NULL && m->miss < POS_DFC_COAST) {

@@ -167,7 +167,7 @@ void pos_star_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample
    * docs/dfc.md). From the prediction they continue the last periods'
    * iterations: the error left is (2|p|)^n times the prediction's. */
   const pos_ident_t *id = s->star.ident;
-  const bool warm = id != NULL && id->warm && s->star.pol.aligned;
+  const bool warm = id != NULL && s->star.pol.aligned;
   bool ok = false;
   if (full) { /* sequentiality: the held components turned to the newest */
     dfc_signals_vector(&m->sig, 2.0f * pos_track_omega(s), &v);

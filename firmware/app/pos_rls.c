@@ -131,4 +131,4 @@ FD_COLD static const char *rls_check(const drive_config_t *cfg, const char **fie
   return NULL;
 }
 
-const pos_ident_t pos_ident_rls = {true, rls_init, rls_step, rls_aligned, rls_check};
+const pos_ident_t pos_ident_rls = {rls_init, rls_step, rls_aligned, rls_check};

@@ -63,10 +63,9 @@ struct pos_tracker_s {
   const char *(*check)(const drive_config_t *cfg, const char **field);
 };
 
+/* With an identification, once aligned, the IVD's iterations start from
+ * the tracker's prediction (warm), not from the raw estimate (pos_dfc.c). */
 struct pos_ident_s {
-  /* once aligned the IVD's iterations start from the tracker's prediction
-   * (warm), not from the raw estimate (pos_dfc.c) */
-  bool warm;
   /* the identification's a, b into s->star.meas.dc, and its state */
   void (*init)(pos_state_t *s, const drive_config_t *cfg);
   /* one period on the vector v at the prediction w (e^{j 2 theta}); when

@@ -166,7 +166,7 @@ static float meas_var(const pos_state_t *s, const drive_config_t *cfg) {
  * from 3.1 and 3.2 rad, tests/python/test_start_polarity.py). */
 static float meas_r(const pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v) {
   const float var = meas_var(s, cfg);
-  const bool warm = s->star.ident != NULL && s->star.ident->warm && s->star.pol.aligned;
+  const bool warm = s->star.ident != NULL && s->star.pol.aligned; /* pos_star.h */
   /* (4.29): |Gamma|^2, the b term in it (4.31); the IVD has removed it (4.30) */
   const float g2 = s->star.method->decoupled ? s->star.meas.dc.a * s->star.meas.dc.a
                                              : v->al * v->al + v->be * v->be;

@@ -2,9 +2,14 @@
 """Mutation check of the acceptance and SIL tests (docs/mutation.md).
 
 Each mutant in tests/mutation/mutants.json is a small, deliberate bug put
-into the firmware (an exact text found once in a file, replaced): the
-tests listed with it must notice, i.e. at least one of them must FAIL on
-the mutated build. A mutant no listed test kills is a hole in the tests.
+into the firmware: a text replaced where a marker comment in the source
+anchors it (`/* mut: ID */` in C, `# mut: ID` in Python, on the mutated
+line or the line before it; the text must occur exactly once in the
+marker's line and the REGION_LINES lines after it), so that code moved by a
+refactor carries its mutant with it and the JSON names no file; or, for an
+entry with "file" and no "anchor", an exact text found once in that file.
+The tests listed with it must notice, i.e. at least one of them must FAIL
+on the mutated build. A mutant no listed test kills is a hole in the tests.
 
 The check works on a copy of the source tree (the caller's files are
 never written): it copies the working tree (tracked and untracked files
@@ -66,9 +71,79 @@ TEST_TIMEOUT = 900  # s, one mutant's pytest run (ctest: each test's own TIMEOUT
 # --------------------------------------------------------------- mutants
 @dataclass
 class Edit:
-    file: str
+    file: str | None  # an anchored edit's: the file its marker is in (resolve_anchors)
     find: str
     replace: str
+    anchor: str | None = None  # the marker's name: `mut: NAME`
+
+
+# a marker comment: `mut: NAME` (C /* ... */ or Python #)
+MARK_RE = re.compile(r"(?:/\*|#)\s*mut: ([A-Za-z0-9_.#-]+)")
+REGION_LINES = 12  # the find text lies within the marker's line and this many after it
+MARK_SUFFIXES = (".c", ".h", ".py", ".cmake", ".ld", ".sh")
+
+
+def markers(root: Path) -> dict[str, list[str]]:
+    """Marker name -> the files it appears in (source files of root)."""
+    out: dict[str, list[str]] = {}
+    for rel in source_files(root):
+        if not rel.endswith(MARK_SUFFIXES):
+            continue
+        try:
+            text = (root / rel).read_text()
+        except (OSError, UnicodeDecodeError):
+            continue
+        if "mut: " not in text:
+            continue
+        for m in MARK_RE.finditer(text):
+            out.setdefault(m.group(1), []).append(rel)
+    return out
+
+
+def resolve_anchors(root: Path, mutants: list[Mutant]) -> dict[str, str]:
+    """Sets each anchored edit's file from its marker in root; returns the
+    mutants whose marker is missing or not unique, with the reason."""
+    index = markers(root) if any(e.anchor for m in mutants for e in m.edits) else {}
+    bad: dict[str, str] = {}
+    for m in mutants:
+        for e in m.edits:
+            if e.anchor is None:
+                continue
+            files = index.get(e.anchor, [])
+            if len(files) == 1:
+                e.file = files[0]
+            else:
+                bad[m.id] = (f"marker 'mut: {e.anchor}' "
+                             f"{'not found' if not files else 'found in ' + ', '.join(files)} "
+                             "(must occur exactly once in the tree)")
+    return bad
+
+
+def locate(text: str, e: Edit) -> int | str:
+    """Offset of e's find text in text, or why it cannot be applied."""
+    first = e.find.strip().splitlines()[0] if e.find.strip() else e.find
+    if e.anchor is None:
+        n = text.count(e.find)
+        if n == 1:
+            return text.index(e.find)
+        return (f"find text {'not found' if n == 0 else f'found {n} times'} in {e.file} "
+                f"(must occur exactly once): {first!r}")
+    hits = [m for m in MARK_RE.finditer(text) if m.group(1) == e.anchor]
+    if len(hits) != 1:
+        return f"marker 'mut: {e.anchor}' found {len(hits)} times in {e.file}"
+    start = text.rfind("\n", 0, hits[0].start()) + 1
+    end = start
+    for _ in range(REGION_LINES + 1):
+        nxt = text.find("\n", end)
+        if nxt < 0:
+            end = len(text)
+            break
+        end = nxt + 1
+    n = text.count(e.find, start, end)
+    if n == 1:
+        return text.index(e.find, start, end)
+    return (f"find text {'not found' if n == 0 else f'found {n} times'} within {REGION_LINES} "
+            f"lines of marker 'mut: {e.anchor}' in {e.file} (must occur exactly once): {first!r}")
 
 
 @dataclass
@@ -83,7 +158,7 @@ class Mutant:
 
     @property
     def files(self) -> list[str]:
-        return sorted({e.file for e in self.edits})
+        return sorted({e.file for e in self.edits if e.file})
 
 
 def _text(v) -> str:
@@ -103,10 +178,12 @@ def load_mutants(paths: list[Path]) -> list[Mutant]:
             where = f"{path}: mutant {m.get('id', '?')}"
             try:
                 if "edits" in m:
-                    edits = [Edit(e.get("file", m.get("file")), _text(e["find"]), _text(e["replace"]))
+                    edits = [Edit(e.get("file", m.get("file")), _text(e["find"]), _text(e["replace"]),
+                                  e.get("anchor"))
                              for e in m["edits"]]
                 else:
-                    edits = [Edit(m["file"], _text(m["find"]), _text(m["replace"]))]
+                    edits = [Edit(m.get("file"), _text(m["find"]), _text(m["replace"]),
+                                  m.get("anchor"))]
                 mut = Mutant(m["id"], m["breaks"], list(m["tests"]), edits, list(m.get("targets", [])),
                              m.get("survives_because", ""), path.stem)
             except (KeyError, ValueError) as e:
@@ -117,8 +194,8 @@ def load_mutants(paths: list[Path]) -> list[Mutant]:
                 if not (t.startswith("ctest:") or t.startswith("pytest:")):
                     raise SystemExit(f"mutation_check: {where}: test {t!r} is neither ctest:NAME "
                                      "nor pytest:NODEID")
-            if any(e.file is None for e in edits):
-                raise SystemExit(f"mutation_check: {where}: an edit names no file")
+            if any(e.file is None and e.anchor is None for e in edits):
+                raise SystemExit(f"mutation_check: {where}: an edit names neither an anchor nor a file")
             if any(x.id == mut.id for x in out):
                 raise SystemExit(f"mutation_check: {where}: duplicate id")
             out.append(mut)
@@ -136,15 +213,13 @@ def targets_of(m: Mutant) -> list[str]:
 
 
 def stale_reason(src: Path, e: Edit) -> str | None:
+    if e.file is None:
+        return f"marker 'mut: {e.anchor}' not resolved"
     p = src / e.file
     if not p.is_file():
         return f"file {e.file} does not exist"
-    n = p.read_text().count(e.find)
-    if n == 1:
-        return None
-    first = e.find.strip().splitlines()[0] if e.find.strip() else e.find
-    return (f"find text {'not found' if n == 0 else f'found {n} times'} in {e.file} "
-            f"(must occur exactly once): {first!r}")
+    where = locate(p.read_text(), e)
+    return where if isinstance(where, str) else None
 
 
 # ------------------------------------------------------------ the copy
@@ -398,7 +473,8 @@ def check_markdown(path: Path, mutants: list[Mutant]) -> list[str]:
             got = doc.pop(want[0], None)
             if got is None:
                 problems.append(f"{m.id}: missing from the {name!r} table")
-            elif got[:len(want)] != want:
+            elif [c for k, c in enumerate(got[:len(want)]) if k != 1] != [c for k, c in enumerate(want) if k != 1]:
+                # (the file column, index 1, follows the marker: not compared)
                 problems.append(f"{m.id}: row of the {name!r} table differs from {name}.json")
         problems += [f"{k.strip('`')}: in the {name!r} table but not in {name}.json" for k in doc]
     return problems
@@ -430,6 +506,7 @@ def main(argv: list[str] | None = None) -> int:
 
     src_root = args.source.resolve()
     mutants = load_mutants(args.mutants or [DEFAULT_MUTANTS])
+    resolve_anchors(src_root, mutants)  # the file column of --list and the docs
     if args.only:
         unknown = set(args.only) - {m.id for m in mutants}
         if unknown:
@@ -485,8 +562,10 @@ def _run(args, src_root: Path, work: Path, python: str, mutants: list[Mutant], t
 
     # stale mutants: reported, not run
     results: dict[str, Result] = {}
+    unresolved = resolve_anchors(src, mutants)
     for m in mutants:
-        why = [r for r in (stale_reason(src, e) for e in m.edits) if r]
+        why = ([unresolved[m.id]] if m.id in unresolved else
+               [r for r in (stale_reason(src, e) for e in m.edits) if r])
         if why:
             results[m.id] = Result(m, "STALE", [], 0.0, "; ".join(why))
             print(f"STALE {m.id}: {'; '.join(why)}", flush=True)
@@ -533,7 +612,9 @@ def _run(args, src_root: Path, work: Path, python: str, mutants: list[Mutant], t
                 text = originals[f]
                 for e in m.edits:
                     if e.file == f:
-                        text = text.replace(e.find, e.replace, 1)
+                        i = locate(text, e)
+                        assert isinstance(i, int), i  # checked before (stale_reason)
+                        text = text[:i] + e.replace + text[i + len(e.find):]
                 (src / f).write_text(text)
             ok, out = runner.build_targets(targets_of(m))
             if not ok:

@@ -2,9 +2,10 @@
  * ctrl.h - the control laws behind one table. A law is a row
  * {name, capabilities, check, init, reset, step} (ctrl_law_t); its state
  * lives in a union (one law runs at a time, RAM of the smallest board); the
- * table (ctrl_laws.c) has one row per entry of DRIVE_LAW_LIST
- * (drive_enums.h). Adding a law: its module (law_*.c with its row), one
- * line in DRIVE_LAW_LIST and one in ctrl_laws.c (docs/architecture.md).
+ * table (ctrl.c, `laws`) is generated from DRIVE_LAW_LIST (drive_enums.h):
+ * one row ctrl_law_<name> per entry (declared in ctrl_laws.h). Adding a
+ * law: its module (law_*.c defining its row) and one line in
+ * DRIVE_LAW_LIST (docs/architecture.md).
  *
  * The drive hands a law one sample (currents, angle, speed, the voltage
  * available, references) and gets the alpha-beta voltage for the next

@@ -9,8 +9,8 @@
 #define FLUXDRIVE_DRIVE_ENUMS_H
 
 /* clang-format off */
-/* Control laws: X(ENUM, name, doc). The law table (ctrl_laws.c) has one
- * row per entry, in this order. */
+/* Control laws: X(ENUM, name, doc). The law table (ctrl.c, generated from
+ * this list) has one row ctrl_law_<name> per entry, in this order. */
 #define DRIVE_LAW_LIST(X)                                                                  \
   X(FOC, foc, "rotor-frame PI current control; torque mode on the MTPA trajectory")       \
   X(PI_DFVC, pi_dfvc, "PI direct flux vector control of SPM machines (Rubino 2020, IV.7)") \

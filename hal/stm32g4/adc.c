@@ -7,8 +7,12 @@
  * and regulator start-up (21.4.6), calibration (21.4.8: ADCAL with ADEN = 0,
  * single-ended), enable (21.4.9: ADRDY), injected group (21.4.21: JSQR with
  * JEXTSEL = TIM1_TRGO, JEXTEN = rising edge; JQDIS = 1, queue disabled).
- * The interrupt is the end of ADC1's injected sequence (JEOS); the board
- * table puts the longest sequence on ADC1 and the handler waits for ADC2.
+ * The PWM-period interrupt is the end of the later of the two injected
+ * sequences: ADC1 and ADC2 share one interrupt line (ADC1_2, vector 18,
+ * RM0440 section 16.3) and each raises it with its own JEOS (JEOSIE on
+ * every ADC in use); the entry of the first end notes it and returns, the
+ * entry of the second runs the period. No wait, whichever sequence is
+ * longer.
  * OPAMP PGA (RM0440 section 25.3.5) for boards that amplify the shunt
  * signal inside the MCU.
  */
@@ -38,13 +42,20 @@ static const hal_pin_t k_adc_pins[BOARD_ADC_NPINS] = BOARD_ADC_PINS;
 /* Data register of each signal, set by hal_adc_init. */
 static reg32_t *s_jdr[SIG_COUNT];
 
+/* The ends a period needs and has seen: bit 0 ADC1's JEOS, bit 1 ADC2's. */
+enum { END_ADC1 = 1u, END_ADC2 = 2u };
+_Static_assert(ADC_ISR_JEOS >> 6 == END_ADC1 && ADC_ISR_JEOS >> 5 == END_ADC2,
+               "ADC1_2_IRQHandler shifts JEOS (RM0440 ADC_ISR bit 6) onto END_*");
+
 static struct {
+  hal_control_fn control; /* the application's period body (hal_stm32g4_start) */
+  uint32_t ends;          /* END_* seen since the last period ran */
+  uint32_t ends_needed;   /* END_* of the ADCs with an injected sequence */
   uint32_t isr_count;
   uint32_t overruns;
   uint32_t cycles_last;
   uint32_t cycles_max;
   uint32_t cycles_acc; /* 256 x the exponential mean (time constant 256 periods) */
-  bool adc2_timeout;   /* this period's ADC2 sequence did not finish in time */
 } s_isr;
 
 /* Sampling cycles of the ADC_SMP_* codes (RM0440 21.4.12), x2 (half cycles). */
@@ -175,16 +186,32 @@ bool hal_adc_init(void) {
 #if BOARD_HAS_STAR_WINDOW
   star_window_adc_init(); /* the after-sample: the star channel on TRGO2 */
 #endif
-  return len[0] >= len[1]; /* the interrupt comes from ADC1: it must finish last */
+  return len[0] + len[1] != 0u; /* the period interrupt needs a sequence */
 }
 
-void hal_adc_start(void) {
+bool hal_adc_start(hal_control_fn control) {
+  if (control == 0) {
+    return false;
+  }
+  s_isr.control = control;
+  s_isr.ends = 0u;
+  s_isr.ends_needed = 0u;
   ADC1->ISR = ADC_ISR_JEOC | ADC_ISR_JEOS | ADC_ISR_JQOVF;
   ADC2->ISR = ADC_ISR_JEOC | ADC_ISR_JEOS | ADC_ISR_JQOVF;
-  ADC1->IER = ADC_IER_JEOSIE;
-  ADC1->CR |= ADC_CR_JADSTART;
-  if ((ADC2->JSQR & (3u << ADC_JSQR_JEXTEN_Pos)) != 0u) {
-    ADC2->CR |= ADC_CR_JADSTART;
+  ADC1->IER = 0u;
+  ADC2->IER = 0u;
+  /* every ADC with an injected sequence (JEXTEN set by hal_adc_init) ends
+   * the period with its JEOS interrupt; the period runs at the last end */
+  for (uint32_t a = 0; a < 2u; a++) {
+    adc_regs_t *adc = adc_of(a + 1u);
+    if ((adc->JSQR & (3u << ADC_JSQR_JEXTEN_Pos)) != 0u) {
+      s_isr.ends_needed |= 1u << a;
+      adc->IER = ADC_IER_JEOSIE;
+      adc->CR |= ADC_CR_JADSTART;
+    }
+  }
+  if (s_isr.ends_needed == 0u) {
+    return false;
   }
 #if BOARD_HAS_STAR_WINDOW
   star_window_adc_start();
@@ -192,6 +219,7 @@ void hal_adc_start(void) {
   NVIC->IPR[IRQN_ADC1_2] = (uint8_t)(0u << (8u - NVIC_PRIO_BITS)); /* highest */
   NVIC->ICPR[IRQN_ADC1_2 / 32u] = 1u << (IRQN_ADC1_2 % 32u);
   NVIC->ISER[IRQN_ADC1_2 / 32u] = 1u << (IRQN_ADC1_2 % 32u);
+  return true;
 }
 
 /* ---- hal.h ---- */
@@ -240,27 +268,37 @@ HOT void hal_adc_read(hal_sample_t *s) {
   s->enc_angle = 0.0f; /* no encoder interface on these boards yet */
   s->t_enc = 0.0f;
   s->enc_valid = false;
-  /* ADC2's sequence did not end in the wait of ADC1_2_IRQHandler: its data
-   * registers hold the previous period's values */
-  s->valid = !s_isr.adc2_timeout;
+  /* the period runs only once every injected sequence has ended
+   * (ADC1_2_IRQHandler): every data register holds this period's sample */
+  s->valid = true;
 }
 
-/* End of ADC1's injected sequence: the PWM-period interrupt. */
+/* The PWM-period interrupt: the end of an injected sequence (JEOS) of
+ * ADC1 or ADC2, which share this line. Each entry takes the JEOS flags it
+ * sees (write 1 to clear only those: an end after the read stays pending
+ * and re-enters) and notes them; the period runs when every ADC in use has
+ * ended since the last one, i.e. on the second entry of a normal period
+ * (or the first, when both ended before it). The first entry costs the
+ * exception and a few register accesses: no wait for the other ADC. An
+ * ADC that never ends (faulty or misconfigured) stops the periods, and
+ * with them the watchdog refresh (drive_background: only when the ISR
+ * advanced): the IWDG resets the MCU with the gates off. */
 void ADC1_2_IRQHandler(void);
 HOT void ADC1_2_IRQHandler(void) {
   const uint32_t t0 = DWT->CYCCNT;
-  ADC1->ISR = ADC_ISR_JEOC | ADC_ISR_JEOS;
-  /* ADC2's sequence is shorter and started on the same trigger: it is done
-   * or ends within a few conversions; 200 polls (~2.4 us) bound the wait */
-  uint32_t t = 0;
-  while (t < 200u && (ADC2->ISR & ADC_ISR_JEOS) == 0u) {
-    t++;
+  const uint32_t f1 = ADC1->ISR & ADC_ISR_JEOS;
+  const uint32_t f2 = ADC2->ISR & ADC_ISR_JEOS;
+  ADC1->ISR = f1;
+  ADC2->ISR = f2;
+  const uint32_t ends = s_isr.ends | (f1 >> 6) | (f2 >> 5); /* JEOS is bit 6: END_ADC1, END_ADC2 */
+  if ((ends & s_isr.ends_needed) != s_isr.ends_needed) {
+    s_isr.ends = ends; /* the first end of this period: the other one comes */
+    return;
   }
-  s_isr.adc2_timeout = (ADC2->JSQR & (3u << ADC_JSQR_JEXTEN_Pos)) != 0u && t >= 200u;
-  ADC2->ISR = ADC_ISR_JEOC | ADC_ISR_JEOS;
+  s_isr.ends = 0u;
   hal_tim1_clear_update(); /* set at this period's valley */
 
-  board_control_isr();
+  s_isr.control();
 
   /* Overrun: the next valley (update) came before the ISR finished. */
   if (hal_tim1_update_pending()) {

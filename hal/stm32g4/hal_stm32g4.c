@@ -49,10 +49,10 @@ uint32_t hal_stm32g4_init(void) {
   return err;
 }
 
-uint32_t hal_stm32g4_start(void) {
+uint32_t hal_stm32g4_start(hal_control_fn control) {
   const uint32_t pm = hal_irq_save();
   const bool aligned = hal_tim1_start();
-  hal_adc_start();
+  const bool armed = hal_adc_start(control);
   hal_irq_restore(pm);
-  return aligned ? 0u : HAL_INIT_ERR_PWM;
+  return (aligned ? 0u : HAL_INIT_ERR_PWM) | (armed ? 0u : HAL_INIT_ERR_ISR);
 }

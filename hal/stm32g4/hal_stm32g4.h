@@ -14,18 +14,21 @@ enum {
   HAL_INIT_ERR_ADC = 1u << 1,   /* ADC regulator / calibration / ready time-out */
   HAL_INIT_ERR_CAN = 1u << 2,   /* FDCAN did not enter or leave INIT */
   HAL_INIT_ERR_PWM = 1u << 3,   /* TIM1 update could not be aligned to the valley */
-  HAL_INIT_ERR_BREAK = 1u << 4  /* DAC3 of the comparator trip did not become ready */
+  HAL_INIT_ERR_BREAK = 1u << 4, /* DAC3 of the comparator trip did not become ready */
+  HAL_INIT_ERR_ISR = 1u << 5    /* no period body given, or no ADC sequence to end a period */
 };
+
+/* The application's body of the PWM-period interrupt, registered by
+ * hal_stm32g4_start: the HAL calls it once per period, after every ADC
+ * injected sequence of the period has ended (adc.c), from the interrupt. */
+typedef void (*hal_control_fn)(void);
 
 /* Configure every peripheral (gates off). Returns HAL_INIT_ERR_* bits. */
 uint32_t hal_stm32g4_init(void);
 /* Start the PWM carrier, align its update, arm the ADC trigger and the
- * PWM-period interrupt. Returns HAL_INIT_ERR_PWM on failure. */
-uint32_t hal_stm32g4_start(void);
-
-/* Implemented by the board file: called from the end-of-conversion
- * interrupt (ADC1 JEOS) every PWM period. */
-void board_control_isr(void);
+ * PWM-period interrupt, which calls `control` every period. Returns
+ * HAL_INIT_ERR_PWM / HAL_INIT_ERR_ISR bits on failure. */
+uint32_t hal_stm32g4_start(hal_control_fn control);
 
 /* ISR execution statistics (cycles, overruns): hal_isr_stats() in hal.h. */
 

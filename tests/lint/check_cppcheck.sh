@@ -8,5 +8,5 @@ cppcheck --quiet --error-exitcode=1 --enable=warning,style,performance,portabili
   --std=c11 --inline-suppr --suppress=missingIncludeSystem --suppress=unusedFunction \
   --suppress='badBitmaskCheck:hal/stm32g4/*' --suppress='redundantAssignment:hal/stm32g4/*' \
   -I firmware/core -I firmware/app -I hal -I hal/sil -I sil/plant -I sil/runner -I pil \
-  firmware hal sil pil
+  firmware hal sil pil boards
 echo "cppcheck: clean"

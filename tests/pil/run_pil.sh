@@ -57,7 +57,7 @@ export PYTHONPATH="$src/tools/src${PYTHONPATH:+:$PYTHONPATH}"
 "$python" -m fluxdrive pil "$src/sil/scenarios/pil_ivd_kf_rls.json" --law foc --isrs all \
   --functions --check-call kf_mech_predict=100 --check-call kf_mech_update=260 \
   --check-call rls_ab_update=220 --check-mean-cordic 3000 \
-  --board-elf "$build/cross/hal/stm32g4/fluxdrive-g474.elf" --sil "$sil" \
+  --board-elf "$build/cross/boards/stm32g4/fluxdrive-g474.elf" --sil "$sil" \
   --elf "$build/cross/pil/fluxdrive-pil.elf" --out "$build/work" \
   --markdown "$build/benchmarks-kf.md"
 "$python" -m fluxdrive pil "$src/sil/scenarios/pil_ekf.json" --law foc --isrs all \

@@ -16,7 +16,7 @@ from fluxdrive.errors import FluxdriveError
 
 REPO = Path(__file__).resolve().parents[2]
 PIL_ELF = REPO / "build" / "cortex-m4f" / "pil" / "fluxdrive-pil.elf"
-BOARD_ELF = REPO / "build" / "stm32g474" / "hal" / "stm32g4" / "fluxdrive-g474.elf"
+BOARD_ELF = REPO / "build" / "stm32g474" / "boards" / "stm32g4" / "fluxdrive-g474.elf"
 
 
 def line(addr: int, size: int, text: str) -> str:
@@ -356,11 +356,17 @@ def test_pil_image_fully_classified() -> None:
 def test_board_bound() -> None:
     b = cm.bound_board(cm.load_program(BOARD_ELF), str(BOARD_ELF))
     t, w = b.typical, b.worst
-    assert "1 ADC2 check" in t.wrapper[2].note and "200 ADC2 checks" in w.wrapper[2].note
-    assert t.wrapper[0].cycles == w.wrapper[0].cycles == 24
-    assert t.wrapper[1].cycles == 34
-    # each extra check: load + AHB wait + lsls + bmi + subs + taken bne >= 9 cycles
-    assert w.wrapper_cycles - t.wrapper_cycles >= 199 * 9
+    # two entries a period (first ADC end, then the period), a third in the worst case
+    names = [p.name.split(":")[0] for p in t.wrapper]
+    assert names == ["first end", "first end", "period", "period", "period"]
+    assert [p.name.split(":")[0] for p in w.wrapper] == ["first end", "first end", "re-entry",
+                                                         "re-entry", "period", "period", "period"]
+    assert t.wrapper[0].cycles == t.wrapper[2].cycles == 24 and t.wrapper[3].cycles == 34
+    # the first end: a few register accesses, no wait, no call
+    assert t.wrapper[1].insns < 30 and "APB" not in t.wrapper[1].note
+    # no wait loop: the worst case adds the re-entry, the overrun count, ART misses only
+    assert t.wrapper_cycles < w.wrapper_cycles < 2 * t.wrapper_cycles
+    assert w.wrapper_cycles < 0.05 * cm.BUDGET_CYCLES
     assert [p.name for p in t.hal] == list(cm.BOARD_HAL)
     assert cm.BOARD_HAL == ("hal_adc_read", "hal_fault_hw_tripped", "hal_pwm_write")
     assert 0 < t.hal_cycles <= w.hal_cycles

@@ -10,7 +10,8 @@ proves:
   3. word 1 = Reset_Handler with the Thumb bit set;
   4. the ADC1_2 entry (IRQ 18, RM0440 vector table) = ADC1_2_IRQHandler | 1,
      and SysTick = SysTick_Handler | 1;
-  5. drive_isr and ADC1_2_IRQHandler run from CCM SRAM, and .ccmram has a
+  5. drive_isr, ADC1_2_IRQHandler and the board's period body
+     (board_control_isr) run from CCM SRAM, and .ccmram has a
      flash load image (copied by startup.c);
   6. every allocated section lies inside its region; .data + .bss + the
      minimum stack fit in RAM; .ccmram + .ccmbss fit in CCM SRAM; the flash
@@ -170,6 +171,7 @@ def main(argv):
         check(elf.binding.get(fn) == 1, "%s is the CORDIC binding (global, not the weak software one)" % fn)
     check(in_ccm("drive_isr"), "drive_isr in CCM SRAM (0x%08x)" % (addr("drive_isr") or 0))
     check(in_ccm("ADC1_2_IRQHandler"), "ADC1_2_IRQHandler in CCM SRAM")
+    check(in_ccm("board_control_isr"), "board_control_isr (the period body) in CCM SRAM")
     ccm = elf.section(".ccmram")
     if ccm is not None and ccm["size"]:
         lma = elf.lma(ccm)

@@ -37,7 +37,7 @@ for preset in "$@"; do
   if ! cmake --preset "$base" -B "$bdir" $extra >/dev/null || ! cmake --build "$bdir"; then
     echo "FAIL: build of $preset"; status=1; continue
   fi
-  elf="$bdir/hal/stm32g4/fluxdrive-$board.elf"
+  elf="$bdir/boards/stm32g4/fluxdrive-$board.elf"
   arm-none-eabi-size -A -x "$elf" | grep -E '^(\.isr_vector|\.ccmram|\.text|\.rodata|\.data|\.bss|\.ccmbss|\._stack) '
   if ! python3 "$ROOT/tests/target/check_elf.py" "$elf" "$ROOT/hal/stm32g4/$ld"; then
     echo "FAIL: static checks of $elf"; status=1

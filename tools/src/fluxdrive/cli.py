@@ -267,7 +267,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--check-cycles", type=_percent, metavar="PCT",
                    help="fail when the DB-DFVC worst case's estimated cycles exceed PCT %% of "
                    "the 10625-cycle budget (170 MHz / 16 kHz)")
-    p.add_argument("--board-elf", metavar="PATH", help="board image (e.g. build/stm32g474/hal/"
+    p.add_argument("--board-elf", metavar="PATH", help="board image (e.g. build/stm32g474/boards/"
                    "stm32g4/fluxdrive-g474.elf): add the ISR wrapper, exception and board HAL "
                    "(fluxdrive cycles-board) to a board estimate")
     p.add_argument("--cpi", type=float, default=None, help="legacy: also show the worst case at "
@@ -289,7 +289,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("cycles-board", help="cycle bound of the board's ISR path outside "
                        "drive_isr (wrapper, exception, register HAL)")
     p.add_argument("elf", metavar="ELF", help="board image, e.g. "
-                   "build/stm32g474/hal/stm32g4/fluxdrive-g474.elf")
+                   "build/stm32g474/boards/stm32g4/fluxdrive-g474.elf")
     p.set_defaults(func=lambda a: __import__("fluxdrive.cm4_cycles").cm4_cycles.main_board(a))
     from fluxdrive.can.cli import add_parser as add_can_parser  # fluxdrive can ...
     from fluxdrive.fluxmap.cli import add_parser as add_map_parser  # fluxdrive map ...

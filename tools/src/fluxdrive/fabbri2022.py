@@ -43,8 +43,10 @@ TWO_PI = 2.0 * np.pi
 
 @dataclass(frozen=True)
 class Paper:
-    """What the thesis and the issue state (/work/shared/papers/
-    fabbri2022-dfc-ivd-sensorless-thesis.txt)."""
+    """What the thesis and the issue state (S. Fabbri,
+    "Sensorless position estimation of PMSMs using state observation and a
+    novel iterative algorithm", doctoral thesis, Universitaet des
+    Saarlandes, Saarbruecken, 2022)."""
 
     # Fig. 3.3: L0, M0, L2 [H]; M2 from p
     l0: float = 442.2e-6
@@ -203,7 +205,8 @@ def refused(sil, root, out, p: float) -> str:
     path.write_text(json.dumps(sc))
     res = subprocess.run([str(sil), str(path), "--print-config"], capture_output=True, text=True,
                          timeout=60)
-    return res.stderr.strip() if res.returncode != 0 else ""
+    # the file named without the machine's path (docs stay independent of the checkout)
+    return res.stderr.strip().replace(str(path), path.name) if res.returncode != 0 else ""
 
 
 @dataclass

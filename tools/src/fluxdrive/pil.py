@@ -694,8 +694,9 @@ def format_markdown(runs: list[PilRun], isrs: int, cpi: float | None, build: str
         out.append(
             f"Board ISR path outside `drive_isr` (`fluxdrive cycles-board`, same model plus "
             f"exception entry/exit with lazy FP stacking and bus wait states): wrapper "
-            f"{t.wrapper_cycles} cycles typical (ADC2 ready at the first check) / "
-            f"{w.wrapper_cycles} worst (wait loop exhausted, 200 checks); board HAL called by "
+            f"{t.wrapper_cycles} cycles typical (two entries: the first ADC end, the "
+            f"period) / {w.wrapper_cycles} worst (a third, spurious entry, overrun "
+            f"bookkeeping, ART misses); board HAL called by "
             f"`drive_isr` {t.hal_cycles} / {w.hal_cycles} (replaces the PIL's replay HAL). "
             f"Board estimate = PIL cycles - replay HAL + board HAL + wrapper:"
         )

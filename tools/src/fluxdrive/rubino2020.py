@@ -28,7 +28,7 @@ RPM = np.pi / 30.0
 class PaperConstants:
     """What the paper states (S. Rubino, R. Bojoi, E. Armando, A. Tenconi,
     "Deadbeat direct flux vector control of surface permanent magnet motor
-    drives", 2020; /work/shared/papers/rubino2020-deadbeat-dfvc-spm.txt).
+    drives", IEEE Transactions on Industry Applications, 2020).
     The acceptance tests take every limit from here, never from what the
     drive prints (`--print-config`)."""
 

@@ -40,8 +40,10 @@ TWO_PI = 2.0 * np.pi
 
 @dataclass(frozen=True)
 class Paper:
-    """What the paper and the issue state (/work/shared/papers/
-    varatharajan2022-decoupled-dfvc-adaptive-mtpa-mtpv.txt)."""
+    """What the paper and the issue state (A. Varatharajan, G. Pellegrino,
+    E. Armando, "Direct Flux Vector Control of Synchronous Motor Drives:
+    Accurate Decoupled Control with Online Adaptive MTPA and MTPV
+    Evaluation", IEEE TIE 69(2), 2022)."""
 
     fs: float = 5000.0  # section VI: dSPACE at 5 kHz
     i_rated: float = 2.3  # Table I [A rms]

@@ -1,7 +1,10 @@
 /*
- * board_main.c - main() of the STM32G4 firmware: drive configuration from
- * the board header, peripheral bring-up, the PWM-period interrupt body and
- * the 1 kHz main loop (SysTick tick, thread mode: CAN, background service).
+ * board_main.c - the STM32G4 board application: main(), the drive
+ * configuration from the board header, peripheral bring-up through the
+ * register HAL (hal/stm32g4), the PWM-period interrupt body that the HAL
+ * calls back (registered with hal_stm32g4_start) and the 1 kHz main loop
+ * (SysTick tick, thread mode: CAN, background service). The HAL knows no
+ * function of this file by name.
  */
 #include <stdint.h>
 
@@ -27,8 +30,9 @@ void SysTick_Handler(void) {
   s_ticks++;
 }
 
-/* Called by ADC1_2_IRQHandler at the end of the injected sequence. */
-__attribute__((section(".ccmram.text.board"))) void board_control_isr(void) {
+/* The period body, registered with hal_stm32g4_start: called by the HAL's
+ * ADC1_2_IRQHandler once the period's injected sequences have ended. */
+__attribute__((section(".ccmram.text.board"))) static void board_control_isr(void) {
   drive_isr(&s_drv);
 }
 
@@ -93,7 +97,7 @@ int main(void) {
     err |= 0x40000000u;
   }
   if (err == 0u) {
-    err |= hal_stm32g4_start(); /* PWM carrier + ADC trigger + ISR */
+    err |= hal_stm32g4_start(board_control_isr); /* PWM carrier + ADC trigger + ISR */
   }
   g_board_init_error = err;
   if (err != 0u) {

@@ -1,6 +1,8 @@
 /*
- * drive.c - the drive: state machine, ISR body, protections, loss-of-control
- * monitor (drive.h).
+ * drive.c - the drive: state machine, ISR body, the per-period checks of
+ * the sample set, and the views through which the protections (owned parts
+ * in protect/) see the drive, with the slow-rate schedule that runs them
+ * (drive.h).
  *
  * idle -> offset calibration -> [align] -> run -> (fault). The ISR takes the
  * main loop's requests at its start, evaluates the protections on the
@@ -9,12 +11,10 @@
  * side of the concurrency contract is drive_host.c.
  */
 #include "drive.h"
-#include "drive_hold.h"
-#include "drive_pos_check.h"
-#include "drive_overrun.h"
-#include "drive_safe.h"
 #include "drive_sync.h"
+#include "proc.h"
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -27,6 +27,26 @@ static bool gates_on_state(drive_state_t s) {
   return s == DRIVE_STATE_RUN || s == DRIVE_STATE_ALIGN;
 }
 
+/* The mode in force (drive_t.mode): current mode only with a law that has
+ * it. Taken where either changes (a command block, a law's selection or
+ * initialisation), not every period. */
+FD_COLD static void drive_mode_refresh(drive_t *drv) {
+  const drive_mode_t m = drv->cmd.mode;
+  /* no law after a refused initialisation (ctrl_init): the set in force
+   * is configured again at once (take_config), or the drive not started */
+  const uint32_t caps = drv->ctrl.impl != NULL ? drv->ctrl.impl->caps : 0u;
+  drv->mode = ((unsigned)m >= (unsigned)DRIVE_MODE_COUNT ||
+               (m == DRIVE_MODE_CURRENT && (caps & CTRL_CAP_CURRENT) == 0u))
+                  ? DRIVE_MODE_TORQUE
+                  : m;
+  /* the loss-of-control conditions that apply with this law and mode */
+  drv->lc_checks =
+      (drv->mode != DRIVE_MODE_CURRENT ? PROTECT_LC_CHECK_TORQUE : 0u) |
+      ((caps & CTRL_CAP_FLUX) != 0u
+           ? PROTECT_LC_CHECK_FLUX | ((caps & CTRL_CAP_DELTA) != 0u ? PROTECT_LC_CHECK_DELTA : 0u)
+           : 0u);
+}
+
 /* All gates off, the pattern back to the middle of the duty range (no
  * voltage when the gates come back). */
 static void drive_gates_off(const drive_t *drv) {
@@ -37,11 +57,11 @@ static void drive_gates_off(const drive_t *drv) {
 }
 
 /* A fault: gates off now (unless already shorted), the safe state chosen
- * in this ISR (drive_safe.c), the cause latched. */
+ * in this ISR (protect/drive_safe.c), the cause latched. */
 static FD_NOINLINE void drive_trip(drive_t *drv, uint32_t bits) {
   if (!drv->safe.asc) {
     drive_gates_off(drv);
-    drive_safe_leave_gates(drv);
+    protect_safe_leave_gates(&drv->safe);
   }
   drv->faults |= bits;
   drv->state = DRIVE_STATE_FAULT;
@@ -111,21 +131,15 @@ FD_COLD int drive_config_usable(const drive_config_t *cfg, drive_law_t law, mach
     err->reason = pwhy;
     return -1;
   }
-  if (cfg->start_mode == 1u && ps->hold == NULL) {
-    err->field = "start_mode";
-    err->reason = "the held start (1) needs a star-point position source (an angle at standstill); "
-                  "the encoder starts by its alignment or its known enc_offset (0)";
+  /* the procedures of the start this set wants (proc.h) */
+  const proc_setup_t psu = {cfg, m, ps, NULL, NULL, false};
+  const char *why_p = proc_start_refusal(&psu, &err->field);
+  if (why_p != NULL) {
+    err->reason = why_p;
     return -1;
   }
   return 0;
 }
-
-/* The encoder's alignment (drive_derive, drive_align): damping ratio, the
- * swing left when it is taken as settled [rad electrical], and the swings
- * after align_time it may take to settle before the position fault. */
-#define DRIVE_ALIGN_ZETA   0.7f
-#define DRIVE_ALIGN_CALM   0.01f
-#define DRIVE_ALIGN_SWINGS 10.0f
 
 /* What the ISR would otherwise divide for every period (LIVE parameters
  * included: called again when they change). */
@@ -144,29 +158,18 @@ FD_COLD static void drive_derive(drive_t *drv) {
   /* Ts / L of the window's sampling correction (linear machines; a
    * flux-map machine has no star-point model in the plant) */
   drv->win_k = (drv->gated && c->machine_map == NULL) ? 2.0f * c->ts / (c->ld + c->lq) : 0.0f;
-  drv->lc_n_fast = c->lc_time / c->ts;
-  drv->lc_n_track = c->lc_track_time / c->ts;
   drv->inv_pole_pairs = 1.0f / c->pole_pairs;
-  /* the encoder's alignment: the rotor swings about the current's axis at
-   * w_n = p sqrt(1.5 lambda_m i_align / J) (electrical), the PM torque
-   * 1.5 p lambda_m i_q; the current's angle led by -k_d omega_e damps it
-   * (theta'' = -w_n^2 (theta + k_d theta'): zeta = k_d w_n / 2) */
-  const float wn2 =
-      1.5f * c->pole_pairs * c->pole_pairs * c->lambda_m * c->align_current / c->inertia;
-  const float wn = wn2 > 0.0f ? sqrtf(wn2) : 0.0f;
-  drv->align_kd = wn > 0.0f ? 2.0f * DRIVE_ALIGN_ZETA / wn : 0.0f;
-  /* settled: |omega_e| < DRIVE_ALIGN_CALM w_n for 2 / w_n (over a quarter
-   * swing: a swing left would show its speed peak), i.e. a swing of at most
-   * DRIVE_ALIGN_CALM rad electrical left */
-  drv->align_w_calm = DRIVE_ALIGN_CALM * wn;
-  drv->align_calm_need = wn > 0.0f ? (uint32_t)(2.0f / (wn * c->ts)) + 1u : 0u;
-  /* a rotor calm from the alignment's start for 1 / w_n started within
-   * DRIVE_ALIGN_CALM rad of the axis (from rest at theta_0 its speed
-   * passes DRIVE_ALIGN_CALM w_n after DRIVE_ALIGN_CALM / (w_n theta_0)) */
-  drv->align_still_need = wn > 0.0f ? (uint32_t)(1.0f / (wn * c->ts)) + 1u : 0u;
-  const float t_out =
-      c->align_time + (wn > 0.0f ? DRIVE_ALIGN_SWINGS * 2.0f * FRAMES_PI / wn : 0.0f);
-  drv->align_n_timeout = (uint32_t)(t_out / c->ts) + 1u;
+}
+
+/* The protections' limits from the parameter set in force (LIVE ones
+ * included: called again when they change) and the machine's scales. */
+FD_COLD static void drive_protect_configure(drive_t *drv) {
+  const drive_config_t *c = &drv->cfg;
+  const protect_lc_cfg_t lc = {c->lc_current,     c->i_max,       c->lc_track,      c->delta_max,
+                               c->lc_delta,       c->lc_time,     c->lc_track_time, c->ts,
+                               drv->torque_scale, drv->flux_scale};
+  protect_lc_configure(&drv->lc, &lc);
+  protect_ra_configure(&drv->ra, c->speed_max, (float)c->slow_div * c->ts);
 }
 
 FD_COLD int drive_config_fits_board(const drive_config_t *cfg, const hal_caps_t *caps,
@@ -225,7 +228,10 @@ FD_COLD static int drive_configure(drive_t *drv, const drive_config_t *cfg, driv
   drive_machine_copy(&drv->machine, &drv->map, &m, &map);
   drive_derive(drv);
   const char *reason = "";
-  if (ctrl_init(&drv->ctrl, &drv->cfg, &drv->machine, drive_t_out(drv, cfg), law, &reason) != 0) {
+  const int law_err =
+      ctrl_init(&drv->ctrl, &drv->cfg, &drv->machine, drive_t_out(drv, cfg), law, &reason);
+  drive_mode_refresh(drv);
+  if (law_err != 0) {
     err->field = "law";
     err->reason = reason;
     return -1;
@@ -237,8 +243,6 @@ FD_COLD static int drive_configure(drive_t *drv, const drive_config_t *cfg, driv
   speed_ctrl_cfg_t scfg;
   speed_cfg_from(&scfg, cfg);
   speed_ctrl_init(&drv->speed, &scfg);
-  const current_ctrl_cfg_t acfg = {&drv->machine, cfg->current_bw, cfg->ts};
-  current_ctrl_init(&drv->align_cc, &acfg);
   drv->torque_min_avail = -cfg->torque_max;
   drv->torque_max_avail = cfg->torque_max;
   /* scales of the loss-of-control monitor: torque and flux on MTPA at i_max */
@@ -250,9 +254,13 @@ FD_COLD static int drive_configure(drive_t *drv, const drive_config_t *cfg, driv
   drv->psi_pm = sqrtf(l_pm.d * l_pm.d + l_pm.q * l_pm.q);
   drv->psi0 = l_pm;
   const dq_t i_sc = machine_current(&drv->machine, (dq_t){0.0f, 0.0f});
-  drv->i_sc = sqrtf(i_sc.d * i_sc.d + i_sc.q * i_sc.q);
-  drv->asc_psi_max = drive_safe_psi_max(drv);
   drv->flux_scale = sqrtf(l_rated.d * l_rated.d + l_rated.q * l_rated.q);
+  /* this set's flux scale bounds the short's bisection (the previous set's,
+   * 0 at start-up, bounded a reluctance machine's trapped flux at 0: every
+   * short refused until a second set was taken) */
+  protect_safe_configure(&drv->safe, &drv->machine, drv->psi_pm,
+                         sqrtf(i_sc.d * i_sc.d + i_sc.q * i_sc.q), drv->flux_scale, cfg->i_trip);
+  drive_protect_configure(drv);
   return 0;
 }
 
@@ -285,6 +293,7 @@ FD_COLD static bool configure_live(drive_t *drv, const drive_config_t *cfg) {
   }
   drv->cfg = next;
   drive_derive(drv);
+  drive_protect_configure(drv);
   speed_ctrl_cfg_t scfg;
   speed_cfg_from(&scfg, &drv->cfg);
   /* new gains and limits; the integral and the ramp carry on */
@@ -312,6 +321,7 @@ FD_COLD int drive_init(drive_t *drv, const drive_config_t *cfg, drive_config_err
   drv->state = DRIVE_STATE_IDLE;
   drv->cmd.law = cfg->law;
   drv->cmd.mode = cfg->mode;
+  drive_mode_refresh(drv);
   drv->armed = true;
   drv->tm.armed = 1u;
   drv->req.cmd = drv->cmd;
@@ -320,7 +330,7 @@ FD_COLD int drive_init(drive_t *drv, const drive_config_t *cfg, drive_config_err
     drv->faults = DRIVE_FAULT_WATCHDOG;
     drv->state = DRIVE_STATE_FAULT;
   }
-  drive_overrun_init(drv);
+  protect_overrun_init(&drv->overrun, hal_isr_overruns());
   drive_gates_off(drv);
   drv->tm.state = drv->state;
   drv->tm.faults = drv->faults;
@@ -395,6 +405,7 @@ static void take_commands(drive_t *drv) {
   DRIVE_BARRIER();
   drv->cmd = drv->req.cmd;
   drv->cmd.seq = seq;
+  drive_mode_refresh(drv);
   if (drv->cmd.clear_count != drv->clear_seen) {
     drv->clear_seen = drv->cmd.clear_count;
     if (drv->state == DRIVE_STATE_FAULT) {
@@ -426,7 +437,48 @@ static FD_NOINLINE uint32_t drive_break_causes(void) {
   return f;
 }
 
+/* The checks that do not depend on the sample's values: the hardware
+ * break, and the position: usable before the gates go on, and plausible
+ * while they are. */
+static uint32_t drive_protect_rest(const drive_t *drv) {
+  uint32_t f = 0u;
+  if (hal_fault_hw_tripped()) {
+    f |= drive_break_causes();
+  }
+  const bool need = drv->gated ? drv->state == DRIVE_STATE_RUN : drive_state_enabled(drv->state);
+  if (need && (!drv->pos.out.valid ||
+               (drv->state == DRIVE_STATE_RUN && drv->pos.out.health > drv->cfg.pos_err_max))) {
+    f |= DRIVE_FAULT_POSITION;
+  }
+  return f;
+}
+
+static uint32_t drive_protect_values(const drive_t *drv, const hal_sample_t *s, const float i[3]);
+
+/* The per-period checks on the sample set. The usual period first: each
+ * comparison below is false for a NaN, and an infinity fails one of them
+ * too, so a sample that passes them all is finite, valid and trips none of
+ * the limits; anything else takes the full checks, which name the causes.
+ * What remains for the usual period is the break and the position. */
 static uint32_t drive_protect(const drive_t *drv, const hal_sample_t *s, const float i[3]) {
+  const drive_config_t *c = &drv->cfg;
+  const float v_lo = gates_on_state(drv->state) ? c->v_dc_min : -FLT_MAX;
+  const float t = c->i_trip;
+  uint32_t f = 0u;
+  if (!(s->valid && fabsf(i[0]) <= t && fabsf(i[1]) <= t && fabsf(i[2]) <= t &&
+        s->v_dc <= c->v_dc_max && s->v_dc >= v_lo && fabsf(drv->omega_m) <= c->speed_trip)) {
+    f = drive_protect_values(drv, s, i);
+    if (f == DRIVE_FAULT_SAMPLE) {
+      return f; /* nothing else is judged on a bad sample */
+    }
+  }
+  return f | drive_protect_rest(drv);
+}
+
+/* The sample's checks off the usual path (a trip, a bad sample): in flash.
+ * DRIVE_FAULT_SAMPLE alone for an invalid or non-finite sample set. */
+FD_COLD static FD_NOINLINE uint32_t drive_protect_values(const drive_t *drv, const hal_sample_t *s,
+                                                         const float i[3]) {
   const drive_config_t *c = &drv->cfg;
   if (!s->valid ||
       !(fd_isfinite(i[0]) && fd_isfinite(i[1]) && fd_isfinite(i[2]) && fd_isfinite(s->v_dc))) {
@@ -445,64 +497,17 @@ static uint32_t drive_protect(const drive_t *drv, const hal_sample_t *s, const f
   if (fabsf(drv->omega_m) > c->speed_trip) {
     f |= DRIVE_FAULT_OVERSPEED;
   }
-  if (hal_fault_hw_tripped()) {
-    f |= drive_break_causes();
-  }
-  /* the position must be usable before the gates go on, and plausible
-   * while they are */
-  const bool need = drv->gated ? drv->state == DRIVE_STATE_RUN : drive_state_enabled(drv->state);
-  if (need && (!drv->pos.out.valid ||
-               (drv->state == DRIVE_STATE_RUN && drv->pos.out.health > c->pos_err_max))) {
-    f |= DRIVE_FAULT_POSITION;
-  }
   return f;
 }
 
-/* Loss of control: each condition must hold for lc_time before the trip. */
+/* Loss of control (protect/lc_monitor.h): each condition must hold for its
+ * time before the trip. */
 static void drive_monitor(drive_t *drv, const ctrl_in_t *in, const ctrl_out_t *out) {
-  const drive_config_t *c = &drv->cfg;
-  uint32_t cond = 0u;
-  const float i_lim = c->lc_current * c->i_max;
-  if (out->i_dq.d * out->i_dq.d + out->i_dq.q * out->i_dq.q > i_lim * i_lim) {
-    cond |= DRIVE_LC_CURRENT;
-  }
-  if (in->mode != DRIVE_MODE_CURRENT) {
-    /* the torque the law says it can deliver now, against its estimate,
-     * on the scale of the torque at i_max */
-    const float t_ref = fd_clampf(in->torque_ref, out->torque_min, out->torque_max);
-    if (fabsf(out->tm.torque - t_ref) > c->lc_track * drv->torque_scale) {
-      cond |= DRIVE_LC_TORQUE;
-    }
-  }
-  if ((drv->ctrl.impl->caps & CTRL_CAP_FLUX) != 0u) {
-    /* the SPM laws' load-angle limit (the decoupled DFVC's MTPV limit is
-     * its torque margin k_T: its load angle from d is near 90 deg on a
-     * reluctance machine) */
-    if ((drv->ctrl.impl->caps & CTRL_CAP_DELTA) != 0u &&
-        fabsf(out->tm.delta) > c->delta_max + c->lc_delta) {
-      cond |= DRIVE_LC_DELTA;
-    }
-    if (fabsf(out->tm.flux - out->tm.flux_ref) > c->lc_track * out->tm.flux_ref) {
-      cond |= DRIVE_LC_FLUX;
-    }
-    /* the observer against its current model, on the scale of the flux at
-     * i_max: a detuned model (Rubino 2020, Figs. 19-20) differs by tens of
-     * per cent of that at most, a diverging integration by more */
-    if (out->tm.obs_err > c->lc_track * drv->flux_scale) {
-      cond |= DRIVE_LC_OBSERVER;
-    }
-  }
-  /* current and load angle within lc_time; tracking within lc_track_time */
-  const float n_fast = drv->lc_n_fast, n_track = drv->lc_n_track;
-  uint32_t trip = 0u;
-  for (unsigned k = 0; k < DRIVE_LC_COUNT; ++k) {
-    drv->lc_n[k] = (cond & (1u << k)) != 0u ? drv->lc_n[k] + 1u : 0u;
-    const uint32_t bit = 1u << k;
-    const float n_max = (bit & (DRIVE_LC_CURRENT | DRIVE_LC_DELTA)) != 0u ? n_fast : n_track;
-    if ((float)drv->lc_n[k] >= n_max) {
-      trip |= bit;
-    }
-  }
+  const uint32_t checks = drv->lc_checks; /* in.mode is drv->mode (drive_mode_refresh) */
+  const protect_lc_view_t v = {out->i_dq.d,      out->i_dq.q,     out->tm.torque, in->torque_ref,
+                               out->torque_min,  out->torque_max, out->tm.delta,  out->tm.flux,
+                               out->tm.flux_ref, out->tm.obs_err, checks};
+  const uint32_t trip = protect_lc_step(&drv->lc, &v);
   if (trip != 0u) {
     drv->tm.lc_cause = trip;
     drive_trip(drv, DRIVE_FAULT_LOST_CONTROL);
@@ -514,7 +519,9 @@ static void drive_monitor(drive_t *drv, const ctrl_in_t *in, const ctrl_out_t *o
  * stays exactly as it was (ctrl_select) and the refusal trips config once
  * (no retry until another law is commanded). */
 static FD_NOINLINE void drive_select_law(drive_t *drv) {
-  if (ctrl_select(&drv->ctrl, drv->cmd.law) != 0) {
+  const int refused = ctrl_select(&drv->ctrl, drv->cmd.law);
+  drive_mode_refresh(drv);
+  if (refused != 0) {
     drv->law_refused = drv->cmd.law;
     drive_trip(drv, DRIVE_FAULT_CONFIG);
   } else {
@@ -546,7 +553,8 @@ static ab_t drive_write(drive_t *drv, const float duty[3], const float dtc[3], f
   /* the correction may not take a leg out of the board's range: the drive
    * asks only for what the board can do (the HAL would clamp the same) */
   float dc[3];
-  hal_pwm_t req; /* centred pulses (hal_pwm_centred), built in the same loop */
+  hal_pwm_t req;     /* centred pulses (hal_pwm_centred), built in the same loop */
+#pragma GCC unroll 3 /* -Os keeps loops: three legs straight through save their overhead */
   for (int x = 0; x < 3; ++x) {
     dc[x] = fd_clampf(duty[x] + dtc[x], drv->duty_lo, drv->duty_hi);
     req.on[x] = 0.5f - 0.5f * dc[x];
@@ -556,13 +564,14 @@ static ab_t drive_write(drive_t *drv, const float duty[3], const float dtc[3], f
   req.n_star = 0u;
   req.t_star_req[0] = 0.0f;
   req.t_star_req[1] = 0.0f;
-  const bool window = drv->gated && !drv->hold.plain;
+  const bool window = drv->gated && !drv->plain;
   if (window) {
     drive_window_pattern(drv, dc, &req);
   }
   hal_pwm_t got;
   hal_pwm_write(&req, &got);
   float pole[3];
+#pragma GCC unroll 3
   for (int x = 0; x < 3; ++x) {
     const float d = got.off[x] - got.on[x];
     drv->tm.duty[x] = d;
@@ -589,110 +598,68 @@ static FD_NOINLINE void drive_window_sample(const drive_t *drv, float i[3], floa
   }
 }
 
-/* The three measured phase currents sum to zero (Kirchhoff, star
- * connection): a gain error, an offset drift or a lost channel shows as a
- * sum beyond i_sum_rel of the largest current (and the noise floor
- * i_sum_abs). Checked at the slow rate with a leaky count (a single
- * channel's error vanishes where its current crosses zero): the fault after
- * DRIVE_I_SUM_TRIP more slow periods over than under. Only where the board
- * measures all three (HAL_CAP_I_ABC) and the gates are on. */
-#define DRIVE_I_SUM_TRIP 8
-static FD_NOINLINE void drive_current_sum_check(drive_t *drv) {
-  const float *i = drv->tm.i_abc; /* the last period's offset-corrected currents */
+/* ------------------------------------------------- the slow-rate schedule */
+
+/* The position check runs every DRIVE_POS_CHECK_DIV-th slow period (its
+ * ISR cost: one sine, one model evaluation). */
+#define DRIVE_POS_CHECK_DIV 2u
+
+/* The current-sum check (protect/isum.h) on the last period's currents. */
+static FD_NOINLINE void drive_isum_row(drive_t *drv, bool due) {
+  (void)due;
   const drive_config_t *c = &drv->cfg;
-  if ((drv->caps->features & HAL_CAP_I_ABC) == 0u || !gates_on_state(drv->state)) {
-    drv->i_sum_n = 0;
-    return;
-  }
-  const float big = fd_maxf(fabsf(i[0]), fd_maxf(fabsf(i[1]), fabsf(i[2])));
-  if (fabsf(i[0] + i[1] + i[2]) > fd_maxf(c->i_sum_abs, c->i_sum_rel * big)) {
-    if (++drv->i_sum_n >= DRIVE_I_SUM_TRIP) {
-      drive_trip(drv, DRIVE_FAULT_CURRENT_SENSOR);
-    }
-  } else if (drv->i_sum_n > 0) {
-    drv->i_sum_n--;
+  const protect_isum_view_t v = {drv->tm.i_abc, c->i_sum_abs, c->i_sum_rel,
+                                 (drv->caps->features & HAL_CAP_I_ABC) != 0u &&
+                                     gates_on_state(drv->state)};
+  const uint32_t f = protect_isum_step(&drv->isum, &v);
+  if (f != 0u) {
+    drive_trip(drv, f);
   }
 }
 
-/* The position plausibility check, half a slow period after the speed
- * loop (the worst-case ISR does not carry both). */
-static FD_NOINLINE void drive_pos_check_step(drive_t *drv) {
-  const uint32_t pf = drive_pos_check(drv);
+/* The ISR overrun check (protect/overrun.h): not while a fault holds. */
+static void drive_overrun_row(drive_t *drv, bool due) {
+  (void)due;
+  const protect_overrun_view_t v = {hal_isr_overruns(), drv->cfg.overrun_n, drv->cfg.overrun_k};
+  if (protect_overrun_step(&drv->overrun, &v) != 0u && drv->state != DRIVE_STATE_FAULT) {
+    drive_trip(drv, DRIVE_FAULT_OVERRUN);
+  }
+}
+
+/* The position plausibility check (protect/drive_pos_check.h) on the
+ * telemetry of the last period, before the source's update. */
+FD_COLD static FD_NOINLINE void drive_pos_check_row(drive_t *drv, bool due) {
+  const drive_config_t *c = &drv->cfg;
+  const drive_telemetry_t *tm = &drv->tm;
+  const protect_pos_view_t v = {
+      c->pos_emf_tol > 0.0f && drv->state == DRIVE_STATE_RUN && tm->state == DRIVE_STATE_RUN &&
+          (drv->pos_src->caps & POS_CAP_GATED) == 0u && fd_isfinite(tm->v_dc),
+      due,
+      DRIVE_POS_CHECK_DIV * (uint32_t)c->slow_div,
+      drv->pos.out.omega,
+      tm->theta_e,
+      (dq_t){tm->i_dq[0], tm->i_dq[1]},
+      (ab_t){tm->v_ab_applied[0], tm->v_ab_applied[1]},
+      tm->v_dc,
+      drive_t_out(drv, c),
+      c->ts,
+      c->rs,
+      c->pos_emf_tol,
+      &drv->machine,
+      drv->psi0,
+      drv->psi_pm};
+  const uint32_t pf = protect_pos_step(&drv->pos_chk, &v);
+  drv->pos_emf_res = drv->pos_chk.res;
   if (pf != 0u) {
     drive_trip(drv, pf);
   }
 }
 
-/* Run-away (issue 23, point 2; docs/faults.md): whatever the position
- * source says, the rotor must not run away from the speed reference
- * against the torque the speed loop asks. The condition, each speed-loop
- * period: the speed is off the (ramped) reference by more than
- * DRIVE_RA_MARGIN |w_ref| + DRIVE_RA_FLOOR speed_max, and the loop's torque
- * pushes it back (torque x error < 0). Held for DRIVE_RA_TIME without a
- * break, it trips lost_control (lc_cause DRIVE_LC_RUNAWAY) if the speed
- * itself has moved meanwhile by DRIVE_RA_FLOOR speed_max further from the
- * reference - the mean over the window's last quarter against the mean
- * over its first, not two single samples of a noisy estimate (a PLL's
- * speed swinging about a rotor that heads for its reference tripped it on a
- * drawn machine) - : the rotor went away against the torque (a wrong polarity or
- * angle turns the torque against the loop). A speed that moves back (a
- * healthy drive braking to its reference, a reversal, a load step the loop
- * catches) or that the reference outruns (a ramp faster than the torque
- * the voltage allows) starts the window again. Once per
- * speed-loop period (1 kHz: the ISR of every slow_div-th period), a few flops. */
-#define DRIVE_RA_MARGIN 0.2f  /* of |w_ref| */
-#define DRIVE_RA_FLOOR  0.02f /* of speed_max: the margin's floor, and the growth */
-#define DRIVE_RA_TIME   0.02f /* s */
-static void drive_runaway_check(drive_t *drv, float w, float w_ref, float torque) {
+/* The speed loop, on the angle rate averaged over the slow period (no lag
+ * under acceleration), and its run-away check (protect/runaway.h). */
+static void drive_speed_row(drive_t *drv, bool due) {
+  (void)due;
   const drive_config_t *c = &drv->cfg;
-  const float e = w - w_ref;
-  const float floor = DRIVE_RA_FLOOR * c->speed_max;
-  const float ae = fabsf(e);
-  if (!(ae > DRIVE_RA_MARGIN * fabsf(w_ref) + floor && torque * e < 0.0f)) {
-    drv->ra_n = 0u;
-    return;
-  }
-  const float t_loop = (float)c->slow_div * c->ts;
-  const float nf = DRIVE_RA_TIME / t_loop + 0.5f; /* periods in the window, rounded */
-  const uint32_t n_win = nf >= 2.0f ? (uint32_t)nf : 1u;
-  const uint32_t q = n_win >= 4u ? n_win / 4u : 1u;
-  if (drv->ra_n == 0u) {
-    drv->ra_w0 = 0.0f;
-    drv->ra_w1 = 0.0f;
-  }
-  drv->ra_n++;
-  if (drv->ra_n <= q) {
-    drv->ra_w0 += w;
-  }
-  if (drv->ra_n + q > n_win) {
-    drv->ra_w1 += w;
-  }
-  if (drv->ra_n >= n_win) {
-    const float d = (drv->ra_w1 - drv->ra_w0) / (float)q;
-    const float away = e > 0.0f ? d : -d;
-    if (away > floor) {
-      drv->tm.lc_cause = DRIVE_LC_RUNAWAY;
-      drive_trip(drv, DRIVE_FAULT_LOST_CONTROL);
-    }
-    drv->ra_n = 0u; /* a new window */
-  }
-}
-
-/* The speed loop, every slow_div ISRs, on the angle rate averaged over that
- * period (no lag under acceleration), with the slow-rate checks. */
-static void drive_speed_loop(drive_t *drv) {
-  const drive_config_t *c = &drv->cfg;
-  const uint32_t phase = (drv->isr_count - 1u) % c->slow_div;
-  if (phase == c->slow_div / 2u) {
-    drive_pos_check_step(drv);
-  }
-  if (phase != 0u) {
-    return;
-  }
-  drive_current_sum_check(drv);
-  if (drive_overrun_check(drv) && drv->state != DRIVE_STATE_FAULT) {
-    drive_trip(drv, DRIVE_FAULT_OVERRUN);
-  }
   const float w =
       drv->rate_n > 0u ? drv->rate_acc / ((float)drv->rate_n * c->pole_pairs) : drv->omega_m;
   drv->rate_acc = 0.0f;
@@ -706,7 +673,12 @@ static void drive_speed_loop(drive_t *drv) {
     const float w_ref = fd_clampf(drv->cmd.speed, -c->speed_max, c->speed_max);
     drv->speed_torque =
         speed_ctrl_update(&drv->speed, w_ref, w, drv->torque_min_avail, drv->torque_max_avail);
-    drive_runaway_check(drv, w, drv->speed.w_ref_ramped, drv->speed_torque);
+    const protect_ra_view_t v = {w, drv->speed.w_ref_ramped, drv->speed_torque};
+    const uint32_t ra = protect_ra_step(&drv->ra, &v);
+    if (ra != 0u) {
+      drv->tm.lc_cause = ra;
+      drive_trip(drv, DRIVE_FAULT_LOST_CONTROL);
+    }
   } else if (drv->speed_active) { /* reset once, when the loop stops */
     speed_ctrl_reset(&drv->speed, drv->omega_m, 0.0f);
     drv->speed_active = false;
@@ -715,14 +687,63 @@ static void drive_speed_loop(drive_t *drv) {
   drv->tm.speed_ref = drv->speed_active ? drv->speed.w_ref_ramped : 0.0f;
 }
 
-/* The mode in force: current mode only with a law that has it. */
-static drive_mode_t mode_in_force(const drive_t *drv) {
-  const drive_mode_t m = drv->cmd.mode;
-  if ((unsigned)m >= (unsigned)DRIVE_MODE_COUNT ||
-      (m == DRIVE_MODE_CURRENT && (drv->ctrl.impl->caps & CTRL_CAP_CURRENT) == 0u)) {
-    return DRIVE_MODE_TORQUE;
+/* The slow-rate schedule: what runs once per slow period (slow_div ISRs,
+ * the speed loop's period), at which ISR of it, how often. The ISR walks
+ * the table every period (drive_schedule: DRIVE_SLOW_ROWS rows, bounded);
+ * a row runs in the ISR whose phase in the slow period is its phase
+ * (DRIVE_PHASE_START: the first ISR, the one after the slow period's last
+ * rate sample; DRIVE_PHASE_MID: slow_div / 2 ISRs later), and `due` tells
+ * it whether this slow period is one of every `divider` (a row may need
+ * the other periods too: the position check restarts when it does not
+ * apply, checked or not). Rows of one phase run in the table's order. The
+ * two phases split the slow work so that the worst-case ISR does not carry
+ * it all: the speed loop and its checks at the start, the position check
+ * (one sine, one model evaluation) half a slow period later. A new slow
+ * check is one row here and one part in protect/ (docs/architecture.md,
+ * "Adding a protection"). */
+enum { DRIVE_PHASE_START, DRIVE_PHASE_MID };
+
+typedef struct {
+  // cppcheck-suppress unusedStructMember
+  const char *name; /* for docs and debuggers (a row's name in a backtrace) */
+  uint8_t phase;    /* DRIVE_PHASE_* */
+  uint8_t divider;  /* due every divider-th slow period (1: each) */
+  void (*run)(drive_t *drv, bool due);
+} drive_slow_row_t;
+
+static const drive_slow_row_t drive_slow_rows[] = {
+    {"current_sum", DRIVE_PHASE_START, 1u, drive_isum_row},
+    {"overrun", DRIVE_PHASE_START, 1u, drive_overrun_row},
+    {"speed_loop", DRIVE_PHASE_START, 1u, drive_speed_row},
+    {"pos_check", DRIVE_PHASE_MID, DRIVE_POS_CHECK_DIV, drive_pos_check_row},
+};
+#define DRIVE_SLOW_ROWS (sizeof drive_slow_rows / sizeof drive_slow_rows[0])
+
+/* Every ISR, before the position source's update (the speed loop runs on
+ * the rates of the previous slow_div periods): the rows whose phase this
+ * ISR is. */
+static void drive_schedule(drive_t *drv) {
+  const uint32_t div = drv->cfg.slow_div;
+  const uint32_t k = drv->isr_count - 1u;
+  const uint32_t at = k % div;
+  const uint32_t mid = div / 2u;
+  if (at != 0u && at != mid) {
+    return; /* the usual ISR: no row */
   }
-  return m;
+  const uint32_t slow_n = k / div;
+  /* the mid phase's rows first: with slow_div 1 both phases are this ISR */
+  for (unsigned pass = 0; pass < 2u; ++pass) {
+    const uint8_t phase = pass == 0u ? DRIVE_PHASE_MID : DRIVE_PHASE_START;
+    if (at != (pass == 0u ? mid : 0u)) {
+      continue;
+    }
+    for (unsigned r = 0; r < DRIVE_SLOW_ROWS; ++r) {
+      const drive_slow_row_t *row = &drive_slow_rows[r];
+      if (row->phase == phase) {
+        row->run(drv, slow_n % row->divider == 0u);
+      }
+    }
+  }
 }
 
 static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
@@ -733,7 +754,7 @@ static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
   in.theta_e = frames_wrap_pi(drv->pos.out.theta + drv->pos.out.omega * (s->t_i - drv->pos.out.t));
   in.omega_e = drv->pos.out.omega;
   in.v_lin = drv->v_lin;
-  in.mode = mode_in_force(drv);
+  in.mode = drv->mode;
   in.torque_ref = in.mode == DRIVE_MODE_SPEED ? drv->speed_torque : drv->cmd.torque;
   in.id_ref = drv->cmd.id;
   in.iq_ref = drv->cmd.iq;
@@ -764,115 +785,139 @@ static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
   drive_monitor(drv, &in, &out);
 }
 
-/* Alignment: d current along theta = 0 for align_time, then the position
- * source takes the current's angle as its reference. A star-point source
- * reads the polarity from the motion (pos_dfc.c). An encoder's offset is
- * taken only once the rotor rests (issue 23, point 18: a light free rotor
- * swung through the offset, -57.5 deg): the current's angle leads against
- * the encoder's speed, -k_d omega_e (at most 45 deg), which damps the
- * swing (drive_derive), and the alignment ends when the rotor has settled
- * (|omega_e| < align_w_calm for align_calm_need periods, or from the start
- * for align_still_need), or trips the position fault after
- * DRIVE_ALIGN_SWINGS swings more. */
-FD_COLD FD_NOINLINE static void drive_align(drive_t *drv, const float i[3], const hal_sample_t *s) {
-  const drive_config_t *c = &drv->cfg;
-  const ab_t i_ab = frames_clarke((abc_t){i[0], i[1], i[2]});
-  const bool enc = !drv->gated && drv->align_kd > 0.0f;
-  const float w = drv->pos.out.omega;
-  const float phi =
-      enc ? fd_clampf(-drv->align_kd * w, -0.25f * FRAMES_PI, 0.25f * FRAMES_PI) : 0.0f;
-  const sincos_t sc = frames_sincos(phi);
-  const dq_t v =
-      current_ctrl_update(&drv->align_cc, (dq_t){c->align_current * sc.c, c->align_current * sc.s},
-                          (dq_t){i_ab.alpha, i_ab.beta}, 0.0f, c->v_margin * drv->v_lin);
-  const modulation_out_t m =
-      modulation_minmax((ab_t){v.d, v.q}, s->v_dc, drv->duty_lo, drv->duty_hi);
-  const float none[3] = {0.0f, 0.0f, 0.0f};
-  drv->v_applied = drive_write(drv, m.duty, none, s->v_dc);
-  drv->align_calm_n = fabsf(w) < drv->align_w_calm ? drv->align_calm_n + 1u : 0u;
-  const uint32_t n = ++drv->align_n;
-  /* calm for 2 / w_n, or from the start on for 1 / w_n (a rotor that never
-   * moved: started at the axis, or held) */
-  const bool settled = !enc || drv->align_calm_n >= drv->align_calm_need ||
-                       (drv->align_calm_n == n && n >= drv->align_still_need);
-  if ((float)n * c->ts >= c->align_time && settled) {
-    drv->pos_src->align(&drv->pos_st, c, s, phi);
-    ctrl_reset(&drv->ctrl);
-    drv->v_applied = (ab_t){0.0f, 0.0f};
-    drv->state = DRIVE_STATE_RUN;
-  } else if (enc && drv->align_n >= drv->align_n_timeout) {
-    drive_trip(drv, DRIVE_FAULT_POSITION); /* the rotor did not settle */
-  }
+/* ------------------------------------------------------- the procedures */
+
+/* What a procedure sees of the drive (proc.h): the parameter set, the
+ * machine, the position source and the offsets it hands its result to. */
+static proc_setup_t drive_proc_setup(drive_t *drv) {
+  return (proc_setup_t){&drv->cfg,    &drv->machine, drv->pos_src,
+                        &drv->pos_st, drv->offset,   drv->gated};
 }
 
-/* The held start (drive_hold.h): zero current, two opposite d pulses, then
- * the run on the estimated angle from standstill. In flash (FD_COLD), as
- * drive_hold.c: the ISR's only for the start's few ms, and the G474's CCM
- * has no room left for it. */
-FD_COLD FD_NOINLINE static void drive_hold(drive_t *drv, const float i[3], const hal_sample_t *s) {
-  const ab_t i_ab = frames_clarke((abc_t){i[0], i[1], i[2]});
-  ab_t v;
-  float theta = 0.0f;
-  const int r = drive_hold_step(drv, i_ab, drv->cfg.v_margin * drv->v_lin, &v, &theta);
-  if (r == DRIVE_HOLD_FAIL) {
-    drive_trip(drv, DRIVE_FAULT_POSITION);
-    return;
-  }
-  const modulation_out_t m = modulation_minmax(v, s->v_dc, drv->duty_lo, drv->duty_hi);
-  const float none[3] = {0.0f, 0.0f, 0.0f};
-  drv->v_applied = drive_write(drv, m.duty, none, s->v_dc);
-  if (r == DRIVE_HOLD_DONE) {
-    drv->pos_src->hold(&drv->pos_st, theta);
-    ctrl_reset(&drv->ctrl);
-    drv->v_applied = (ab_t){0.0f, 0.0f};
-    drv->state = DRIVE_STATE_RUN;
-  }
-}
-
-FD_COLD FD_NOINLINE static void drive_start(drive_t *drv) {
+/* The gates come on (a procedure that modulates, or the run): what the run
+ * starts from (the law, the source's input, the speed loop, the monitor),
+ * the pattern in the middle of the duty range, then the gates. */
+FD_COLD FD_NOINLINE static void drive_gates_start(drive_t *drv) {
   ctrl_reset(&drv->ctrl);
   drv->pos.in = (pos_input_t){0.0f, 0.0f}; /* no torque before the run */
   drv->speed_active = false;
   drv->speed_torque = 0.0f;
-  memset(drv->lc_n, 0, sizeof drv->lc_n);
-  drv->ra_n = 0u;
-  drv->ra_w0 = 0.0f;
-  drv->ra_w1 = 0.0f;
+  protect_lc_reset(&drv->lc);
+  protect_ra_reset(&drv->ra);
   drv->tm.lc_cause = 0u;
   drv->v_applied = (ab_t){0.0f, 0.0f};
-  const bool hold = drv->cfg.start_mode == 1u && drv->pos_src->hold != NULL;
-  const bool align =
-      hold || (drv->cfg.align_time > 0.0f && (drv->pos_src->caps & POS_CAP_ALIGN) != 0u);
-  if (align) {
-    current_ctrl_reset(&drv->align_cc);
-    drv->align_n = 0u;
-    drv->align_calm_n = 0u;
-  }
-  drive_hold_reset(drv); /* also its plain pattern: a start aborted mid-pulse left it */
+  drv->plain = false; /* a start aborted mid-pulse may have left it */
   const float mid = 0.5f * (drv->duty_lo + drv->duty_hi);
   const hal_pwm_t p = hal_pwm_centred(mid, mid, mid);
   hal_pwm_write(&p, NULL);
   hal_pwm_enable();
-  drv->state = align ? DRIVE_STATE_ALIGN : DRIVE_STATE_RUN;
 }
 
-static void drive_offset_cal(drive_t *drv, const hal_sample_t *s) {
-  for (int x = 0; x < 3; ++x) {
-    drv->offset_acc[x] += s->i_abc[x];
+/* The start from sequence index k on (proc_start_sequence): the next
+ * procedure that applies begins, the gates coming on first if it
+ * modulates; none left: the law runs (from a reset: a procedure's current
+ * leaves the law's observers and integrators behind). */
+FD_COLD FD_NOINLINE static void drive_proc_next(drive_t *drv, uint32_t k) {
+  const proc_setup_t su = drive_proc_setup(drv);
+  unsigned n;
+  const proc_id_t *seq = proc_start_sequence(&n);
+  while (k < n && !proc_applies(seq[k], &su)) {
+    ++k;
   }
-  drv->offset_n++;
-  if (drv->offset_n < drv->cfg.offset_samples) {
+  const proc_row_t *r = k < n ? proc_row(seq[k]) : NULL;
+  const bool gates = gates_on_state(drv->state);
+  if (!gates && (r == NULL || (r->caps & PROC_CAP_GATES) != 0u)) {
+    drive_gates_start(drv);
+  }
+  drv->proc = r;
+  drv->proc_k = k;
+  drv->plain = false;
+  if (r == NULL) {
+    if (gates) { /* after a procedure with the gates on */
+      ctrl_reset(&drv->ctrl);
+      drv->v_applied = (ab_t){0.0f, 0.0f};
+    }
+    drv->state = DRIVE_STATE_RUN;
     return;
   }
-  const float n = (float)drv->offset_n;
-  for (int x = 0; x < 3; ++x) {
-    drv->offset[x] = drv->offset_acc[x] / n;
-    if (fabsf(drv->offset[x]) > drv->cfg.offset_max) {
-      drive_trip(drv, DRIVE_FAULT_OFFSET);
-      return;
-    }
+  r->init(&drv->proc_st, &su);
+  proc_telemetry_t *t = &drv->tm.proc;
+  *t = (proc_telemetry_t){(uint8_t)r->id, PROC_ST_RUNNING, 0u, 0u, 0u, {0.0f, 0.0f, 0.0f}};
+  drv->state = (drive_state_t)r->state;
+}
+
+/* Disabled, or tripped by another cause, while a procedure ran. */
+FD_COLD FD_NOINLINE static void drive_proc_abort(drive_t *drv) {
+  if (drv->proc->abort != NULL) {
+    drv->proc->abort(&drv->proc_st);
   }
-  drive_start(drv);
+  drv->proc = NULL;
+  drv->plain = false;
+  drv->tm.proc.status = PROC_ST_ABORTED;
+}
+
+/* One period of the procedure in force: its voltage modulated and written
+ * (as a law's, without dead-time compensation), its progress published;
+ * done: the next one or the run; failed: its fault. In flash (FD_COLD): the
+ * ISR's only during the start. */
+FD_COLD FD_NOINLINE static void drive_proc_step(drive_t *drv, const float i[3],
+                                                const hal_sample_t *s) {
+  const proc_row_t *r = drv->proc;
+  const proc_setup_t su = drive_proc_setup(drv);
+  const proc_in_t in = {s, frames_clarke((abc_t){i[0], i[1], i[2]}), drv->cfg.v_margin * drv->v_lin,
+                        &drv->pos.out};
+  proc_out_t out;
+  const int res = r->step(&drv->proc_st, &su, &in, &out);
+  drv->plain = out.plain;
+  if (out.apply) {
+    const modulation_out_t m = modulation_minmax(out.v_ab, s->v_dc, drv->duty_lo, drv->duty_hi);
+    const float none[3] = {0.0f, 0.0f, 0.0f};
+    drv->v_applied = drive_write(drv, m.duty, none, s->v_dc);
+  }
+  proc_telemetry_t *t = &drv->tm.proc;
+  r->publish(&drv->proc_st, t);
+  if (res == PROC_FAILED) {
+    t->status = PROC_ST_FAILED;
+    t->fault = out.fault;
+    drv->proc = NULL;
+    drv->plain = false;
+    drive_trip(drv, out.fault);
+  } else if (res == PROC_DONE) {
+    t->status = PROC_ST_DONE;
+    drive_proc_next(drv, drv->proc_k + 1u);
+  }
+}
+
+/* The safe state with the gates not modulating (protect/drive_safe.h):
+ * the part decides on its view, the drive applies its switch actions. In
+ * flash: never in an ISR that runs the law. */
+FD_COLD FD_NOINLINE static void drive_safe(drive_t *drv, const float i[3], const hal_sample_t *s) {
+  const drive_config_t *c = &drv->cfg;
+  const protect_safe_view_t v = {i,
+                                 s->v_dc,
+                                 drv->state,
+                                 drv->faults,
+                                 hal_fault_hw_tripped(),
+                                 drv->pos.out.valid,
+                                 (drv->pos_src->caps & POS_CAP_GATED) != 0u,
+                                 drv->pos.out.omega,
+                                 drv->tm.state == DRIVE_STATE_RUN,
+                                 (dq_t){drv->tm.i_dq[0], drv->tm.i_dq[1]},
+                                 drv->tm.law_tm.flux,
+                                 (drv->ctrl.impl->caps & CTRL_CAP_FLUX) != 0u,
+                                 &drv->machine,
+                                 c->asc_speed,
+                                 c->i_max,
+                                 c->v_dc_max,
+                                 c->ts,
+                                 c->asc_hold};
+  const uint32_t act = protect_safe_step(&drv->safe, &v);
+  if ((act & PROTECT_SAFE_DISABLE) != 0u) {
+    hal_pwm_disable();
+  }
+  if ((act & PROTECT_SAFE_SHORT) != 0u) {
+    hal_pwm_short();
+  }
 }
 
 static void drive_publish(drive_t *drv, const hal_sample_t *s, const float i[3]) {
@@ -917,7 +962,8 @@ void drive_isr(drive_t *drv) {
   if (drv->gated) {
     drive_window_sample(drv, i, s.v_dc);
   }
-  drive_speed_loop(drv); /* on the rates of the previous slow_div periods */
+  drive_schedule(
+      drv); /* the slow rows; the speed loop on the rates of the previous slow_div periods */
   drv->pos_src->update(&drv->pos_st, &drv->cfg, &s, &drv->pos);
   drv->omega_m = drv->pos.out.omega * drv->inv_pole_pairs;
   drv->rate_acc += drv->pos.out.rate;
@@ -942,43 +988,44 @@ void drive_isr(drive_t *drv) {
     if (drv->cmd.law != drv->ctrl.law && drv->cmd.law != drv->law_refused && !drv->cfg_pending) {
       drive_select_law(drv);
     }
-    if (enable && !drv->safe.asc) { /* the short first ends (drive_safe.c) */
-      drv->offset_acc[0] = drv->offset_acc[1] = drv->offset_acc[2] = 0.0f;
-      drv->offset_n = 0u;
+    if (enable && !drv->safe.asc) { /* the short first ends (protect/drive_safe.c) */
       drv->pos_src->reset(&drv->pos_st);
-      drv->state = DRIVE_STATE_OFFSET_CAL;
+      drive_proc_next(drv, 0u); /* the start's first procedure: the offsets */
     }
     break;
   case DRIVE_STATE_OFFSET_CAL:
     if (!enable) {
+      drive_proc_abort(drv);
       drv->state = DRIVE_STATE_IDLE;
     } else {
-      drive_offset_cal(drv, &s);
+      drive_proc_step(drv, i, &s);
     }
     break;
   case DRIVE_STATE_ALIGN:
   case DRIVE_STATE_RUN:
     if (!enable) {
       drive_gates_off(drv);
-      drive_safe_leave_gates(drv);
+      protect_safe_leave_gates(&drv->safe);
+      if (drv->proc != NULL) {
+        drive_proc_abort(drv);
+      }
       drv->state = DRIVE_STATE_IDLE;
     } else if (drv->state == DRIVE_STATE_ALIGN) {
-      if (drv->cfg.start_mode == 1u) {
-        drive_hold(drv, i, &s);
-      } else {
-        drive_align(drv, i, &s);
-      }
+      drive_proc_step(drv, i, &s); /* the alignment or the held start */
     } else {
       drive_run(drv, i, &s);
     }
     break;
   case DRIVE_STATE_FAULT:
   default:
-    break; /* all off or shorted: drive_safe_step */
+    if (drv->proc != NULL) { /* tripped by another cause during a procedure */
+      drive_proc_abort(drv);
+    }
+    break; /* all off or shorted: drive_safe */
   }
   if (!gates_on_state(drv->state)) {
     drv->v_applied = (ab_t){0.0f, 0.0f};
-    drive_safe_step(drv, i, &s);
+    drive_safe(drv, i, &s);
   }
   drive_publish(drv, &s, i);
 }

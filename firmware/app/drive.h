@@ -38,27 +38,26 @@
 #define FLUXDRIVE_DRIVE_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "control/current_ctrl.h"
 #include "control/speed_ctrl.h"
 #include "ctrl.h"
 #include "drive_config.h"
-#include "drive_phase_check.h"
 #include "hal.h"
 #include "model/machine.h"
 #include "pos_source.h"
-
-/* Loss-of-control conditions (drive_telemetry_t.lc_cause). */
-enum {
-  DRIVE_LC_CURRENT = 1u << 0,  /* |i| above lc_current * i_max */
-  DRIVE_LC_DELTA = 1u << 1,    /* |load angle| beyond delta_max + lc_delta */
-  DRIVE_LC_TORQUE = 1u << 2,   /* torque off its (deliverable) reference */
-  DRIVE_LC_FLUX = 1u << 3,     /* flux off its reference */
-  DRIVE_LC_OBSERVER = 1u << 4, /* observer flux off the current model */
-  DRIVE_LC_RUNAWAY = 1u << 5   /* speed running away against the speed loop's torque */
-};
-#define DRIVE_LC_COUNT 5 /* the ISR's own conditions; the run-away is the speed loop's */
+#include "proc.h"
+/* the protections, each an owned part (docs/architecture.md, "Adding a
+ * protection"); lc_monitor.h defines the DRIVE_LC_* causes */
+#include "protect/drive_phase_check.h"
+#include "protect/drive_pos_check.h"
+#include "protect/drive_safe.h"
+#include "protect/isum.h"
+#include "protect/lc_monitor.h"
+#include "protect/overrun.h"
+#include "protect/runaway.h"
 
 /* Low-pass of the applied voltage for the main loop's voltage balance
  * (drive_telemetry_t.v_ab_filt): the share of each ISR's voltage. */
@@ -92,6 +91,7 @@ typedef struct {
   uint32_t armed;        /* drive_t.armed, written where it changes (a trip, a clear that
                             cleared a fault, an enable command after them) */
   ctrl_telemetry_t law_tm;
+  proc_telemetry_t proc;  /* the procedure in force or the last one: progress, results (proc.h) */
   uint32_t isr_count_end; /* ... and last: equal to isr_count in a consistent copy */
 } drive_telemetry_t;
 
@@ -112,43 +112,34 @@ typedef struct {
   uint32_t fault_total;                    /* drive_request_fault() calls, all bits */
 } drive_cmd_t;
 
-/* The safe state while the gates do not modulate (idle, fault): all
- * switches off, or the active short circuit (drive_safe.c). ISR-owned. */
-typedef struct {
-  bool decide;     /* the gates just left modulation: choose at this ISR */
-  bool asc;        /* active short circuit engaged */
-  float w_i;       /* electrical speed from the current vector's rotation [rad/s] */
-  float i_prev[2]; /* the previous current vector (alpha, beta) [A] */
-  uint32_t n;      /* periods since the short began */
-  uint32_t n_low;  /* consecutive periods below the exit speed */
-  uint32_t n_high; /* consecutive periods above the entry speed (gates off) */
-} drive_safe_t;
-
 typedef struct drive_s {
   /* ===== owned by the ISR ===== */
   const hal_caps_t *caps;
   drive_state_t state;
   uint32_t faults;
   uint32_t isr_count;
-  drive_cmd_t cmd;   /* the commands in force (the ISR's copy of req) */
-  uint32_t cfg_seen; /* creq.seq taken */
-  bool cfg_pending;  /* a parameter set waits for the gates to go off (or
-                        for the fault and the short to end) */
-  bool armed;        /* an enable command posted since the last disarm (arm_mark) */
+  drive_cmd_t cmd;    /* the commands in force (the ISR's copy of req) */
+  uint32_t cfg_seen;  /* creq.seq taken */
+  bool cfg_pending;   /* a parameter set waits for the gates to go off (or
+                         for the fault and the short to end) */
+  bool armed;         /* an enable command posted since the last disarm (arm_mark) */
+  drive_mode_t mode;  /* the mode in force: cmd.mode unless the law lacks it (drive_mode_refresh) */
+  uint32_t lc_checks; /* PROTECT_LC_CHECK_* with this law and mode (drive_mode_refresh) */
 
-  /* offset calibration */
+  /* the current offsets in force (the offset procedure's, proc_offset.c) */
   float offset[3];
-  float offset_acc[3];
-  uint32_t offset_n;
 
-  /* alignment (state align): d current along theta = 0 (an encoder's:
-   * damped by its speed, held until the rotor has settled) */
-  current_ctrl_t align_cc;
-  uint32_t align_n;
+  /* the procedure in force (proc.h: offset calibration, alignment, held
+   * start), its place in the start sequence and its state: 84 B on the
+   * Cortex-M, what the offset calibration's and the alignment's fields took
+   * here before, so the periodic path's fields after them keep their
+   * offsets (and the PIL counts; a larger union moves them) */
+  const proc_row_t *proc; /* NULL: none (idle, run, fault) */
+  uint32_t proc_k;        /* its index in proc_start_sequence() */
+  proc_state_t proc_st;
 
   /* position */
   const pos_source_row_t *pos_src;
-  pos_state_t pos_st;
   pos_io_t pos;   /* the source's estimate (out), and its input (in): the last run
                      period's q current and torque (0 from a start) */
   float omega_m;  /* mechanical speed (source, per ISR) [rad/s] */
@@ -156,25 +147,33 @@ typedef struct drive_s {
   uint32_t rate_n;
 
   /* control */
-  ctrl_t ctrl;
   ab_t v_applied;     /* voltage applied over the period ending at this sample */
   speed_ctrl_t speed; /* run every slow_div ISRs */
   bool speed_active;
   float speed_torque;                       /* torque reference from the speed loop [N m] */
   float torque_min_avail, torque_max_avail; /* what the law can deliver now */
-  uint32_t lc_n[DRIVE_LC_COUNT];            /* periods each condition has held */
-  uint32_t ra_n;                            /* speed-loop periods the run-away condition held */
-  float ra_w0, ra_w1; /* the speed's sums over the window's first and last quarter [rad/s] */
-  float torque_scale, flux_scale; /* torque and flux amplitude on MTPA at i_max */
-  float lc_n_fast, lc_n_track;    /* lc_time, lc_track_time in periods */
+  protect_lc_t lc;                          /* the loss-of-control monitor (every run period) */
   float inv_pole_pairs;
   float v_lin;            /* linear voltage range now [V] */
   float duty_lo, duty_hi; /* duty range: the board's, narrowed by a DFC window */
   float v_lin_k;          /* linear voltage range per volt of DC link */
   unsigned dfc_leg;       /* leg of the next DFC test vector (0: v1, 1: v3, 2: v5) */
   bool gated;             /* the position source measures through the DFC window */
+  bool plain;             /* the pattern without the DFC window: a procedure's clean sample
+                             (the held start's pulses, proc_hold.c) */
   float win_m[3];         /* the window pattern in force: phase moments (dfc_window.h) */
   float win_k;            /* Ts / L of their current correction [s/H] */
+
+  /* telemetry, under a sequence lock: written every period, right after
+   * the per-period scalars (its floats within a VSTR's reach too) */
+  volatile uint32_t tm_seq;
+  drive_telemetry_t tm;
+
+  /* the per-period parts the code reaches through a pointer (after the
+   * per-period scalars: they do not push those beyond the short load
+   * offsets: the asserts after the type) */
+  ctrl_t ctrl;        /* the control law in force and its state */
+  pos_state_t pos_st; /* the position source's state */
 
   /* the parameter set in force and its machine (after the per-period
    * state: a parameter added to the table does not move that state's
@@ -183,10 +182,6 @@ typedef struct drive_s {
   drive_config_t cfg; /* in force */
   machine_t machine;
   flux_map_t map; /* cfg's flux map, parsed (machine.map points here) */
-
-  /* telemetry, under a sequence lock */
-  volatile uint32_t tm_seq;
-  drive_telemetry_t tm;
 
   /* ===== written by the main loop only ===== */
   struct {
@@ -213,40 +208,44 @@ typedef struct drive_s {
   drive_law_t law_refused;   /* a law whose switch the ISR refused (DRIVE_LAW_COUNT: none) */
   uint32_t fault_total_seen; /* req.fault_total taken */
   uint32_t fault_seen[DRIVE_FAULT_COUNT];
-  int32_t i_sum_n;   /* the current-sensor check's leaky count (drive.c) */
-  drive_safe_t safe; /* the safe state with the gates not modulating (drive_safe.c) */
-  float psi_pm;      /* |flux linkage at zero current| of the model [Vs] */
-  dq_t psi0;         /* that flux linkage [Vs] */
-  float asc_psi_max; /* largest stator flux a short may trap (drive_safe_psi_max) [Vs] */
-  float i_sc;        /* |current at zero flux|: the steady short-circuit current at speed [A] */
-  int32_t pos_chk_n; /* the position plausibility check's leaky count (drive_pos_check.c) */
-  float pos_emf_res; /* its residual / tolerance at the last check (logs) */
-  dq_t pos_psi;      /* the model flux at the last check [Vs] */
-  bool pos_psi_ok;   /* ... taken in this run */
-  /* the ISR overrun check (drive_overrun.c), at the slow rate */
-  uint32_t overrun_seen; /* the board's overrun count at the last slow period */
-  uint32_t overrun_hist; /* bit j: overruns in the slow period j back */
-  /* the alignment's settling (drive_align; an encoder's: damped by its
-   * speed, held until the rotor has settled) */
-  uint32_t align_calm_n;     /* periods the encoder's speed has stayed below align_w_calm */
-  float align_kd;            /* the damping: angle of the current per electrical rad/s [s] */
-  float align_w_calm;        /* settled: |speed| below this [rad/s electrical] ... */
-  uint32_t align_calm_need;  /* ... for this many periods */
-  uint32_t align_still_need; /* ... or from the start for this many */
-  uint32_t align_n_timeout;  /* not settled after this many periods: position fault */
-
-  /* the held start (start_mode 1, state align; drive_hold.c) */
-  struct {
-    uint8_t phase;           /* DRIVE_HOLD_* */
-    uint16_t n;              /* periods into the phase */
-    float theta;             /* the estimate's angle the pulses are applied along [rad] */
-    float i0;                /* the d current when a pulse began [A] */
-    float di[2];             /* the d current each pulse built, along theta and theta + pi [A] */
-    uint8_t n_pulse, n_zero; /* periods of each pulse and of the way back (drive_hold.c) */
-    dq_t v_prev;             /* the voltage asked last period, in the estimate's frame [V] */
-    bool plain;              /* the pattern without the DFC window (a pulse's clean sample) */
-  } hold;
+  /* the protections at the slow rate (drive.c's schedule table) or with
+   * the gates off, each an owned part in protect/ */
+  protect_isum_t isum;       /* the current-sum (current-sensor) check */
+  protect_ra_t ra;           /* the speed loop's run-away check */
+  protect_pos_t pos_chk;     /* the position plausibility check */
+  protect_overrun_t overrun; /* the ISR overrun check */
+  protect_safe_t safe;       /* the safe state with the gates not modulating */
+  float pos_emf_res;         /* pos_chk.res published for the logs (sil/runner/log_npy.c) */
+  float torque_scale;        /* torque on MTPA at i_max [N m] */
+  float flux_scale;          /* flux amplitude on MTPA at i_max [Vs] */
+  float psi_pm;              /* |flux linkage at zero current| of the model [Vs] */
+  dq_t psi0;                 /* that flux linkage [Vs] */
 } drive_t;
+
+/* The layout rules the ISR's instruction counts depend on (docs/pil.md),
+ * on a 32-bit target (the Cortex-M; a host's pointers make it larger):
+ *  - the per-period scalars, up to win_k, within the reach of a single
+ *    VLDR/VSTR from the drive's base (8-bit word offset: 1020 bytes), so
+ *    that each float the ISR reads costs one instruction;
+ *  - the parts reached through a pointer (the law, the position source,
+ *    the parameter set in force) and the telemetry within one ADDW
+ *    (12-bit offset) of the base;
+ *  - the parameter set after the per-period state (a parameter added to
+ *    the table moves nothing the ISR reads every period), and the fields
+ *    used at the slow rate or on a command last, after the main loop's. */
+_Static_assert(sizeof(void *) != 4u || offsetof(drive_t, win_k) + sizeof(float) <= 1024u,
+               "drive_t: a per-period scalar beyond a VLDR's reach from the base");
+_Static_assert(sizeof(void *) != 4u || offsetof(drive_t, tm) + sizeof(drive_telemetry_t) <= 4095u,
+               "drive_t: the telemetry beyond an ADDW's reach from the base");
+_Static_assert(sizeof(void *) != 4u || offsetof(drive_t, cfg) <= 4095u,
+               "drive_t: the parameter set beyond an ADDW's reach from the base");
+_Static_assert(offsetof(drive_t, cfg) > offsetof(drive_t, win_k) &&
+                   offsetof(drive_t, ctrl) > offsetof(drive_t, win_k) &&
+                   offsetof(drive_t, pos_st) > offsetof(drive_t, win_k),
+               "drive_t: the parts reached through a pointer after the per-period scalars");
+_Static_assert(offsetof(drive_t, clear_seen) > offsetof(drive_t, host) &&
+                   offsetof(drive_t, psi0) > offsetof(drive_t, clear_seen),
+               "drive_t: the slow-rate and command fields last");
 
 /* Validates cfg, initialises everything and latches DRIVE_FAULT_WATCHDOG
  * if the last reset was the watchdog's. 0, or -1 with *err naming the

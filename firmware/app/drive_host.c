@@ -32,11 +32,29 @@ bool drive_telemetry_read(drive_t *drv, drive_telemetry_t *out) {
   return false;
 }
 
+/* The phase-balance check (protect/drive_phase_check.h) on the fresh
+ * telemetry copy, with the parameters requested; its fault is requested
+ * like any other main-loop fault (taken by the next ISR). */
+static void phase_check(drive_t *drv) {
+  const drive_telemetry_t *tm = &drv->host.tm;
+  const drive_config_t *c = &drv->creq.cfg;
+  const drive_phase_view_t v = {tm->isr_count, tm->state == DRIVE_STATE_RUN,
+                                tm->omega_m,   tm->i_abc,
+                                tm->v_ab_filt, tm->theta_e,
+                                tm->v_dc,      c->pole_pairs,
+                                c->ts,         c->rs,
+                                c->i_max};
+  const uint32_t f = drive_phase_check(&drv->host.ph, &v);
+  if (f != 0u) {
+    drive_request_fault(drv, f);
+  }
+}
+
 void drive_background(drive_t *drv) {
   drive_telemetry_t tm;
   if (drive_telemetry_read(drv, &tm)) {
     drv->host.tm = tm;
-    drive_phase_check(drv);
+    phase_check(drv);
   }
   const uint32_t n = drv->isr_count; /* one aligned word: read atomically */
   if (n != drv->host.isr_seen) {

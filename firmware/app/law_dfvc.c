@@ -106,7 +106,11 @@ static void pi_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *in
   dfvc_law_step(DFVC_LAW_PI, s, su, in, out);
 }
 
-const ctrl_law_t ctrl_law_pi_dfvc = {
-    "pi_dfvc", CTRL_CAP_FLUX | CTRL_CAP_DELTA, dfvc_check, dfvc_law_init, dfvc_law_reset, pi_step};
-const ctrl_law_t ctrl_law_db_dfvc = {
-    "db_dfvc", CTRL_CAP_FLUX | CTRL_CAP_DELTA, dfvc_check, dfvc_law_init, dfvc_law_reset, db_step};
+const ctrl_law_t ctrl_law_pi_dfvc = {"pi_dfvc",      CTRL_CAP_FLUX | CTRL_CAP_DELTA,
+                                     dfvc_check,     dfvc_law_init,
+                                     dfvc_law_reset, pi_step,
+                                     NULL,           0u};
+const ctrl_law_t ctrl_law_db_dfvc = {"db_dfvc",      CTRL_CAP_FLUX | CTRL_CAP_DELTA,
+                                     dfvc_check,     dfvc_law_init,
+                                     dfvc_law_reset, db_step,
+                                     NULL,           0u};

@@ -245,7 +245,7 @@ FD_COLD void pos_star_align(pos_state_t *s, const drive_config_t *cfg, const hal
   }
 }
 
-/* The held start (drive_hold.c): the estimate's branch nearest theta, the
+/* The held start (proc_hold.c): the estimate's branch nearest theta, the
  * polarity resolved; the evidence of an alignment is not used (the rotor
  * was held, a load may have moved it a little). Once per start: FD_COLD. */
 FD_COLD void pos_star_hold(pos_state_t *s, float theta) {

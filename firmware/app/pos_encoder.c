@@ -57,8 +57,10 @@ void pos_encoder_update(pos_state_t *s, const drive_config_t *cfg, const hal_sam
     angle_pll_reset(pll, th, 0.0f);
     s->enc.started = true;
   }
-  out->health = fabsf(frames_wrap_pi(th - pll->theta)); /* measured - predicted */
-  angle_pll_update(pll, th);
+  /* th is finite (frames_wrap_pi): angle_pll_update's error, taken once */
+  const float e = frames_wrap_pi(th - pll->theta);
+  out->health = fabsf(e); /* measured - predicted */
+  angle_pll_update_err(pll, e);
   out->theta = th;
   out->omega = pll->omega;
   out->rate = pll->omega_rate;

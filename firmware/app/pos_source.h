@@ -27,6 +27,7 @@
 #include "estimation/kf_mech.h"
 #include "estimation/rls_ab.h"
 #include "hal.h"
+#include "signal_row.h"
 
 typedef struct {
   float theta;  /* electrical angle at t [rad], (-pi, pi] */
@@ -142,11 +143,15 @@ typedef struct pos_source_row_s {
   /* Whether cfg can run this source: NULL, or the reason with *field set
    * to the parameter (NULL: nothing to check). */
   const char *(*check)(const drive_config_t *cfg, const char **field);
-  /* The held start (start_mode 1, drive_hold.c) knows the rotor is at
+  /* The held start (start_mode 1, proc_hold.c) knows the rotor is at
    * electrical angle theta to within a quarter turn (the polarity from the
    * d-axis saturation pulses): take the branch of the estimate nearest it.
    * NULL: the source cannot start held (it has no angle at standstill). */
   void (*hold)(pos_state_t *s, float theta);
+  /* the source's own signals (logs, docs/log-format.md): getters on its
+   * pos_state_t, read after the ISR; NULL, 0: none */
+  const signal_row_t *signals;
+  unsigned n_signals;
   /* the star point's columns (pos_star.h) */
   const pos_method_t *method;   /* DFC, inverse DFC, IVD (Full IVD with phase shifts) */
   const pos_tracker_t *tracker; /* PLL, Kalman filter, EKF */

@@ -9,6 +9,7 @@
  */
 #include <stddef.h>
 
+#include "pos_dfc_signals.h"
 #include "pos_encoder.h"
 #include "pos_star.h"
 
@@ -17,6 +18,7 @@
     .caps = POS_CAP_ALIGN | POS_CAP_GATED, .init = pos_star_init, .reset = pos_star_reset,         \
     .update = pos_star_update, .align = pos_star_align, .check = pos_star_check,                   \
     .hold = pos_star_hold, .method = (m), .tracker = (t), .ident = (i),                            \
+    .signals = pos_dfc_signals, .n_signals = POS_DFC_N_SIGNALS,                                    \
   }
 
 /* The EKF is not combined with the RLS: its angle is itself a function of
@@ -29,7 +31,9 @@ static const pos_source_row_t sources[POS_SOURCE_COUNT] = {
                             .update = pos_encoder_update,
                             .align = pos_encoder_align,
                             .check = pos_encoder_check,
-                            .hold = NULL},
+                            .hold = NULL,
+                            .signals = NULL,
+                            .n_signals = 0u},
     /*                              method               tracker           identification */
     [POS_SOURCE_DFC] = POS_STAR_ROW(&pos_method_dfc, &pos_tracker_pll, NULL),
     [POS_SOURCE_DFC_INV] = POS_STAR_ROW(&pos_method_dfc_inv, &pos_tracker_pll, NULL),

@@ -6,7 +6,9 @@
  *
  * --print-config prints the resolved parameters (JSON) and exits.
  * --print-params prints the parameter table and the drive's named values
- * (JSON; no scenario needed) and exits.
+ * (JSON; no scenario needed) and exits; --print-signals the signal tables
+ * (the log's columns, the CAN signals and PIL fields they fill: JSON, no
+ * scenario needed, signals_json.h).
  * --preempt PERIODS [--seed N] [--max-gap-us U] runs PERIODS ISRs of the
  * scenario's plant and drive with the ISR preempting the main loop at
  * random points (sil/runner/sil_preempt.h; at most 600 s of wall time) and
@@ -36,6 +38,7 @@
 #include "log_npy.h"
 #include "scenario.h"
 #include "sil_preempt.h"
+#include "signals_json.h"
 #include "sil_run.h"
 #include "summary.h"
 
@@ -43,6 +46,7 @@ static int usage(void) {
   fprintf(stderr,
           "usage: fluxdrive-sil SCENARIO.json [--log PATH.npy] [--summary PATH.json]\n"
           "                     [--decimate N] [--bench] [--print-config] [--print-params]\n"
+          "                     [--print-signals]\n"
           "                     [--record-isr PATH.bin] [--realtime]\n"
           "                     [--preempt PERIODS [--seed N] [--max-gap-us U]]\n"
           "                     [--can socketcand:PORT | --can socketcan:IFACE]\n"
@@ -95,7 +99,7 @@ static int parse_long(const char *opt, const char *s, long lo, long hi, long *ou
 
 int main(int argc, char **argv) {
   const char *scenario = NULL, *log_path = NULL, *summary_path = NULL, *record_path = NULL;
-  int decimate = 0, bench = 0, print_config = 0, print_params = 0, realtime = 0;
+  int decimate = 0, bench = 0, print_config = 0, print_params = 0, print_signals = 0, realtime = 0;
   const char *can = NULL;
   long preempt_n = 0;
   double max_gap_us = 20.0;
@@ -134,6 +138,8 @@ int main(int argc, char **argv) {
       print_config = 1;
     } else if (strcmp(argv[i], "--print-params") == 0) {
       print_params = 1;
+    } else if (strcmp(argv[i], "--print-signals") == 0) {
+      print_signals = 1;
     } else if (strcmp(argv[i], "--preempt") == 0 && i + 1 < argc) {
       if (parse_long("--preempt", argv[++i], 1, 100000000, &preempt_n) != 0) {
         return 2;
@@ -154,8 +160,8 @@ int main(int argc, char **argv) {
       scenario = argv[i];
     }
   }
-  if (print_params) {
-    char *js = params_json();
+  if (print_params || print_signals) {
+    char *js = print_params ? params_json() : signals_json();
     if (js == NULL) {
       return 1;
     }

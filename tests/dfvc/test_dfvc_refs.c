@@ -45,7 +45,7 @@ static double w_of_rpm(double rpm) {
  * 0.21696787017745833 (11), 0.26903750507749286 (20). */
 static void test_mtpa(void **state) {
   (void)state;
-  const dfvc_refs_t r = make();
+  dfvc_refs_t r = make();
   near_rel(dfvc_refs_lambda_mtpa(&r, 0.0f), 0.19, 1e-6);
   near_rel(dfvc_refs_lambda_mtpa(&r, 10.0f), 0.21253304398276637, 1e-6);
   near_rel(dfvc_refs_lambda_mtpa(&r, -11.0f), 0.21696787017745833, 1e-6);
@@ -58,7 +58,7 @@ static void test_mtpa(void **state) {
 
 static void test_voltage_limit(void **state) {
   (void)state;
-  const dfvc_refs_t r = make();
+  dfvc_refs_t r = make();
   const double vmax = 310.0 / sqrt(3.0) * 0.95;
   const double rpm[3] = {600.0, 1200.0, -900.0};
   const double ids = -1.2, iqs = 2.1;
@@ -114,7 +114,7 @@ static void test_voltage_limit(void **state) {
 
 static void test_iqs_limits(void **state) {
   (void)state;
-  const dfvc_refs_t r = make();
+  dfvc_refs_t r = make();
   dfvc_refs_out_t o;
   /* 10 N m at 100 rpm: eq. (24), no limit */
   dfvc_refs_in_t in = {10.0f, 0.0f, (float)w_of_rpm(100.0), 310.0f / sqrtf(3.0f),
@@ -154,7 +154,7 @@ static void test_iqs_limits(void **state) {
  * the same for both torque signs, with tan capped at tan(delta_max). */
 static void test_iqs_limit_next(void **state) {
   (void)state;
-  const dfvc_refs_t r = make();
+  dfvc_refs_t r = make();
   dfvc_refs_out_t o;
   const double d1 = 60.0 * 0.017453292519943295, ids1 = 1.9, iqs1 = 2.9;
   dfvc_refs_in_t in = {

@@ -4,7 +4,7 @@ docs/faults.md, the run-away row).
 A drive whose position is wrong turns its torque against its speed loop: the
 rotor runs away from the reference while the loop asks for the opposite
 torque. The drive's speed loop checks it (firmware/app/drive.c,
-drive_runaway_check): the speed off the ramped reference by more than
+protect/runaway.c, protect_ra_step): the speed off the ramped reference by more than
 RA_MARGIN |w_ref| + RA_FLOOR speed_max with the loop's torque pushing back,
 held for RA_TIME with the speed itself moved RA_FLOOR speed_max further
 away from the reference (against the torque), trips
@@ -46,7 +46,7 @@ PP = 8  # fabbri2022_t51
 SPEED_MAX = 1500.0 * RPM  # the preset's speed_max [rad/s]
 NOISE = 0.0368  # V, the calibrated star noise
 REF = 300.0  # rpm
-RA_MARGIN, RA_FLOOR, RA_TIME = 0.2, 0.02, 0.02  # drive.c DRIVE_RA_*
+RA_MARGIN, RA_FLOOR, RA_TIME = 0.2, 0.02, 0.02  # protect/runaway.h PROTECT_RA_*
 LC, POSITION = "lost_control", "position"
 LC_RUNAWAY = 32
 RATED = 0.3  # N m, the preset's rated torque

@@ -3,7 +3,7 @@
  * while the profile is > 0.5 the PWM-period interrupt ends after the next
  * valley; its pattern misses the timer's update (the previous one acts one
  * more period) and the board counts an overrun (hal_isr_stats). The drive's
- * `overrun` fault (drive_overrun.c) trips when overruns occurred in
+ * `overrun` fault (protect/overrun.c) trips when overruns occurred in
  * overrun_k of the last overrun_n slow periods (defaults 4 of 16, slow
  * period 1 ms).
  * Base: the Rubino 2020 SPM machine (p = 21, L = 57 mH, lambda_m = 0.19 Vs)

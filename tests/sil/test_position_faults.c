@@ -1,6 +1,6 @@
 /*
  * SIL: encoder faults and the position plausibility check (issue 13 item
- * 2; firmware/app/drive_pos_check.c, sil/runner/sil_enc_faults.c,
+ * 2; firmware/app/protect/drive_pos_check.c, sil/runner/sil_enc_faults.c,
  * docs/faults.md).
  *
  * Rubino's SPM machine, free rotor without load, FOC speed control at

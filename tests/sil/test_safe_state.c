@@ -1,6 +1,6 @@
 /*
  * SIL: the safe state after a trip at top speed with an active load
- * (issue 13 item 5; firmware/app/drive_safe.c, docs/faults.md).
+ * (issue 13 item 5; firmware/app/protect/drive_safe.c, docs/faults.md).
  *
  * A dynamometer (imposed speed: an active load of any strength) turns the
  * machine at its top speed on a diode-rectifier link (braking energy stays

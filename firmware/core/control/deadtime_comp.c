@@ -8,7 +8,7 @@
 
 #include "math/fd_math.h"
 
-int deadtime_comp_init(deadtime_comp_t *d, const deadtime_comp_cfg_t *cfg) {
+FD_COLD int deadtime_comp_init(deadtime_comp_t *d, const deadtime_comp_cfg_t *cfg) {
   memset(d, 0, sizeof(*d));
   if (!(fd_isfinite(cfg->td) && cfg->td >= 0.0f && fd_isfinite(cfg->ts) && cfg->ts > 0.0f &&
         cfg->td < cfg->ts && fd_isfinite(cfg->i_band) && cfg->i_band >= 0.0f)) {

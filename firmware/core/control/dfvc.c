@@ -11,7 +11,7 @@
 #define DFVC_2PI 6.28318530717959f
 #define DFVC_DEG 0.0174532925199433f
 
-void dfvc_cfg_defaults(dfvc_cfg_t *cfg, const machine_t *machine) {
+FD_COLD void dfvc_cfg_defaults(dfvc_cfg_t *cfg, const machine_t *machine) {
   memset(cfg, 0, sizeof(*cfg));
   cfg->machine = machine;
   cfg->ts = 62.5e-6f; /* Rubino 2020, section IV: 16 kHz */
@@ -53,6 +53,8 @@ FD_COLD int dfvc_init(dfvc_t *c, const dfvc_cfg_t *cfg) {
       dfvc_pi_init(&c->pi, &ic) != 0) {
     return -1;
   }
+  /* rot_advance exactly 0.5 (<= and >= : no float ==) */
+  c->adv_half = k->rot_advance >= 0.5f && k->rot_advance <= 0.5f;
   c->last_law = DFVC_LAW_DEADBEAT;
   return 0;
 }
@@ -77,6 +79,13 @@ static int dfvc_inputs_ok(const dfvc_in_t *in) {
                   fd_zero_if_finite(in->v_lin) + fd_zero_if_finite(in->torque_ref) +
                   fd_zero_if_finite(in->lambda_ref);
   return (in->law == DFVC_LAW_DEADBEAT || in->law == DFVC_LAW_PI) && fd_isfinite(z);
+}
+
+/* delta(tau+1) = theta_s(tau+1) - theta_r(tau+1), wrapped; theta_r(tau+1)
+ * = theta_r + omega_r Ts (dfvc.h) */
+static float dfvc_delta_next(const dfvc_in_t *in, const flux_observer_out_t *o, float ts) {
+  const float theta_r1 = in->theta_r + in->omega_r * ts;
+  return frames_wrap_pi(fd_atan2f(o->sc_s_next.s, o->sc_s_next.c) - theta_r1);
 }
 
 void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
@@ -104,9 +113,7 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
   flux_observer_out_t o;
   flux_observer_update_sc(&c->obs, in->i_ab, i1, in->v_ab_applied, in->theta_r, scr, in->omega_r,
                           &o);
-  const float theta_r1 = in->theta_r + in->omega_r * k->ts;
   const dq_t i1_dqs = frames_park(i1, o.sc_s_next);
-  const float delta1 = frames_wrap_pi(o.theta_s_next - theta_r1);
   const sincos_t sc_delta1 = frames_sincos_sub(o.sc_s_next, scr1);
 
   /* references, Fig. 5, eqs. (22)-(26), from the quantities at tau; the
@@ -127,6 +134,12 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
     di.lambda_s_next = o.lambda_s_next;
     di.i_dqs_next = i1_dqs;
     di.omega_r = in->omega_r;
+    /* delta(tau+1) as an angle (an atan2) only where it is read: the
+     * observed rate, and the target's branch beyond |delta| = pi/2 (the
+     * asin of dfvc_deadbeat_omega_delta_target_sc; 0 is not read there) */
+    const float delta1 = (k->omega_delta_mode != DFVC_OMEGA_DELTA_TARGET || !(sc_delta1.c >= 0.0f))
+                             ? dfvc_delta_next(in, &o, k->ts)
+                             : 0.0f;
     di.omega_delta =
         (k->omega_delta_mode == DFVC_OMEGA_DELTA_TARGET)
             ? dfvc_deadbeat_omega_delta_target_sc(&c->db, r.iqs_ref, i1_dqs.q, delta1, sc_delta1)
@@ -161,7 +174,9 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
 
   /* (ds, qs) -> (alpha, beta) at the predicted flux angle theta_s(tau+1)
    * (Rubino 2020, Fig. 7), advanced by rot_advance * omega_r * Ts */
-  const sincos_t adv = frames_sincos(k->rot_advance * in->omega_r * k->ts);
+  /* at the default half period this is the predictor's half-angle
+   * evaluation: (0.5 omega_r) Ts and 0.5 (omega_r Ts) are the same float */
+  const sincos_t adv = c->adv_half ? w.half : frames_sincos(k->rot_advance * in->omega_r * k->ts);
   sincos_t scv;
   scv.c = o.sc_s_next.c * adv.c - o.sc_s_next.s * adv.s;
   scv.s = o.sc_s_next.s * adv.c + o.sc_s_next.c * adv.s;

@@ -60,6 +60,7 @@
 #ifndef FD_CONTROL_DFVC_H
 #define FD_CONTROL_DFVC_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "control/dfvc_deadbeat.h"
@@ -157,6 +158,7 @@ typedef struct {
   dfvc_deadbeat_t db;
   dfvc_pi_t pi;
   dfvc_law_t last_law;
+  bool adv_half; /* rot_advance = 0.5: the output rotation is the MPE's half-angle sin/cos */
 } dfvc_t;
 
 /* Paper constants for the given machine (lambda_min from its PM flux). */

@@ -13,7 +13,7 @@ static int dfvc_deadbeat_pos(float x) {
   return fd_isfinite(x) && x > 0.0f;
 }
 
-int dfvc_deadbeat_init(dfvc_deadbeat_t *db, const dfvc_deadbeat_cfg_t *cfg) {
+FD_COLD int dfvc_deadbeat_init(dfvc_deadbeat_t *db, const dfvc_deadbeat_cfg_t *cfg) {
   memset(db, 0, sizeof(*db));
   const dfvc_deadbeat_cfg_t *c = cfg;
   if (!(c->machine != NULL && dfvc_deadbeat_pos(c->machine->lambda_m) && dfvc_deadbeat_pos(c->ts) &&

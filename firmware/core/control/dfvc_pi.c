@@ -37,7 +37,7 @@ static float dfvc_pi_axis(float *integ, float kp, float ki, float ts, float err,
   return y;
 }
 
-int dfvc_pi_init(dfvc_pi_t *c, const dfvc_pi_cfg_t *cfg) {
+FD_COLD int dfvc_pi_init(dfvc_pi_t *c, const dfvc_pi_cfg_t *cfg) {
   memset(c, 0, sizeof(*c));
   const dfvc_pi_cfg_t *k = cfg;
   if (!(k->machine != NULL && dfvc_pi_pos(k->ts) && dfvc_pi_pos(k->bw_flux) &&

@@ -17,7 +17,7 @@ static int dfvc_refs_pos(float x) {
   return fd_isfinite(x) && x > 0.0f;
 }
 
-int dfvc_refs_init(dfvc_refs_t *r, const dfvc_refs_cfg_t *cfg) {
+FD_COLD int dfvc_refs_init(dfvc_refs_t *r, const dfvc_refs_cfg_t *cfg) {
   memset(r, 0, sizeof(*r));
   const dfvc_refs_cfg_t *c = cfg;
   if (!(c->machine != NULL && dfvc_refs_pos(c->machine->lambda_m) && dfvc_refs_pos(c->i_max) &&
@@ -39,6 +39,8 @@ void dfvc_refs_reset(dfvc_refs_t *r) {
   r->cos_delta_max = cd;
   r->tan_delta_max = sd / fd_maxf(cd, 1e-3f); /* delta_max = pi/2: 1000 */
   r->torque_mtpa_max = 1.5f * r->cfg.machine->pole_pairs * r->cfg.machine->lambda_m * r->cfg.i_max;
+  r->mtpa_t = NAN;
+  r->mtpa_lambda = 0.0f;
 }
 
 float dfvc_refs_lambda_mtpa(const dfvc_refs_t *r, float torque_ref) {
@@ -89,13 +91,23 @@ static float dfvc_refs_limit_iqs(const dfvc_refs_out_t *out, float iq, unsigned 
   return iq;
 }
 
-void dfvc_refs_update(const dfvc_refs_t *r, const dfvc_refs_in_t *in, dfvc_refs_out_t *out) {
+/* dfvc_refs_lambda_mtpa(r, t), computed again only when t changes (a NaN
+ * on either side compares false: computed again) */
+static float dfvc_refs_mtpa_cached(dfvc_refs_t *r, float t) {
+  if (!(fabsf(t - r->mtpa_t) <= 0.0f)) {
+    r->mtpa_lambda = dfvc_refs_lambda_mtpa(r, t);
+    r->mtpa_t = t;
+  }
+  return r->mtpa_lambda;
+}
+
+void dfvc_refs_update(dfvc_refs_t *r, const dfvc_refs_in_t *in, dfvc_refs_out_t *out) {
   const dfvc_refs_cfg_t *c = &r->cfg;
   unsigned lim = 0u;
 
   /* Fig. 5: flux reference */
   out->lambda_mtpa =
-      (in->lambda_override > 0.0f) ? in->lambda_override : dfvc_refs_lambda_mtpa(r, in->torque_ref);
+      (in->lambda_override > 0.0f) ? in->lambda_override : dfvc_refs_mtpa_cached(r, in->torque_ref);
   const float vq = dfvc_refs_vq_avail(r, in->v_lin, in->i_ds);
   const float inv_w = 1.0f / fd_maxf(fabsf(in->omega_r), DFVC_REFS_W_MIN);
   out->lambda_vlim = dfvc_refs_vlim_of(r, vq, inv_w, in->omega_r, in->i_qs);

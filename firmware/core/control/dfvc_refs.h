@@ -75,6 +75,10 @@ typedef struct {
   float cos_delta_max;   /* cos(delta_max) [-] */
   float tan_delta_max;   /* tan(delta_max), cap of the slope in (25) [-] */
   float torque_mtpa_max; /* 1.5 p lambda_m I_max [N m] */
+  /* the last MTPA flux (22): the torque reference changes at the speed
+   * loop's rate or with a command, so (22) is reused in between */
+  float mtpa_t;      /* its torque reference [N m] (NaN: none) */
+  float mtpa_lambda; /* dfvc_refs_lambda_mtpa(r, mtpa_t) [Vs] */
 } dfvc_refs_t;
 
 typedef struct {
@@ -109,12 +113,13 @@ typedef struct {
 
 /* Returns 0, or -1 for invalid parameters. */
 int dfvc_refs_init(dfvc_refs_t *r, const dfvc_refs_cfg_t *cfg);
-/* No dynamic state: recomputes the derived limits from cfg. */
+/* Recomputes the derived limits from cfg and forgets the MTPA point. */
 void dfvc_refs_reset(dfvc_refs_t *r);
 /* Eqs. (22)-(23) only (useful to callers and tests). */
 float dfvc_refs_lambda_mtpa(const dfvc_refs_t *r, float torque_ref);
 float dfvc_refs_lambda_vlim(const dfvc_refs_t *r, float v_lin, float omega_r, float i_ds,
                             float i_qs);
-void dfvc_refs_update(const dfvc_refs_t *r, const dfvc_refs_in_t *in, dfvc_refs_out_t *out);
+/* One period; r is written only by the MTPA point's cache. */
+void dfvc_refs_update(dfvc_refs_t *r, const dfvc_refs_in_t *in, dfvc_refs_out_t *out);
 
 #endif

@@ -13,7 +13,7 @@
 #define DFVC_SAT_2PI       6.28318530717959f
 #define DFVC_SAT_I_APP_MIN 0.05f /* below: apparent inductance from the unsaturated one [A] */
 
-void dfvc_sat_cfg_defaults(dfvc_sat_cfg_t *cfg, const machine_t *machine) {
+FD_COLD void dfvc_sat_cfg_defaults(dfvc_sat_cfg_t *cfg, const machine_t *machine) {
   memset(cfg, 0, sizeof(*cfg));
   cfg->machine = machine;
   cfg->ts = 2e-4f;                    /* Varatharajan 2022, section VI: 5 kHz */

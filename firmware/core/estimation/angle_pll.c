@@ -26,7 +26,10 @@ void angle_pll_reset(angle_pll_t *p, float theta, float omega) {
 
 /* A non-finite measurement is skipped: the PLL coasts at its speed. */
 void angle_pll_update(angle_pll_t *p, float theta_meas) {
-  const float e = fd_isfinite(theta_meas) ? frames_wrap_pi(theta_meas - p->theta) : 0.0f;
+  angle_pll_update_err(p, fd_isfinite(theta_meas) ? frames_wrap_pi(theta_meas - p->theta) : 0.0f);
+}
+
+void angle_pll_update_err(angle_pll_t *p, float e) {
   p->omega += p->ki * p->ts * e;
   p->omega_rate = p->omega + p->kp * e;
   p->theta = frames_wrap_pi(p->theta + p->ts * p->omega_rate);

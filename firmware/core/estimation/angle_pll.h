@@ -19,5 +19,8 @@ typedef struct {
 void angle_pll_init(angle_pll_t *p, float bandwidth, float ts);
 void angle_pll_reset(angle_pll_t *p, float theta, float omega);
 void angle_pll_update(angle_pll_t *p, float theta_meas);
+/* The same with the error e = wrap(theta_meas - theta) the caller already
+ * has (a position source's health is |e|: one wrap, not two). */
+void angle_pll_update_err(angle_pll_t *p, float e);
 
 #endif

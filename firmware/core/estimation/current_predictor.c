@@ -29,7 +29,7 @@ void current_predictor_reset(current_predictor_t *p) {
 void current_predictor_speed(const current_predictor_t *p, float omega_r,
                              current_predictor_speed_t *w) {
   w->omega_r = omega_r;
-  w->coef = spm_discrete_coef_rot(&p->disc, omega_r, &w->rot);
+  w->coef = spm_discrete_coef_rot(&p->disc, omega_r, &w->rot, &w->half);
 }
 
 ab_t current_predictor_step_sc(const current_predictor_t *p, const current_predictor_speed_t *w,

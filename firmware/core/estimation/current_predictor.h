@@ -56,6 +56,7 @@ typedef struct {
   float omega_r;            /* [rad/s] */
   spm_discrete_coef_t coef; /* eqs. (14)-(15) at omega_xy = omega_r */
   sincos_t rot;             /* e^{j omega_r Ts} */
+  sincos_t half;            /* e^{j omega_r Ts / 2}: fd_sincosf(0.5f * (omega_r * Ts)) */
 } current_predictor_speed_t;
 
 void current_predictor_speed(const current_predictor_t *p, float omega_r,

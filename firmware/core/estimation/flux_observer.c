@@ -10,7 +10,7 @@
 #include "math/fast_trig.h"
 #include "math/fd_math.h"
 
-/* The integrator and its angles inlined into each entry point (as calls
+/* The integrator, its angles and the polar form inlined into each entry point (as calls
  * they cost the SPM laws 43 instructions a period, PIL). */
 #if defined(__GNUC__)
 #define FO_INLINE static inline __attribute__((always_inline))
@@ -20,7 +20,7 @@
 
 /* Amplitude and unit vector of a flux vector; a vanishing vector gets the
  * identity direction (theta = 0). */
-static float flux_observer_polar(ab_t x, sincos_t *sc) {
+FO_INLINE float flux_observer_polar(ab_t x, sincos_t *sc) {
   const float a = sqrtf(x.alpha * x.alpha + x.beta * x.beta);
   if (a > 1e-9f) {
     sc->c = x.alpha / a;
@@ -97,7 +97,6 @@ FO_INLINE void fo_angles(flux_observer_t *o, float theta_r, float omega_r,
                          flux_observer_out_t *out) {
   const flux_observer_cfg_t *c = &o->cfg;
   out->theta_s = fd_atan2f(out->sc_s.s, out->sc_s.c);
-  out->theta_s_next = fd_atan2f(out->sc_s_next.s, out->sc_s_next.c);
   /* flux-frame speed: filtered derivative of theta_s */
   if (!o->angles_started) {
     o->omega_s = fd_isfinite(omega_r) ? omega_r : 0.0f;
@@ -129,7 +128,6 @@ void flux_observer_update_cm(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, ab
   fo_core(o, i, i_next, v, lcm, out);
   /* the angles: flux_observer_angles() */
   out->theta_s = 0.0f;
-  out->theta_s_next = 0.0f;
   out->omega_s = 0.0f;
   out->delta = 0.0f;
 }

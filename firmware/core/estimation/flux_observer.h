@@ -58,7 +58,8 @@ typedef struct {
   ab_t lambda_cm;      /* current model at t, eq. (2) [Vs] */
   ab_t lambda_next;    /* prediction at t+1, eq. (19) [Vs] */
   float lambda_s_next; /* [Vs] */
-  float theta_s_next;  /* [rad] */
+  /* its angle is left to the caller (fd_atan2f(sc_s_next.s, sc_s_next.c)):
+   * the DFVC needs it on a rare branch only, so no atan2 every period */
   sincos_t sc_s_next;
   float omega_s; /* filtered d theta_s / dt [rad/s] */
   float delta;   /* load angle theta_s - theta_r at t, wrapped [rad] */
@@ -84,11 +85,11 @@ void flux_observer_update_sc(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, fl
  * this observer with omega_c = g and the flux map (or any machine model) as
  * the current model (the rotation e^{J theta} of a diagonal G commutes with
  * the difference). The SPM model of update_sc is one such current model.
- * Fills every field but the angles (theta_s, theta_s_next, omega_s, delta:
- * 0), which cost two atan2 a period: flux_observer_angles(). */
+ * Fills every field but the angles (theta_s, omega_s, delta: 0), which
+ * cost an atan2 a period: flux_observer_angles(). */
 void flux_observer_update_cm(flux_observer_t *o, ab_t i, ab_t i_next, ab_t v, ab_t lambda_cm,
                              flux_observer_out_t *out);
-/* The angles of out (after update_cm): theta_s, theta_s_next, the filtered
+/* The angles of out (after update_cm): theta_s, the filtered
  * omega_s and the load angle delta = theta_s - theta_r. */
 void flux_observer_angles(flux_observer_t *o, float theta_r, float omega_r,
                           flux_observer_out_t *out);

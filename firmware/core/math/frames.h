@@ -106,8 +106,10 @@ float frames_wrap_pi_slow(float theta);
 
 /* Wrap an angle to [-pi, pi). Non-finite input gives 0. Constant time. */
 static inline float frames_wrap_pi(float theta) {
-  /* Fast paths: nearly every caller is within one turn of the range. */
-  if (theta >= -FRAMES_PI && theta < FRAMES_PI) {
+  /* Fast paths: nearly every caller is within one turn of the range. The
+   * first as |theta| < pi: one constant and one compare (theta = -pi, in
+   * the range, takes the slow path, which returns it unchanged) */
+  if (fabsf(theta) < FRAMES_PI) {
     return theta;
   }
   if (theta >= FRAMES_PI && theta < 3.0f * FRAMES_PI) {

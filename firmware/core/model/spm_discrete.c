@@ -23,7 +23,7 @@ void spm_discrete_reset(spm_discrete_t *m) {
   m->b_ab = m->one_minus_k / m->rs;
 }
 
-int spm_discrete_init(spm_discrete_t *m, float rs, float ls, float ts) {
+FD_COLD int spm_discrete_init(spm_discrete_t *m, float rs, float ls, float ts) {
   memset(m, 0, sizeof(*m));
   if (!spm_discrete_valid(rs) || !spm_discrete_valid(ls) || !spm_discrete_valid(ts)) {
     return -1;
@@ -37,16 +37,20 @@ int spm_discrete_init(spm_discrete_t *m, float rs, float ls, float ts) {
 
 spm_discrete_coef_t spm_discrete_coef(const spm_discrete_t *m, float omega_xy) {
   sincos_t rot;
-  return spm_discrete_coef_rot(m, omega_xy, &rot);
+  sincos_t half;
+  return spm_discrete_coef_rot(m, omega_xy, &rot, &half);
 }
 
-spm_discrete_coef_t spm_discrete_coef_rot(const spm_discrete_t *m, float omega_xy, sincos_t *rot) {
+spm_discrete_coef_t spm_discrete_coef_rot(const spm_discrete_t *m, float omega_xy, sincos_t *rot,
+                                          sincos_t *half) {
   spm_discrete_coef_t c;
   const float phi = omega_xy * m->ts; /* eq. (12) */
   /* one sin/cos evaluation at phi/2: sin phi = 2 sh ch, 1 - cos phi = 2 sh^2 */
   float sh;
   float ch;
   fd_sincosf(0.5f * phi, &sh, &ch);
+  half->s = sh;
+  half->c = ch;
   const float vers = 2.0f * sh * sh;
   /* Rubino 2020, eq. (14) */
   rot->c = 1.0f - vers;

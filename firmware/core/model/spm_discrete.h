@@ -42,8 +42,11 @@ void spm_discrete_reset(spm_discrete_t *m);
 /* Eqs. (12), (14), (15) for a frame rotating at omega_xy [rad/s]. */
 spm_discrete_coef_t spm_discrete_coef(const spm_discrete_t *m, float omega_xy);
 /* The same, also giving rot = e^{j phi}, phi = omega_xy Ts, from the same
- * sin/cos evaluation (the frame's rotation over one period). */
-spm_discrete_coef_t spm_discrete_coef_rot(const spm_discrete_t *m, float omega_xy, sincos_t *rot);
+ * sin/cos evaluation (the frame's rotation over one period), and half =
+ * e^{j phi/2}, the evaluation itself (the DFVC's output rotation by half a
+ * period reuses it: dfvc.c). */
+spm_discrete_coef_t spm_discrete_coef_rot(const spm_discrete_t *m, float omega_xy, sincos_t *rot,
+                                          sincos_t *half);
 /* Eq. (10): i(k+1) = A_d i(k) + b_d u(k); u from eq. (8). */
 dq_t spm_discrete_step(const spm_discrete_coef_t *c, dq_t i, dq_t u);
 

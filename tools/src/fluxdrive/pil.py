@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from fluxdrive import cm4_cycles, params, sil
+from fluxdrive.signals import pil_out
 from fluxdrive.errors import FluxdriveError
 
 ENV_ELF = "FLUXDRIVE_PIL_ELF"
@@ -75,15 +76,18 @@ HEADER = np.dtype(
     ]
 )
 MAGIC, VERSION, FORCE_APPLIED = 0x52534946, 5, 1
-OUT = np.dtype(
-    [("duty", "<f4", 3), ("flags", "<u4"), ("faults", "<u4"), ("state", "<u4")]
-)
+# the output record's fields, named after the signals they carry
+# (sil/runner/isr_stream.h ISR_STREAM_OUT_FIELDS, `fluxdrive signals`)
+OUT = np.dtype(pil_out())
+DUTIES = ("duty_a", "duty_b", "duty_c")
 IN_SIZE = 240
 
 #: Blocks of the per-function share: the first pattern that a function name
 #: starts with (or equals) names its block.
 BLOCKS = [
-    ("drive (ISR body, commands, protections, offsets)", ("drive_", "hal_pwm_centred")),
+    # protect_: the protections, owned parts of the drive (firmware/app/protect)
+    ("drive (ISR body, commands, protections, offsets)", ("drive_", "protect_",
+                                                          "hal_pwm_centred")),
     ("speed loop (speed_ctrl, every slow_div ISRs)", ("speed_ctrl_",)),
     ("position source (encoder, star point, PLL)", ("enc_", "pdfc_", "nearest_branch",
                                                     "pos_source", "pos_encoder_", "pos_star_",
@@ -379,7 +383,10 @@ def compare(host: np.ndarray, pil: np.ndarray) -> Agreement:
     if len(pil) != len(host):
         raise FluxdriveError(f"PIL wrote {len(pil)} ISR outputs, expected {len(host)}",
                              exit_code=1)
-    dev = np.abs(host["duty"].astype(np.float64) - pil["duty"].astype(np.float64)).max(axis=1)
+    def duty(x: np.ndarray) -> np.ndarray:
+        return np.stack([x[d].astype(np.float64) for d in DUTIES], axis=-1).reshape(-1, 3)
+
+    dev = np.abs(duty(host) - duty(pil)).max(axis=1)
     dev = np.where(np.isnan(dev), np.inf, dev) if len(dev) else dev
     k = int(np.argmax(dev)) if len(dev) else 0
     return Agreement(
@@ -387,7 +394,7 @@ def compare(host: np.ndarray, pil: np.ndarray) -> Agreement:
         max_duty_dev=float(dev[k]) if len(dev) else 0.0,
         max_dev_isr=k,
         duty_bad=int((dev > DUTY_TOL).sum()),
-        gates_bad=int(((host["flags"] ^ pil["flags"]) & 1).sum()),
+        gates_bad=int(((host["gates"] ^ pil["gates"]) & 1).sum()),
         faults_bad=int((host["faults"] != pil["faults"]).sum()),
         state_bad=int((host["state"] != pil["state"]).sum()),
     )

@@ -1,5 +1,5 @@
 /*
- * drive_safe.c - the safe state while the gates do not modulate (idle and
+ * protect/drive_safe.c - the safe state while the gates do not modulate (idle and
  * fault): all switches off, or the active short circuit (ASC, hal.h
  * hal_pwm_short), issue 13 item 5, docs/faults.md "Safe state".
  *
@@ -39,9 +39,10 @@
  *    asc_speed = 0 (all off only, the former behaviour).
  * An enable waits while the short is on (the offset calibration needs the
  * gates off and no current). The functions live in flash (FD_COLD): they
- * never run while the law does.
+ * never run while the law does. The part asks for the switch actions
+ * (PROTECT_SAFE_*); drive.c applies them.
  */
-#include "drive_safe.h"
+#include "protect/drive_safe.h"
 
 #include <math.h>
 
@@ -61,26 +62,25 @@
 /* Faults after which the bridge is not trusted with a short. */
 #define SAFE_NO_ASC (DRIVE_FAULT_HW_OVERCURRENT | DRIVE_FAULT_GATE_DRIVER)
 
-static bool asc_allowed(const drive_t *drv) {
-  return drv->cfg.asc_speed > 0.0f && drv->i_sc < drv->cfg.i_max &&
-         (drv->faults & SAFE_NO_ASC) == 0u && !hal_fault_hw_tripped();
+static bool asc_allowed(const protect_safe_t *z, const protect_safe_view_t *v) {
+  return v->asc_speed > 0.0f && z->i_sc < v->i_max && (v->faults & SAFE_NO_ASC) == 0u &&
+         !v->hw_tripped;
 }
 
 /* The source's electrical speed when it is known with the gates off (or
  * at the instant they went off), else -1. */
-static float known_speed(const drive_t *drv, bool at_trip) {
-  const bool gated = (drv->pos_src->caps & POS_CAP_GATED) != 0u;
-  if (!drv->pos.out.valid || (drv->faults & DRIVE_FAULT_POSITION) != 0u || (gated && !at_trip) ||
-      !fd_isfinite(drv->pos.out.omega)) {
+static float known_speed(const protect_safe_view_t *v, bool at_trip) {
+  if (!v->pos_valid || (v->faults & DRIVE_FAULT_POSITION) != 0u || (v->pos_gated && !at_trip) ||
+      !fd_isfinite(v->pos_omega)) {
     return -1.0f;
   }
-  return fabsf(drv->pos.out.omega);
+  return fabsf(v->pos_omega);
 }
 
 /* Largest |f(r e^{j phi})| over RING_N directions: f = machine_current
  * (flux to current) or machine_flux (current to flux). */
 #define RING_N 8
-static float ring_max(const machine_t *m, float r, bool current) {
+FD_COLD static float ring_max(const machine_t *m, float r, bool current) {
   static const float cs[RING_N][2] = {
       {1.0f, 0.0f},  {0.70710678f, 0.70710678f},   {0.0f, 1.0f},  {-0.70710678f, 0.70710678f},
       {-1.0f, 0.0f}, {-0.70710678f, -0.70710678f}, {0.0f, -1.0f}, {0.70710678f, -0.70710678f}};
@@ -99,20 +99,24 @@ static float ring_max(const machine_t *m, float r, bool current) {
  * largest |psi_0| whose ring stays within i_trip (bisection, at
  * configuration): a reluctance machine's trapped flux along its low
  * inductance would otherwise drive a current far beyond the trip. */
-FD_COLD float drive_safe_psi_max(const drive_t *drv) {
-  float lo = 0.0f, hi = 4.0f * (drv->psi_pm + drv->flux_scale);
-  if (ring_max(&drv->machine, hi, true) <= drv->cfg.i_trip) {
-    return hi;
+FD_COLD void protect_safe_configure(protect_safe_t *z, const machine_t *m, float psi_pm, float i_sc,
+                                    float flux_scale, float i_trip) {
+  z->psi_pm = psi_pm;
+  z->i_sc = i_sc;
+  float lo = 0.0f, hi = 4.0f * (psi_pm + flux_scale);
+  if (ring_max(m, hi, true) <= i_trip) {
+    z->psi_max = hi;
+    return;
   }
   for (unsigned k = 0; k < 12u; ++k) {
     const float mid = 0.5f * (lo + hi);
-    if (ring_max(&drv->machine, mid, true) <= drv->cfg.i_trip) {
+    if (ring_max(m, mid, true) <= i_trip) {
       lo = mid;
     } else {
       hi = mid;
     }
   }
-  return lo;
+  z->psi_max = lo;
 }
 
 /* The stator flux a short would trap now: the model's at the last run
@@ -120,29 +124,29 @@ FD_COLD float drive_safe_psi_max(const drive_t *drv) {
  * the angle known; else the law's observed flux when it has an observer
  * (the DFVC laws: a voltage model, independent of the position at speed);
  * else bounded from the current's amplitude in any direction. */
-static float trapped_flux(const drive_t *drv, float amp, bool from_run, bool angle_known) {
-  const bool ran = drv->tm.state == DRIVE_STATE_RUN;
-  if (from_run && ran && angle_known) {
-    const dq_t l = machine_flux(&drv->machine, (dq_t){drv->tm.i_dq[0], drv->tm.i_dq[1]});
+FD_COLD static float trapped_flux(const protect_safe_view_t *v, float amp, bool from_run,
+                                  bool angle_known) {
+  if (from_run && v->ran && angle_known) {
+    const dq_t l = machine_flux(v->machine, v->i_dq);
     return sqrtf(l.d * l.d + l.q * l.q);
   }
-  const float obs = drv->tm.law_tm.flux;
-  if (from_run && ran && (drv->ctrl.impl->caps & CTRL_CAP_FLUX) != 0u && fd_isfinite(obs) &&
-      obs > 0.0f) {
+  const float obs = v->law_flux;
+  if (from_run && v->ran && v->law_has_flux && fd_isfinite(obs) && obs > 0.0f) {
     return obs;
   }
-  return ring_max(&drv->machine, amp, false);
+  return ring_max(v->machine, amp, false);
 }
 
-/* Starts the short unless the flux it would trap exceeds asc_psi_max:
- * then all off. */
-static void start_short(drive_t *drv, const float i[3], bool from_run, bool angle_known) {
-  drive_safe_t *z = &drv->safe;
+/* Starts the short unless the flux it would trap exceeds psi_max: then
+ * all off. PROTECT_SAFE_SHORT when it starts, else 0. */
+FD_COLD static uint32_t start_short(protect_safe_t *z, const protect_safe_view_t *v, bool from_run,
+                                    bool angle_known) {
+  const float *i = v->i;
   const ab_t a = frames_clarke((abc_t){i[0], i[1], i[2]});
   const float amp = sqrtf(a.alpha * a.alpha + a.beta * a.beta);
-  const float psi = trapped_flux(drv, amp, from_run, angle_known);
-  if (!fd_isfinite(amp) || !(psi <= drv->asc_psi_max)) {
-    return;
+  const float psi = trapped_flux(v, amp, from_run, angle_known);
+  if (!fd_isfinite(amp) || !(psi <= z->psi_max)) {
+    return 0u;
   }
   z->asc = true;
   z->n = 0u;
@@ -150,85 +154,84 @@ static void start_short(drive_t *drv, const float i[3], bool from_run, bool angl
   z->w_i = 0.0f;
   z->i_prev[0] = a.alpha;
   z->i_prev[1] = a.beta;
-  hal_pwm_short();
+  return PROTECT_SAFE_SHORT;
 }
 
-static void end_short(drive_t *drv) {
-  drv->safe.asc = false;
-  drv->safe.n_high = 0u;
-  hal_pwm_disable();
+FD_COLD static uint32_t end_short(protect_safe_t *z) {
+  z->asc = false;
+  z->n_high = 0u;
+  return PROTECT_SAFE_DISABLE;
 }
 
 /* The rotation rate of the current vector, low-pass filtered; 0 while
  * the vector is too small to have a direction. */
-static void current_speed(drive_t *drv, const float i[3]) {
-  drive_safe_t *z = &drv->safe;
+FD_COLD static void current_speed(protect_safe_t *z, const protect_safe_view_t *v) {
+  const float *i = v->i;
   const ab_t a = frames_clarke((abc_t){i[0], i[1], i[2]});
-  const float floor2 = I_FLOOR * I_FLOOR * drv->cfg.i_max * drv->cfg.i_max;
+  const float floor2 = I_FLOOR * I_FLOOR * v->i_max * v->i_max;
   const float m0 = z->i_prev[0] * z->i_prev[0] + z->i_prev[1] * z->i_prev[1];
   const float m1 = a.alpha * a.alpha + a.beta * a.beta;
   float w = 0.0f;
   if (m0 > floor2 && m1 > floor2) {
     const float cr = z->i_prev[0] * a.beta - z->i_prev[1] * a.alpha;
     const float dt = z->i_prev[0] * a.alpha + z->i_prev[1] * a.beta;
-    w = fd_atan2f(cr, dt) / drv->cfg.ts;
+    w = fd_atan2f(cr, dt) / v->ts;
   }
   if (fd_isfinite(w)) {
-    z->w_i += fd_minf(1.0f, W_I_BW * drv->cfg.ts) * (w - z->w_i);
+    z->w_i += fd_minf(1.0f, W_I_BW * v->ts) * (w - z->w_i);
   }
   z->i_prev[0] = a.alpha;
   z->i_prev[1] = a.beta;
 }
 
-FD_COLD void drive_safe_leave_gates(drive_t *drv) {
-  drv->safe.decide = true;
+FD_COLD void protect_safe_leave_gates(protect_safe_t *z) {
+  z->decide = true;
 }
 
-FD_COLD void drive_safe_step(drive_t *drv, const float i[3], const hal_sample_t *s) {
-  drive_safe_t *z = &drv->safe;
-  const drive_config_t *c = &drv->cfg;
-  const bool finite_v = fd_isfinite(s->v_dc);
-  const bool over_v = finite_v && s->v_dc > SAFE_V_RATIO * c->v_dc_max;
+FD_COLD uint32_t protect_safe_step(protect_safe_t *z, const protect_safe_view_t *v) {
+  const bool finite_v = fd_isfinite(v->v_dc);
+  const bool over_v = finite_v && v->v_dc > SAFE_V_RATIO * v->v_dc_max;
   /* back-EMF peak per rad/s against the link: the speed where the diodes rectify */
-  const float k_emf = SAFE_SQRT3 * drv->psi_pm;
-  const float v_entry = c->asc_speed * (finite_v ? fd_maxf(s->v_dc, 0.0f) : 0.0f);
-  if (!asc_allowed(drv)) {
+  const float k_emf = SAFE_SQRT3 * z->psi_pm;
+  const float v_entry = v->asc_speed * (finite_v ? fd_maxf(v->v_dc, 0.0f) : 0.0f);
+  if (!asc_allowed(z, v)) {
     z->decide = false;
-    if (z->asc || drv->state == DRIVE_STATE_FAULT) {
-      end_short(drv);
+    if (z->asc || v->state == DRIVE_STATE_FAULT) {
+      return end_short(z);
     }
-    return;
+    return 0u;
   }
+  uint32_t act = 0u;
   if (z->decide) {
     z->decide = false;
-    const float w = known_speed(drv, true);
+    const float w = known_speed(v, true);
     if (over_v || w < 0.0f || k_emf * w > v_entry) {
-      start_short(drv, i, true, w >= 0.0f);
+      act |= start_short(z, v, true, w >= 0.0f);
     }
   }
   if (!z->asc) {
-    if (drv->state == DRIVE_STATE_FAULT) {
-      hal_pwm_disable(); /* held off, whatever wrote the timer */
+    if (v->state == DRIVE_STATE_FAULT) {
+      act |= PROTECT_SAFE_DISABLE; /* held off, whatever wrote the timer */
     }
-    if (drv->state == DRIVE_STATE_OFFSET_CAL) {
-      return; /* entered with the short off; the gates stay off */
+    if (v->state == DRIVE_STATE_OFFSET_CAL) {
+      return act; /* entered with the short off; the gates stay off */
     }
-    const float w = known_speed(drv, false);
+    const float w = known_speed(v, false);
     z->n_high = (w >= 0.0f && k_emf * w > v_entry) ? z->n_high + 1u : 0u;
     if (over_v || z->n_high >= ENTRY_N) {
-      start_short(drv, i, false, false);
+      act |= start_short(z, v, false, false);
     }
-    return;
+    return act;
   }
-  current_speed(drv, i);
+  current_speed(z, v);
   z->n++;
-  const float wk = known_speed(drv, false);
+  const float wk = known_speed(v, false);
   const float w = wk >= 0.0f ? wk : fabsf(z->w_i);
   const bool low = finite_v && !over_v && k_emf * w < EXIT_RATIO * v_entry;
   z->n_low = low ? z->n_low + 1u : 0u;
-  if ((float)z->n * c->ts >= c->asc_hold && z->n_low >= EXIT_N) {
-    end_short(drv);
-    return;
+  if ((float)z->n * v->ts >= v->asc_hold && z->n_low >= EXIT_N) {
+    return end_short(z); /* (a short started in this step cannot end in it: EXIT_N) */
   }
-  hal_pwm_short(); /* held, as the gates-off state is (the break may have ended it) */
+  return act |
+         PROTECT_SAFE_SHORT; /* held, as the gates-off state is (the break may have ended it) */
 }

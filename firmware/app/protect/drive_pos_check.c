@@ -1,5 +1,5 @@
 /*
- * drive_pos_check.c - position plausibility (issue 13 item 2,
+ * protect/drive_pos_check.c - position plausibility (issue 13 item 2,
  * docs/faults.md): the voltage model of the machine against the voltage
  * the drive applied, in the frame of the position source.
  *
@@ -21,66 +21,62 @@
  * Trips when |r| > pos_emf_tol (w_e (|psi(0)| + |psi(i) - psi(0)|) + R |i|)
  * + POS_V_FLOOR v_dc for POS_TRIP_S worth of checks more than not (a leaky
  * count: transients and single bad samples do not trip), one check every
- * POS_EVERY slow periods. Only in run, and only for sources that measure
+ * second slow period (its row's divider in the drive's schedule table,
+ * drive.c: the ISR cost). Only in run, and only for sources that measure
  * with the gates off (the encoder): the star-point sources are themselves
  * voltage measurements, checked by their own prediction (pos_err_max). The
  * applied voltage (telemetry of the last period) acts over the period after
  * its sample, so it is turned by w_e t_out (drive_t_out) ahead of the
  * sample's angle. One sine/cosine and one model evaluation per check.
  */
-#include "drive_pos_check.h"
+#include "protect/drive_pos_check.h"
 
 #include <math.h>
 
+#include "drive_enums.h"
 #include "math/fast_trig.h"
 #include "math/fd_math.h"
-#include "math/frames.h"
 
-#define POS_EVERY   2      /* checked every POS_EVERY slow periods (ISR cost) */
 #define POS_TRIP_S  0.016f /* leaky count over the checks: this time's worth trips */
 #define POS_V_FLOOR 0.05f  /* voltage floor, times v_dc: inverter errors */
 
-uint32_t drive_pos_check(drive_t *drv) {
-  const drive_config_t *c = &drv->cfg;
-  const drive_telemetry_t *tm = &drv->tm;
-  if (c->pos_emf_tol <= 0.0f || drv->state != DRIVE_STATE_RUN || tm->state != DRIVE_STATE_RUN ||
-      (drv->pos_src->caps & POS_CAP_GATED) != 0u || !fd_isfinite(tm->v_dc)) {
-    drv->pos_chk_n = 0;
-    drv->pos_psi_ok = false;
+uint32_t protect_pos_step(protect_pos_t *p, const protect_pos_view_t *v) {
+  if (!v->active) {
+    p->n = 0;
+    p->psi_ok = false;
     return 0u;
   }
-  if (((drv->isr_count - 1u) / c->slow_div) % POS_EVERY != 0u) {
+  if (!v->due) {
     return 0u;
   }
-  const float w = drv->pos.out.omega;
-  const dq_t i = {tm->i_dq[0], tm->i_dq[1]};
+  const float w = v->omega_e;
+  const dq_t i = v->i_dq;
   sincos_t sc;
-  fd_sincosf(tm->theta_e + w * (1.5f * c->ts - drv->caps->t_i), &sc.s, &sc.c);
-  const dq_t v = frames_park((ab_t){tm->v_ab_applied[0], tm->v_ab_applied[1]}, sc);
-  const dq_t psi = machine_flux(&drv->machine, i);
+  fd_sincosf(v->theta_e + w * v->t_out, &sc.s, &sc.c);
+  const dq_t u = frames_park(v->v_ab, sc);
+  const dq_t psi = machine_flux(v->machine, i);
   /* d psi / dt from the previous check: the flux a law builds over a few
    * ms (a reluctance machine at its voltage limit) is not a fault */
-  const float inv_dt = 1.0f / ((float)(POS_EVERY * c->slow_div) * c->ts);
-  const dq_t dpsi =
-      drv->pos_psi_ok ? (dq_t){(psi.d - drv->pos_psi.d) * inv_dt, (psi.q - drv->pos_psi.q) * inv_dt}
-                      : (dq_t){0.0f, 0.0f};
-  drv->pos_psi = psi;
-  drv->pos_psi_ok = true;
-  const float rd = v.d - (c->rs * i.d + dpsi.d - w * psi.q);
-  const float rq = v.q - (c->rs * i.q + dpsi.q + w * psi.d);
+  const float inv_dt = 1.0f / ((float)v->periods * v->ts);
+  const dq_t dpsi = p->psi_ok ? (dq_t){(psi.d - p->psi.d) * inv_dt, (psi.q - p->psi.q) * inv_dt}
+                              : (dq_t){0.0f, 0.0f};
+  p->psi = psi;
+  p->psi_ok = true;
+  const float rd = u.d - (v->rs * i.d + dpsi.d - w * psi.q);
+  const float rq = u.q - (v->rs * i.q + dpsi.q + w * psi.d);
   /* the flux's two parts, the magnet's and the currents', each on its own
    * scale (in flux weakening they cancel, their errors do not) */
-  const float pd = psi.d - drv->psi0.d, pq = psi.q - drv->psi0.q;
-  const float emf = fabsf(w) * (drv->psi_pm + sqrtf(pd * pd + pq * pq));
-  const float ir = c->rs * sqrtf(i.d * i.d + i.q * i.q);
-  const float tol = c->pos_emf_tol * (emf + ir) + POS_V_FLOOR * tm->v_dc;
-  drv->pos_emf_res = sqrtf(rd * rd + rq * rq) / fd_maxf(tol, 1e-6f);
+  const float pd = psi.d - v->psi0.d, pq = psi.q - v->psi0.q;
+  const float emf = fabsf(w) * (v->psi_pm + sqrtf(pd * pd + pq * pq));
+  const float ir = v->rs * sqrtf(i.d * i.d + i.q * i.q);
+  const float tol = v->emf_tol * (emf + ir) + POS_V_FLOOR * v->v_dc;
+  p->res = sqrtf(rd * rd + rq * rq) / fd_maxf(tol, 1e-6f);
   if (!(rd * rd + rq * rq <= tol * tol)) { /* NaN counts as over */
-    if ((float)++drv->pos_chk_n * (float)(POS_EVERY * c->slow_div) * c->ts >= POS_TRIP_S) {
+    if ((float)++p->n * (float)v->periods * v->ts >= POS_TRIP_S) {
       return DRIVE_FAULT_POSITION;
     }
-  } else if (drv->pos_chk_n > 0) {
-    drv->pos_chk_n--;
+  } else if (p->n > 0) {
+    p->n--;
   }
   return 0u;
 }

@@ -1,13 +1,13 @@
 /*
- * drive_phase_check.c - phase balance on the telemetry copy (main loop);
- * drive_phase_check.h says what and why.
+ * protect/drive_phase_check.c - phase balance on the telemetry copy (main
+ * loop); drive_phase_check.h says what and why.
  */
-#include "drive_phase_check.h"
+#include "protect/drive_phase_check.h"
 
 #include <math.h>
 #include <string.h>
 
-#include "drive.h"
+#include "drive_enums.h"
 #include "math/fast_trig.h"
 #include "math/fd_math.h"
 #include "math/frames.h"
@@ -15,7 +15,7 @@
 /* One sample into the window: x = v_applied - R_s i in (alpha, beta) at
  * the electrical angle theta, tau the fraction of a revolution swept
  * (drive_phase_check.h). */
-static void window_add(drive_ph_window_t *p, const drive_telemetry_t *tm, float rs, float tau) {
+static void window_add(drive_ph_window_t *p, const drive_phase_view_t *tm, float rs, float tau) {
   const float ia = tm->i_abc[0];
   const float ib = (tm->i_abc[0] + 2.0f * tm->i_abc[1]) * FRAMES_INV_SQRT3;
   const float xa = tm->v_ab_filt[0] - rs * ia;
@@ -97,20 +97,19 @@ static int verdict(drive_phase_check_t *p, float i_max, float v_dc) {
   return v;
 }
 
-void drive_phase_check(drive_t *drv) {
-  drive_phase_check_t *p = &drv->host.ph;
-  const drive_telemetry_t *tm = &drv->host.tm;
-  const drive_config_t *c = &drv->creq.cfg;
+uint32_t drive_phase_check(drive_phase_check_t *p, const drive_phase_view_t *view) {
+  const drive_phase_view_t *tm = view; /* the telemetry copy's part */
+  const drive_phase_view_t *c = view;  /* the parameters' */
   if (tm->isr_count == p->isr_last) {
-    return; /* no fresh copy */
+    return 0u; /* no fresh copy */
   }
   const uint32_t isrs = tm->isr_count - p->isr_last;
   const bool first = p->isr_last == 0u;
   p->isr_last = tm->isr_count;
-  if (tm->state != DRIVE_STATE_RUN || first) {
+  if (!tm->run || first) {
     memset(&p->w, 0, sizeof p->w);
     p->bad = 0;
-    return;
+    return 0u;
   }
   p->w.angle += fabsf(tm->omega_m) * c->pole_pairs * (float)isrs * c->ts;
   window_add(&p->w, tm, c->rs, p->w.angle * (1.0f / FRAMES_2PI));
@@ -119,7 +118,7 @@ void drive_phase_check(drive_t *drv) {
       memset(&p->w, 0, sizeof p->w);
       p->bad = 0;
     }
-    return;
+    return 0u;
   }
   const int v = verdict(p, c->i_max, tm->v_dc);
   p->bad = v > 0 ? p->bad + 1 : 0;
@@ -127,6 +126,7 @@ void drive_phase_check(drive_t *drv) {
   if (p->bad >= DRIVE_PH_TRIP) {
     p->bad = 0;
     p->trips++;
-    drive_request_fault(drv, DRIVE_FAULT_LOST_CONTROL);
+    return DRIVE_FAULT_LOST_CONTROL;
   }
+  return 0u;
 }

@@ -1,6 +1,11 @@
 /*
- * drive_phase_check.h - phase balance, checked by the main loop on the
- * telemetry copy (no ISR cost).
+ * protect/drive_phase_check.h - phase balance, checked by the main loop
+ * on the telemetry copy (no ISR cost). An owned part of the drive's
+ * protections (docs/architecture.md, "Adding a protection"): its state in
+ * drive_t.host (main-loop owned), a step on a read-only view of the
+ * telemetry copy that returns the fault the main loop requests. The file
+ * keeps its name because the G474 linker script lists it among the files
+ * kept out of the CCM (hal/stm32g4/stm32g474re.ld).
  *
  * Over one electrical revolution every phase carries the same mean |i_x|.
  * An open phase (a motor lead off) or a lost one (both switches of a leg
@@ -43,9 +48,10 @@
  * (torque, flux) still leaks into D for the revolution it falls in: two in
  * a row are needed.
  */
-#ifndef FLUXDRIVE_DRIVE_PHASE_CHECK_H
-#define FLUXDRIVE_DRIVE_PHASE_CHECK_H
+#ifndef FLUXDRIVE_PROTECT_PHASE_CHECK_H
+#define FLUXDRIVE_PROTECT_PHASE_CHECK_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #define DRIVE_PH_MIN_N 4
@@ -87,8 +93,21 @@ typedef struct {
   uint32_t trips;      /* lost_control requests made */
 } drive_phase_check_t;
 
-struct drive_s;
-/* One main-loop period (drive_background, after the telemetry copy). */
-void drive_phase_check(struct drive_s *drv);
+/* What the check reads: the main loop's telemetry copy and the parameters
+ * requested (filled by drive_host.c). */
+typedef struct {
+  uint32_t isr_count;     /* of the copy (0: none yet) */
+  bool run;               /* the copy's state is run */
+  float omega_m;          /* [rad/s] */
+  const float *i_abc;     /* offset-corrected phase currents [A] */
+  const float *v_ab_filt; /* the applied voltage, low-passed (drive.h DRIVE_VF_K) [V] */
+  float theta_e;          /* [rad] */
+  float v_dc;             /* [V] */
+  float pole_pairs, ts, rs, i_max;
+} drive_phase_view_t;
+
+/* One main-loop period (drive_background, after the telemetry copy):
+ * DRIVE_FAULT_LOST_CONTROL when the main loop is to request it, else 0. */
+uint32_t drive_phase_check(drive_phase_check_t *p, const drive_phase_view_t *v);
 
 #endif

@@ -1,0 +1,52 @@
+/*
+ * protect/drive_pos_check.h - position plausibility: the voltage the drive
+ * applied against the machine model's at the position source's angle and
+ * speed (drive_pos_check.c, docs/faults.md). An owned part of the drive's
+ * protections (docs/architecture.md, "Adding a protection"); the file
+ * keeps its name because the G474 linker script lists it among the files
+ * kept out of the CCM (hal/stm32g4/stm32g474re.ld).
+ */
+#ifndef FLUXDRIVE_PROTECT_POS_CHECK_H
+#define FLUXDRIVE_PROTECT_POS_CHECK_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "math/frames.h"
+#include "model/machine.h"
+
+typedef struct {
+  int32_t n;   /* the leaky count */
+  float res;   /* residual / tolerance at the last check (logs: drive_t.pos_emf_res) */
+  dq_t psi;    /* the model flux at the last check [Vs] */
+  bool psi_ok; /* ... taken in this run */
+} protect_pos_t;
+
+/* What the check reads (filled by drive.c, on the telemetry of the last
+ * period and the source's speed). */
+typedef struct {
+  bool active;              /* run now and in the last period, a source that measures
+                               with the gates off (not a star-point one), pos_emf_tol > 0
+                               and the last DC link finite: otherwise the check restarts */
+  bool due;                 /* this slow period is one of the check's (the schedule's divider) */
+  uint32_t periods;         /* ISR periods between two checks */
+  float omega_e;            /* the source's speed [rad/s electrical] */
+  float theta_e;            /* the angle at the last period's sample [rad] */
+  dq_t i_dq;                /* the last period's rotor-frame currents [A] */
+  ab_t v_ab;                /* the voltage applied after that sample [V] */
+  float v_dc;               /* [V] */
+  float t_out;              /* from the sample to the output's centre (1.5 Ts - t_i) [s] */
+  float ts;                 /* [s] */
+  float rs;                 /* [Ohm] */
+  float emf_tol;            /* pos_emf_tol */
+  const machine_t *machine; /* the drive's machine model */
+  dq_t psi0;                /* its flux at zero current [Vs] */
+  float psi_pm;             /* |psi0| [Vs] */
+} protect_pos_view_t;
+
+/* Once per slow period (the drive's schedule table), before the position
+ * source's update. Returns DRIVE_FAULT_POSITION when the check trips,
+ * else 0. */
+uint32_t protect_pos_step(protect_pos_t *p, const protect_pos_view_t *v);
+
+#endif

@@ -12,7 +12,8 @@
 
 #include "math/fd_math.h"
 
-#define DFC_STATE(owner) (&((const pos_state_t *)(owner))->dfc)
+#define STAR(owner)      (&((const pos_state_t *)(owner))->star)
+#define DFC_STATE(owner) (&STAR(owner)->meas)
 
 FD_COLD static double sig_t(const void *o) {
   return (double)DFC_STATE(o)->t;
@@ -45,15 +46,16 @@ DFC_K(8)
 #undef DFC_K
 _Static_assert(DFC_ITER_MAX == 8u, "one dfc_k signal per IVD step");
 
-/* the a, b the IVD used this period: identified (ivd+kf+rls), else 0 */
+/* the a, b the IVD used this period: identified (a row with an
+ * identification: ivd+kf+rls), else 0 */
 FD_COLD static double sig_rls_a(const void *o) {
-  return (double)(DFC_STATE(o)->rls_on ? DFC_STATE(o)->dc.a : 0.0f);
+  return (double)(STAR(o)->ident != NULL ? DFC_STATE(o)->dc.a : 0.0f);
 }
 FD_COLD static double sig_rls_b(const void *o) {
-  return (double)(DFC_STATE(o)->rls_on ? DFC_STATE(o)->dc.b : 0.0f);
+  return (double)(STAR(o)->ident != NULL ? DFC_STATE(o)->dc.b : 0.0f);
 }
 FD_COLD static double sig_kf_r(const void *o) {
-  return (double)DFC_STATE(o)->r;
+  return (double)STAR(o)->trk.r;
 }
 
 #define K_ROW(k)                                                                                   \

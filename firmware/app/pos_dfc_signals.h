@@ -1,6 +1,6 @@
 /*
  * pos_dfc_signals.h - the star-point sources' signals (pos_dfc_signals.c),
- * the signal column of their rows (pos_dfc.c).
+ * the signal column of their rows (pos_sources.c).
  */
 #ifndef FLUXDRIVE_POS_DFC_SIGNALS_H
 #define FLUXDRIVE_POS_DFC_SIGNALS_H

@@ -190,7 +190,8 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
   k.one_way = pl->aux.one_way;
   for (int j = 0; j < 3; j++) {
     k.d[j] = duty[j];
-    k.kd[j] = duty[j] > 0.0 && duty[j] < 1.0 ? pl->aux.kdt : 0.0;
+    /* kdt or +0 (kdt >= 0 finite): both comparisons, no branch */
+    k.kd[j] = pl->aux.kdt * (double)((duty[j] > 0.0) & (duty[j] < 1.0));
   }
   k.imposed = p->mech.mode == PLANT_MECH_IMPOSED;
   k.ideal = p->dclink.kind == PLANT_DC_IDEAL;

@@ -118,8 +118,8 @@ static int period_steps(const plant_t *pl) {
     return 0;
   }
   /* ceil(y) > substeps exactly when y > substeps (an integer): the usual
-   * period, within the scenario's steps, needs no ceil (a libm call on
-   * x86-64 without SSE4.1) */
+   * period, within the scenario's steps, needs no ceil (without SSE4.1's
+   * rounding instruction, a sequence of ~20 instructions) */
   const double y = we * pl->p.ts / PLANT_HW_MAX;
   const int ns = pl->p.inverter.substeps;
   return y > (double)ns ? (int)ceil(y) : ns;

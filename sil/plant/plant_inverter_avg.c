@@ -124,10 +124,16 @@ static AVG_ALWAYS_INLINE void avg_rk4(const plant_t *pl, const avg_k_t *restrict
   const double h = pl->p.ts / n, h2 = 0.5 * h, h6 = h / 6.0;
   const avg_k_t *restrict k = kc; /* not copied: a copy of the just-written struct would stall */
   double t = pl->t;
-  double m0 = plant_mech_input(pl, t);
+  /* one step inside the mechanical input's constant span (the usual
+   * period): t <= t + h/2 <= t + h < m_t1, so plant_mech_input gives the
+   * span's value at every stage, without the three look-ups */
+  const plant_aux_t *a = &pl->aux;
+  const int m_const = n == 1 && t >= a->m_t0 && t + h < a->m_t1;
+  const double m_span = a->m_val + a->fric;
+  double m0 = m_const ? m_span : plant_mech_input(pl, t);
   for (int j = 0; j < n; j++) {
-    const double m1 = plant_mech_input(pl, t + h2);
-    const double m2 = plant_mech_input(pl, t + h);
+    const double m1 = m_const ? m_span : plant_mech_input(pl, t + h2);
+    const double m2 = m_const ? m_span : plant_mech_input(pl, t + h);
     double k1[X_N], k2[X_N], k3[X_N], k4[X_N], xs[X_N];
     double c, s;
     if (j > 0) { /* carry the reference angle: libm once per period at speed */
@@ -190,7 +196,8 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
   k.one_way = pl->aux.one_way;
   for (int j = 0; j < 3; j++) {
     k.d[j] = duty[j];
-    k.kd[j] = duty[j] > 0.0 && duty[j] < 1.0 ? pl->aux.kdt : 0.0;
+    /* kdt or +0 (kdt >= 0 finite): both comparisons, no branch */
+    k.kd[j] = pl->aux.kdt * (double)((duty[j] > 0.0) & (duty[j] < 1.0));
   }
   k.imposed = p->mech.mode == PLANT_MECH_IMPOSED;
   k.ideal = p->dclink.kind == PLANT_DC_IDEAL;

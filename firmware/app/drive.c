@@ -533,9 +533,10 @@ FD_COLD static FD_NOINLINE uint32_t drive_protect_values(const drive_t *drv, con
  * time before the trip. */
 static void drive_monitor(drive_t *drv, const ctrl_in_t *in, const ctrl_out_t *out) {
   const uint32_t checks = drv->lc_checks; /* in.mode is drv->mode (drive_mode_refresh) */
-  const protect_lc_view_t v = {out->i_dq.d,      out->i_dq.q,     out->tm.torque, in->torque_ref,
-                               out->torque_min,  out->torque_max, out->tm.delta,  out->tm.flux,
-                               out->tm.flux_ref, out->tm.obs_err, checks};
+  const ctrl_telemetry_t *t = out->tm;
+  const protect_lc_view_t v = {out->i_dq.d,     out->i_dq.q,     t->torque, in->torque_ref,
+                               out->torque_min, out->torque_max, t->delta,  t->flux,
+                               t->flux_ref,     t->obs_err,      checks};
   const uint32_t trip = protect_lc_step(&drv->lc, &v);
   if (trip != 0u) {
     drv->tm.lc_cause = trip;
@@ -790,15 +791,21 @@ static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
   in.flux_ref = drv->cmd.flux;
 
   ctrl_out_t out;
+  /* the law writes its telemetry where it is published (also on the
+   * period it faults: what it saw then) */
+  out.tm = &drv->tm.law_tm;
   ctrl_step(&drv->ctrl, &in, &out);
   if (out.fault != 0u) {
     drive_trip(drv, DRIVE_FAULT_CONTROL);
     return;
   }
-  const modulation_out_t m = modulation_minmax(out.v_ref, s->v_dc, drv->duty_lo, drv->duty_hi);
+  /* the duties alone: drive_write rebuilds the applied voltage from what
+   * the board will apply */
+  float duty[3];
+  (void)modulation_minmax_duty(out.v_ref, s->v_dc, drv->duty_lo, drv->duty_hi, duty);
   float dtc[3];
   ctrl_deadtime_delta(&drv->ctrl, &out, dtc);
-  drv->v_applied = drive_write(drv, m.duty, dtc, s->v_dc);
+  drv->v_applied = drive_write(drv, duty, dtc, s->v_dc);
   drv->torque_min_avail = out.torque_min;
   drv->torque_max_avail = out.torque_max;
 
@@ -807,10 +814,9 @@ static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
   tm->i_dq[1] = out.i_dq.q;
   tm->theta_e = in.theta_e;
   tm->torque_ref = in.torque_ref;
-  tm->torque_est = out.tm.torque;
+  tm->torque_est = out.tm->torque;
   drv->pos.in.i_q = out.i_dq.q;
-  drv->pos.in.torque = out.tm.torque;
-  tm->law_tm = out.tm;
+  drv->pos.in.torque = out.tm->torque;
   drive_monitor(drv, &in, &out);
 }
 
@@ -835,10 +841,10 @@ FD_COLD FD_NOINLINE static void drive_align(drive_t *drv, const float i[3], cons
   const dq_t v =
       current_ctrl_update(&drv->align_cc, (dq_t){c->align_current * sc.c, c->align_current * sc.s},
                           (dq_t){i_ab.alpha, i_ab.beta}, 0.0f, c->v_margin * drv->v_lin);
-  const modulation_out_t m =
-      modulation_minmax((ab_t){v.d, v.q}, s->v_dc, drv->duty_lo, drv->duty_hi);
+  float duty[3];
+  (void)modulation_minmax_duty((ab_t){v.d, v.q}, s->v_dc, drv->duty_lo, drv->duty_hi, duty);
   const float none[3] = {0.0f, 0.0f, 0.0f};
-  drv->v_applied = drive_write(drv, m.duty, none, s->v_dc);
+  drv->v_applied = drive_write(drv, duty, none, s->v_dc);
   drv->align_calm_n = fabsf(w) < drv->align_w_calm ? drv->align_calm_n + 1u : 0u;
   const uint32_t n = ++drv->align_n;
   /* calm for 2 / w_n, or from the start on for 1 / w_n (a rotor that never
@@ -868,9 +874,10 @@ FD_COLD FD_NOINLINE static void drive_hold(drive_t *drv, const float i[3], const
     drive_trip(drv, DRIVE_FAULT_POSITION);
     return;
   }
-  const modulation_out_t m = modulation_minmax(v, s->v_dc, drv->duty_lo, drv->duty_hi);
+  float duty[3];
+  (void)modulation_minmax_duty(v, s->v_dc, drv->duty_lo, drv->duty_hi, duty);
   const float none[3] = {0.0f, 0.0f, 0.0f};
-  drv->v_applied = drive_write(drv, m.duty, none, s->v_dc);
+  drv->v_applied = drive_write(drv, duty, none, s->v_dc);
   if (r == DRIVE_HOLD_DONE) {
     drv->pos_src->hold(&drv->pos_st, theta);
     ctrl_reset(&drv->ctrl);

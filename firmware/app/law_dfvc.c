@@ -84,7 +84,7 @@ static void dfvc_law_step(dfvc_law_t law, ctrl_state_t *s, const ctrl_setup_t *s
   out->torque_max = fd_minf(d.torque_max, su->cfg->torque_max);
   out->fault = d.fault;
   /* every field written (no zero-fill call in the ISR) */
-  ctrl_telemetry_t *tm = &out->tm;
+  ctrl_telemetry_t *tm = out->tm; /* where the drive publishes it */
   tm->flux = d.lambda_s;
   tm->flux_ref = d.lambda_ref;
   tm->delta = d.delta; /* the load-angle limit's: taken every ISR */

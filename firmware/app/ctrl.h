@@ -93,9 +93,16 @@ typedef struct {
   dq_t mtpa_i;  /* its currents [A] */
 } ctrl_foc_t;
 
+/* PI-DFVC and DB-DFVC: one state and one step; the row's init says which
+ * voltage law the step runs (no per-law wrapper call in the ISR). */
+typedef struct {
+  dfvc_t core;
+  dfvc_law_t law; /* DFVC_LAW_PI or DFVC_LAW_DEADBEAT */
+} ctrl_dfvc_t;
+
 typedef union {
   ctrl_foc_t foc;
-  dfvc_t dfvc;
+  ctrl_dfvc_t dfvc;
   dfvc_sat_t dfvc_sat;
 } ctrl_state_t;
 

@@ -200,14 +200,10 @@ static void test_duty_only_same(void **state) {
 
 int main(void) {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_v_max),
-      cmocka_unit_test(test_duty_only_same),
-      cmocka_unit_test(test_known_vectors),
-      cmocka_unit_test(test_linear_range_applied),
-      cmocka_unit_test(test_linear_limit),
-      cmocka_unit_test(test_overmodulation),
-      cmocka_unit_test(test_bad_inputs),
-      cmocka_unit_test(test_board_range),
+      cmocka_unit_test(test_v_max),         cmocka_unit_test(test_duty_only_same),
+      cmocka_unit_test(test_known_vectors), cmocka_unit_test(test_linear_range_applied),
+      cmocka_unit_test(test_linear_limit),  cmocka_unit_test(test_overmodulation),
+      cmocka_unit_test(test_bad_inputs),    cmocka_unit_test(test_board_range),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

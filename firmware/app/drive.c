@@ -792,7 +792,8 @@ static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
 
   ctrl_out_t out;
   /* the law writes its telemetry where it is published (also on the
-   * period it faults: what it saw then) */
+   * period it faults: what it saw then; the safe state keeps reading the
+   * last good period's flux, law_flux) */
   out.tm = &drv->tm.law_tm;
   ctrl_step(&drv->ctrl, &in, &out);
   if (out.fault != 0u) {
@@ -808,6 +809,7 @@ static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
   drv->v_applied = drive_write(drv, duty, dtc, s->v_dc);
   drv->torque_min_avail = out.torque_min;
   drv->torque_max_avail = out.torque_max;
+  drv->law_flux = out.tm->flux;
 
   drive_telemetry_t *tm = &drv->tm;
   tm->i_dq[0] = out.i_dq.d;
@@ -945,7 +947,7 @@ FD_COLD FD_NOINLINE static void drive_safe(drive_t *drv, const float i[3], const
                                  drv->pos.out.omega,
                                  drv->tm.state == DRIVE_STATE_RUN,
                                  (dq_t){drv->tm.i_dq[0], drv->tm.i_dq[1]},
-                                 drv->tm.law_tm.flux,
+                                 drv->law_flux,
                                  (drv->ctrl.impl->caps & CTRL_CAP_FLUX) != 0u,
                                  &drv->machine,
                                  c->asc_speed,

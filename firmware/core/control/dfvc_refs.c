@@ -104,8 +104,6 @@ static float dfvc_refs_mtpa_cached(dfvc_refs_t *r, float t) {
 void dfvc_refs_update(dfvc_refs_t *r, const dfvc_refs_in_t *in, dfvc_refs_out_t *out) {
   const dfvc_refs_cfg_t *c = &r->cfg;
   unsigned lim = 0u;
-  /* 3/2 p, read once (the products below keep their order: same values) */
-  const float kt = 1.5f * c->machine->pole_pairs;
 
   /* Fig. 5: flux reference */
   out->lambda_mtpa =
@@ -145,7 +143,7 @@ void dfvc_refs_update(dfvc_refs_t *r, const dfvc_refs_in_t *in, dfvc_refs_out_t 
   out->iqs_max_delta = r->iqs_max_delta;
 
   /* Rubino 2020, eq. (24), limited by (25), (26) */
-  float iu = in->torque_ref / (kt * lref);
+  float iu = in->torque_ref / (1.5f * c->machine->pole_pairs * lref);
   float iq = dfvc_refs_limit_iqs(out, iu, &lim);
 
   /* Rubino 2020, eq. (23) with the limited i_qs* (the q_s current at tau+2)
@@ -160,13 +158,14 @@ void dfvc_refs_update(dfvc_refs_t *r, const dfvc_refs_in_t *in, dfvc_refs_out_t 
       lref = c->lambda_min;
       lim |= DFVC_REFS_FLUX_MIN;
     }
-    iu = in->torque_ref / (kt * lref);
+    iu = in->torque_ref / (1.5f * c->machine->pole_pairs * lref);
     iq = dfvc_refs_limit_iqs(out, iu, &lim);
   }
   out->lambda_ref = lref;
   out->iqs_unlimited = iu;
   out->iqs_ref = iq;
-  out->torque_max = kt * lref * fd_minf(out->iqs_max_i, out->iqs_max_delta);
+  out->torque_max =
+      1.5f * c->machine->pole_pairs * lref * fd_minf(out->iqs_max_i, out->iqs_max_delta);
   out->torque_min = -out->torque_max;
   out->limits = lim;
 }

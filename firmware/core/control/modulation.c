@@ -18,9 +18,14 @@
 
 #define MOD_INV_SQRT3 0.577350269189626f
 
-float modulation_v_max(float v_dc, float d_min, float d_max) {
+/* modulation_v_max(), inline in the ISR's modulation (no call) */
+static inline float mod_v_max(float v_dc, float d_min, float d_max) {
   const float span = d_max - d_min;
   return (v_dc > 0.0f && fd_isfinite(v_dc) && span > 0.0f) ? span * v_dc * MOD_INV_SQRT3 : 0.0f;
+}
+
+float modulation_v_max(float v_dc, float d_min, float d_max) {
+  return mod_v_max(v_dc, d_min, d_max);
 }
 
 static float mod_clamp(float x, float lo, float hi) {
@@ -40,7 +45,7 @@ static float mod_min3(float a, float b, float c) {
 int modulation_minmax_duty(ab_t v_ref, float v_dc, float d_min, float d_max, float duty[3]) {
   const float mid = 0.5f * (d_min + d_max);
   duty[0] = duty[1] = duty[2] = mid; /* the safe output until the duties below */
-  const float v_max = modulation_v_max(v_dc, d_min, d_max);
+  const float v_max = mod_v_max(v_dc, d_min, d_max);
   if (!(v_max > 0.0f) || !fd_isfinite(v_ref.alpha) || !fd_isfinite(v_ref.beta)) {
     return MODULATION_SAFE; /* zero average voltage, flagged */
   }

@@ -23,12 +23,14 @@
 # (main loop and start-up only): the CAN protocol and codec, the parameter
 # set's checks and access, the drive's main-loop side (drive_host.c,
 # drive_phase_check.c, drive_pos_check.c, drive_safe.c's slow checks), the
-# enumerations' names, the flux-map blob parser, and the held start
-# (drive_hold.c: the ISR's only for the 39 periods of a start).
+# enumerations' names, the flux-map blob parser, and the procedures
+# (proc*.c: offset calibration, alignment, held start; the ISR's only for
+# the periods of a start) and the signal getters (logs, CAN: main loop).
 set(FD_PLACEMENT_g474 all)
 set(FD_FLASH_SOURCES_g474
   can_proto.c can_codec.c drive_config.c drive_params.c drive_host.c drive_enums.c
-  drive_safe.c drive_pos_check.c drive_phase_check.c drive_hold.c
+  drive_safe.c drive_pos_check.c drive_phase_check.c
+  proc.c proc_offset.c proc_align.c proc_hold.c drive_signals.c pos_dfc_signals.c
   flux_map_blob.c)
 
 # B-G431B-ESC1 (10 KiB CCM SRAM): the drive's ISR body and the law step

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "drive_params.h"
+#include "drive_signals.h"
 #include "hal.h"
 
 #define RPM_PER_RADS 9.54929659f /* 60 / (2 pi) */
@@ -388,18 +389,33 @@ static void timeout_step(can_proto_t *p, drive_t *drv, uint32_t now) {
 }
 
 /* ------------------------------------------------------------- transmit */
+/* A telemetry frame: every signal of message m that a row of the drive's
+ * signal table names (drive_signal_table.h: value * can_scale); the
+ * protocol's own signals stay 0 for the caller. */
+static void telemetry_frame(hal_can_frame_t *f, can_msg_t m, uint8_t node,
+                            const drive_signal_src_t *src) {
+  frame_init(f, m, node);
+  const can_msg_desc_t *d = can_codec_msg(m);
+  for (unsigned i = 0u; i < d->n_signals; ++i) {
+    const can_sig_t s = (can_sig_t)((unsigned)d->first + i);
+    const drive_signal_t *row = drive_signal_of_can(s);
+    if (row != NULL) {
+      can_codec_set(s, f->data, (float)row->row.get(src) * row->can_scale);
+    }
+  }
+}
+
 static void send_periodic(can_proto_t *p, can_period_t which, const drive_t *drv) {
   const drive_telemetry_t *tm = drive_telemetry(drv);
+  const drive_signal_src_t src = {drv, tm};
   const uint8_t node = p->cfg.node;
   hal_can_frame_t f;
   switch (which) {
   case CAN_PERIOD_STATUS:
-    frame_init(&f, CAN_MSG_STATUS, node);
-    can_codec_set_raw(CAN_SIG_STATE, f.data, (uint32_t)tm->state);
+    /* state, faults, v_dc from the signal table; the rest the protocol's */
+    telemetry_frame(&f, CAN_MSG_STATUS, node, &src);
     can_codec_set_raw(CAN_SIG_CTRL_MODE, f.data, (uint32_t)tm->mode);
     can_codec_set_raw(CAN_SIG_CTRL_LAW, f.data, (uint32_t)tm->law);
-    can_codec_set_raw(CAN_SIG_FAULTS, f.data, tm->faults);
-    can_codec_set(CAN_SIG_V_DC, f.data, tm->v_dc);
     can_codec_set_raw(CAN_SIG_TIMEOUT_RAMP, f.data, p->ramp ? 1u : 0u);
     /* the enable in force as the ISR holds it (armed), not the level posted */
     can_codec_set_raw(CAN_SIG_CMD_ENABLED, f.data,
@@ -415,40 +431,22 @@ static void send_periodic(can_proto_t *p, can_period_t which, const drive_t *drv
     can_codec_set_raw(CAN_SIG_HB_STATE, f.data, (uint32_t)tm->state);
     break;
   case CAN_PERIOD_TM_SPEED:
-    frame_init(&f, CAN_MSG_TM_SPEED, node);
-    can_codec_set(CAN_SIG_SPEED_RPM, f.data, tm->omega_m * RPM_PER_RADS);
-    can_codec_set(CAN_SIG_SPEED_REF_RPM, f.data, tm->speed_ref * RPM_PER_RADS);
+    telemetry_frame(&f, CAN_MSG_TM_SPEED, node, &src);
     break;
   case CAN_PERIOD_TM_TORQUE:
-    frame_init(&f, CAN_MSG_TM_TORQUE, node);
-    can_codec_set(CAN_SIG_TORQUE_EST, f.data, tm->torque_est);
-    can_codec_set(CAN_SIG_TORQUE_REF, f.data, tm->torque_ref);
+    telemetry_frame(&f, CAN_MSG_TM_TORQUE, node, &src);
     break;
   case CAN_PERIOD_TM_PHASE:
-    frame_init(&f, CAN_MSG_TM_PHASE, node);
-    can_codec_set(CAN_SIG_I_A, f.data, tm->i_abc[0]);
-    can_codec_set(CAN_SIG_I_B, f.data, tm->i_abc[1]);
-    can_codec_set(CAN_SIG_I_C, f.data, tm->i_abc[2]);
+    telemetry_frame(&f, CAN_MSG_TM_PHASE, node, &src);
     break;
   case CAN_PERIOD_TM_DQ:
-    frame_init(&f, CAN_MSG_TM_DQ, node);
-    can_codec_set(CAN_SIG_I_D, f.data, tm->i_dq[0]);
-    can_codec_set(CAN_SIG_I_Q, f.data, tm->i_dq[1]);
-    can_codec_set(CAN_SIG_I_DS, f.data, tm->law_tm.i_ds);
-    can_codec_set(CAN_SIG_I_QS, f.data, tm->law_tm.i_qs);
+    telemetry_frame(&f, CAN_MSG_TM_DQ, node, &src);
     break;
   case CAN_PERIOD_TM_FLUX:
-    frame_init(&f, CAN_MSG_TM_FLUX, node);
-    can_codec_set(CAN_SIG_FLUX, f.data, tm->law_tm.flux);
-    can_codec_set(CAN_SIG_FLUX_REF, f.data, tm->law_tm.flux_ref);
-    can_codec_set(CAN_SIG_DELTA, f.data, ctrl_tm_delta(&tm->law_tm));
-    can_codec_set(CAN_SIG_I_QS_REF, f.data, tm->law_tm.i_qs_ref);
+    telemetry_frame(&f, CAN_MSG_TM_FLUX, node, &src);
     break;
   case CAN_PERIOD_TM_POSITION:
-    frame_init(&f, CAN_MSG_TM_POSITION, node);
-    can_codec_set(CAN_SIG_LOAD_TORQUE_EST, f.data, tm->load_est);
-    can_codec_set(CAN_SIG_POS_ERR, f.data, tm->pos_health);
-    can_codec_set(CAN_SIG_RLS_OK, f.data, tm->rls_ok ? 1.0f : 0.0f);
+    telemetry_frame(&f, CAN_MSG_TM_POSITION, node, &src);
     break;
   case CAN_PERIOD_TM_CPU:
   default: {

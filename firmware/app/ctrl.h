@@ -27,6 +27,7 @@
 #include "math/fd_math.h"
 #include "math/frames.h"
 #include "model/machine.h"
+#include "signal_row.h"
 
 /* Law-specific telemetry (zero where a law has no such quantity). */
 typedef struct {
@@ -122,6 +123,10 @@ typedef struct {
   void (*reset)(ctrl_state_t *s); /* on enable: observers and integrators restart */
   /* one period; writes every field of *out, and *out->tm */
   void (*step)(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *in, ctrl_out_t *out);
+  /* the law's own signals beyond ctrl_telemetry_t (logs, docs/log-format.md):
+   * getters on its ctrl_state_t, read after the ISR; NULL, 0: none */
+  const signal_row_t *signals;
+  unsigned n_signals;
 } ctrl_law_t;
 
 typedef struct {

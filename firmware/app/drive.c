@@ -11,8 +11,8 @@
  * side of the concurrency contract is drive_host.c.
  */
 #include "drive.h"
-#include "drive_hold.h"
 #include "drive_sync.h"
+#include "proc.h"
 
 #include <float.h>
 #include <math.h>
@@ -131,21 +131,15 @@ FD_COLD int drive_config_usable(const drive_config_t *cfg, drive_law_t law, mach
     err->reason = pwhy;
     return -1;
   }
-  if (cfg->start_mode == 1u && ps->hold == NULL) {
-    err->field = "start_mode";
-    err->reason = "the held start (1) needs a star-point position source (an angle at standstill); "
-                  "the encoder starts by its alignment or its known enc_offset (0)";
+  /* the procedures of the start this set wants (proc.h) */
+  const proc_setup_t psu = {cfg, m, ps, NULL, NULL, false};
+  const char *why_p = proc_start_refusal(&psu, &err->field);
+  if (why_p != NULL) {
+    err->reason = why_p;
     return -1;
   }
   return 0;
 }
-
-/* The encoder's alignment (drive_derive, drive_align): damping ratio, the
- * swing left when it is taken as settled [rad electrical], and the swings
- * after align_time it may take to settle before the position fault. */
-#define DRIVE_ALIGN_ZETA   0.7f
-#define DRIVE_ALIGN_CALM   0.01f
-#define DRIVE_ALIGN_SWINGS 10.0f
 
 /* What the ISR would otherwise divide for every period (LIVE parameters
  * included: called again when they change). */
@@ -165,26 +159,6 @@ FD_COLD static void drive_derive(drive_t *drv) {
    * flux-map machine has no star-point model in the plant) */
   drv->win_k = (drv->gated && c->machine_map == NULL) ? 2.0f * c->ts / (c->ld + c->lq) : 0.0f;
   drv->inv_pole_pairs = 1.0f / c->pole_pairs;
-  /* the encoder's alignment: the rotor swings about the current's axis at
-   * w_n = p sqrt(1.5 lambda_m i_align / J) (electrical), the PM torque
-   * 1.5 p lambda_m i_q; the current's angle led by -k_d omega_e damps it
-   * (theta'' = -w_n^2 (theta + k_d theta'): zeta = k_d w_n / 2) */
-  const float wn2 =
-      1.5f * c->pole_pairs * c->pole_pairs * c->lambda_m * c->align_current / c->inertia;
-  const float wn = wn2 > 0.0f ? sqrtf(wn2) : 0.0f;
-  drv->align_kd = wn > 0.0f ? 2.0f * DRIVE_ALIGN_ZETA / wn : 0.0f;
-  /* settled: |omega_e| < DRIVE_ALIGN_CALM w_n for 2 / w_n (over a quarter
-   * swing: a swing left would show its speed peak), i.e. a swing of at most
-   * DRIVE_ALIGN_CALM rad electrical left */
-  drv->align_w_calm = DRIVE_ALIGN_CALM * wn;
-  drv->align_calm_need = wn > 0.0f ? (uint32_t)(2.0f / (wn * c->ts)) + 1u : 0u;
-  /* a rotor calm from the alignment's start for 1 / w_n started within
-   * DRIVE_ALIGN_CALM rad of the axis (from rest at theta_0 its speed
-   * passes DRIVE_ALIGN_CALM w_n after DRIVE_ALIGN_CALM / (w_n theta_0)) */
-  drv->align_still_need = wn > 0.0f ? (uint32_t)(1.0f / (wn * c->ts)) + 1u : 0u;
-  const float t_out =
-      c->align_time + (wn > 0.0f ? DRIVE_ALIGN_SWINGS * 2.0f * FRAMES_PI / wn : 0.0f);
-  drv->align_n_timeout = (uint32_t)(t_out / c->ts) + 1u;
 }
 
 /* The protections' limits from the parameter set in force (LIVE ones
@@ -269,8 +243,6 @@ FD_COLD static int drive_configure(drive_t *drv, const drive_config_t *cfg, driv
   speed_ctrl_cfg_t scfg;
   speed_cfg_from(&scfg, cfg);
   speed_ctrl_init(&drv->speed, &scfg);
-  const current_ctrl_cfg_t acfg = {&drv->machine, cfg->current_bw, cfg->ts};
-  current_ctrl_init(&drv->align_cc, &acfg);
   drv->torque_min_avail = -cfg->torque_max;
   drv->torque_max_avail = cfg->torque_max;
   /* scales of the loss-of-control monitor: torque and flux on MTPA at i_max */
@@ -282,13 +254,12 @@ FD_COLD static int drive_configure(drive_t *drv, const drive_config_t *cfg, driv
   drv->psi_pm = sqrtf(l_pm.d * l_pm.d + l_pm.q * l_pm.q);
   drv->psi0 = l_pm;
   const dq_t i_sc = machine_current(&drv->machine, (dq_t){0.0f, 0.0f});
-  /* flux_scale as it stood before this set (0 at start-up): the bisection's
-   * upper bound as the drive has always taken it (before the protections
-   * became parts, drive_safe_psi_max read drv->flux_scale before it was
-   * updated here) */
+  drv->flux_scale = sqrtf(l_rated.d * l_rated.d + l_rated.q * l_rated.q);
+  /* this set's flux scale bounds the short's bisection (the previous set's,
+   * 0 at start-up, bounded a reluctance machine's trapped flux at 0: every
+   * short refused until a second set was taken) */
   protect_safe_configure(&drv->safe, &drv->machine, drv->psi_pm,
                          sqrtf(i_sc.d * i_sc.d + i_sc.q * i_sc.q), drv->flux_scale, cfg->i_trip);
-  drv->flux_scale = sqrtf(l_rated.d * l_rated.d + l_rated.q * l_rated.q);
   drive_protect_configure(drv);
   return 0;
 }
@@ -594,7 +565,7 @@ static ab_t drive_write(drive_t *drv, const float duty[3], const float dtc[3], f
   req.n_star = 0u;
   req.t_star_req[0] = 0.0f;
   req.t_star_req[1] = 0.0f;
-  const bool window = drv->gated && !drv->hold.plain;
+  const bool window = drv->gated && !drv->plain;
   if (window) {
     drive_window_pattern(drv, dc, &req);
   }
@@ -822,73 +793,19 @@ static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
   drive_monitor(drv, &in, &out);
 }
 
-/* Alignment: d current along theta = 0 for align_time, then the position
- * source takes the current's angle as its reference. A star-point source
- * reads the polarity from the motion (pos_dfc.c). An encoder's offset is
- * taken only once the rotor rests (issue 23, point 18: a light free rotor
- * swung through the offset, -57.5 deg): the current's angle leads against
- * the encoder's speed, -k_d omega_e (at most 45 deg), which damps the
- * swing (drive_derive), and the alignment ends when the rotor has settled
- * (|omega_e| < align_w_calm for align_calm_need periods, or from the start
- * for align_still_need), or trips the position fault after
- * DRIVE_ALIGN_SWINGS swings more. */
-FD_COLD FD_NOINLINE static void drive_align(drive_t *drv, const float i[3], const hal_sample_t *s) {
-  const drive_config_t *c = &drv->cfg;
-  const ab_t i_ab = frames_clarke((abc_t){i[0], i[1], i[2]});
-  const bool enc = !drv->gated && drv->align_kd > 0.0f;
-  const float w = drv->pos.out.omega;
-  const float phi =
-      enc ? fd_clampf(-drv->align_kd * w, -0.25f * FRAMES_PI, 0.25f * FRAMES_PI) : 0.0f;
-  const sincos_t sc = frames_sincos(phi);
-  const dq_t v =
-      current_ctrl_update(&drv->align_cc, (dq_t){c->align_current * sc.c, c->align_current * sc.s},
-                          (dq_t){i_ab.alpha, i_ab.beta}, 0.0f, c->v_margin * drv->v_lin);
-  float duty[3];
-  (void)modulation_minmax_duty((ab_t){v.d, v.q}, s->v_dc, drv->duty_lo, drv->duty_hi, duty);
-  const float none[3] = {0.0f, 0.0f, 0.0f};
-  drv->v_applied = drive_write(drv, duty, none, s->v_dc);
-  drv->align_calm_n = fabsf(w) < drv->align_w_calm ? drv->align_calm_n + 1u : 0u;
-  const uint32_t n = ++drv->align_n;
-  /* calm for 2 / w_n, or from the start on for 1 / w_n (a rotor that never
-   * moved: started at the axis, or held) */
-  const bool settled = !enc || drv->align_calm_n >= drv->align_calm_need ||
-                       (drv->align_calm_n == n && n >= drv->align_still_need);
-  if ((float)n * c->ts >= c->align_time && settled) {
-    drv->pos_src->align(&drv->pos_st, c, s, phi);
-    ctrl_reset(&drv->ctrl);
-    drv->v_applied = (ab_t){0.0f, 0.0f};
-    drv->state = DRIVE_STATE_RUN;
-  } else if (enc && drv->align_n >= drv->align_n_timeout) {
-    drive_trip(drv, DRIVE_FAULT_POSITION); /* the rotor did not settle */
-  }
+/* ------------------------------------------------------- the procedures */
+
+/* What a procedure sees of the drive (proc.h): the parameter set, the
+ * machine, the position source and the offsets it hands its result to. */
+static proc_setup_t drive_proc_setup(drive_t *drv) {
+  return (proc_setup_t){&drv->cfg,    &drv->machine, drv->pos_src,
+                        &drv->pos_st, drv->offset,   drv->gated};
 }
 
-/* The held start (drive_hold.h): zero current, two opposite d pulses, then
- * the run on the estimated angle from standstill. In flash (FD_COLD), as
- * drive_hold.c: the ISR's only for the start's few ms, and the G474's CCM
- * has no room left for it. */
-FD_COLD FD_NOINLINE static void drive_hold(drive_t *drv, const float i[3], const hal_sample_t *s) {
-  const ab_t i_ab = frames_clarke((abc_t){i[0], i[1], i[2]});
-  ab_t v;
-  float theta = 0.0f;
-  const int r = drive_hold_step(drv, i_ab, drv->cfg.v_margin * drv->v_lin, &v, &theta);
-  if (r == DRIVE_HOLD_FAIL) {
-    drive_trip(drv, DRIVE_FAULT_POSITION);
-    return;
-  }
-  float duty[3];
-  (void)modulation_minmax_duty(v, s->v_dc, drv->duty_lo, drv->duty_hi, duty);
-  const float none[3] = {0.0f, 0.0f, 0.0f};
-  drv->v_applied = drive_write(drv, duty, none, s->v_dc);
-  if (r == DRIVE_HOLD_DONE) {
-    drv->pos_src->hold(&drv->pos_st, theta);
-    ctrl_reset(&drv->ctrl);
-    drv->v_applied = (ab_t){0.0f, 0.0f};
-    drv->state = DRIVE_STATE_RUN;
-  }
-}
-
-FD_COLD FD_NOINLINE static void drive_start(drive_t *drv) {
+/* The gates come on (a procedure that modulates, or the run): what the run
+ * starts from (the law, the source's input, the speed loop, the monitor),
+ * the pattern in the middle of the duty range, then the gates. */
+FD_COLD FD_NOINLINE static void drive_gates_start(drive_t *drv) {
   ctrl_reset(&drv->ctrl);
   drv->pos.in = (pos_input_t){0.0f, 0.0f}; /* no torque before the run */
   drv->speed_active = false;
@@ -897,39 +814,87 @@ FD_COLD FD_NOINLINE static void drive_start(drive_t *drv) {
   protect_ra_reset(&drv->ra);
   drv->tm.lc_cause = 0u;
   drv->v_applied = (ab_t){0.0f, 0.0f};
-  const bool hold = drv->cfg.start_mode == 1u && drv->pos_src->hold != NULL;
-  const bool align =
-      hold || (drv->cfg.align_time > 0.0f && (drv->pos_src->caps & POS_CAP_ALIGN) != 0u);
-  if (align) {
-    current_ctrl_reset(&drv->align_cc);
-    drv->align_n = 0u;
-    drv->align_calm_n = 0u;
-  }
-  drive_hold_reset(drv); /* also its plain pattern: a start aborted mid-pulse left it */
+  drv->plain = false; /* a start aborted mid-pulse may have left it */
   const float mid = 0.5f * (drv->duty_lo + drv->duty_hi);
   const hal_pwm_t p = hal_pwm_centred(mid, mid, mid);
   hal_pwm_write(&p, NULL);
   hal_pwm_enable();
-  drv->state = align ? DRIVE_STATE_ALIGN : DRIVE_STATE_RUN;
 }
 
-static void drive_offset_cal(drive_t *drv, const hal_sample_t *s) {
-  for (int x = 0; x < 3; ++x) {
-    drv->offset_acc[x] += s->i_abc[x];
+/* The start from sequence index k on (proc_start_sequence): the next
+ * procedure that applies begins, the gates coming on first if it
+ * modulates; none left: the law runs (from a reset: a procedure's current
+ * leaves the law's observers and integrators behind). */
+FD_COLD FD_NOINLINE static void drive_proc_next(drive_t *drv, uint32_t k) {
+  const proc_setup_t su = drive_proc_setup(drv);
+  unsigned n;
+  const proc_id_t *seq = proc_start_sequence(&n);
+  while (k < n && !proc_applies(seq[k], &su)) {
+    ++k;
   }
-  drv->offset_n++;
-  if (drv->offset_n < drv->cfg.offset_samples) {
+  const proc_row_t *r = k < n ? proc_row(seq[k]) : NULL;
+  const bool gates = gates_on_state(drv->state);
+  if (!gates && (r == NULL || (r->caps & PROC_CAP_GATES) != 0u)) {
+    drive_gates_start(drv);
+  }
+  drv->proc = r;
+  drv->proc_k = k;
+  drv->plain = false;
+  if (r == NULL) {
+    if (gates) { /* after a procedure with the gates on */
+      ctrl_reset(&drv->ctrl);
+      drv->v_applied = (ab_t){0.0f, 0.0f};
+    }
+    drv->state = DRIVE_STATE_RUN;
     return;
   }
-  const float n = (float)drv->offset_n;
-  for (int x = 0; x < 3; ++x) {
-    drv->offset[x] = drv->offset_acc[x] / n;
-    if (fabsf(drv->offset[x]) > drv->cfg.offset_max) {
-      drive_trip(drv, DRIVE_FAULT_OFFSET);
-      return;
-    }
+  r->init(&drv->proc_st, &su);
+  proc_telemetry_t *t = &drv->tm.proc;
+  *t = (proc_telemetry_t){(uint8_t)r->id, PROC_ST_RUNNING, 0u, 0u, 0u, {0.0f, 0.0f, 0.0f}};
+  drv->state = (drive_state_t)r->state;
+}
+
+/* Disabled, or tripped by another cause, while a procedure ran. */
+FD_COLD FD_NOINLINE static void drive_proc_abort(drive_t *drv) {
+  if (drv->proc->abort != NULL) {
+    drv->proc->abort(&drv->proc_st);
   }
-  drive_start(drv);
+  drv->proc = NULL;
+  drv->plain = false;
+  drv->tm.proc.status = PROC_ST_ABORTED;
+}
+
+/* One period of the procedure in force: its voltage modulated and written
+ * (as a law's, without dead-time compensation), its progress published;
+ * done: the next one or the run; failed: its fault. In flash (FD_COLD): the
+ * ISR's only during the start. */
+FD_COLD FD_NOINLINE static void drive_proc_step(drive_t *drv, const float i[3],
+                                                const hal_sample_t *s) {
+  const proc_row_t *r = drv->proc;
+  const proc_setup_t su = drive_proc_setup(drv);
+  const proc_in_t in = {s, frames_clarke((abc_t){i[0], i[1], i[2]}), drv->cfg.v_margin * drv->v_lin,
+                        &drv->pos.out};
+  proc_out_t out;
+  const int res = r->step(&drv->proc_st, &su, &in, &out);
+  drv->plain = out.plain;
+  if (out.apply) {
+    float duty[3];
+    (void)modulation_minmax_duty(out.v_ab, s->v_dc, drv->duty_lo, drv->duty_hi, duty);
+    const float none[3] = {0.0f, 0.0f, 0.0f};
+    drv->v_applied = drive_write(drv, duty, none, s->v_dc);
+  }
+  proc_telemetry_t *t = &drv->tm.proc;
+  r->publish(&drv->proc_st, t);
+  if (res == PROC_FAILED) {
+    t->status = PROC_ST_FAILED;
+    t->fault = out.fault;
+    drv->proc = NULL;
+    drv->plain = false;
+    drive_trip(drv, out.fault);
+  } else if (res == PROC_DONE) {
+    t->status = PROC_ST_DONE;
+    drive_proc_next(drv, drv->proc_k + 1u);
+  }
 }
 
 /* The safe state with the gates not modulating (protect/drive_safe.h):
@@ -1033,17 +998,16 @@ void drive_isr(drive_t *drv) {
       drive_select_law(drv);
     }
     if (enable && !drv->safe.asc) { /* the short first ends (protect/drive_safe.c) */
-      drv->offset_acc[0] = drv->offset_acc[1] = drv->offset_acc[2] = 0.0f;
-      drv->offset_n = 0u;
       drv->pos_src->reset(&drv->pos_st);
-      drv->state = DRIVE_STATE_OFFSET_CAL;
+      drive_proc_next(drv, 0u); /* the start's first procedure: the offsets */
     }
     break;
   case DRIVE_STATE_OFFSET_CAL:
     if (!enable) {
+      drive_proc_abort(drv);
       drv->state = DRIVE_STATE_IDLE;
     } else {
-      drive_offset_cal(drv, &s);
+      drive_proc_step(drv, i, &s);
     }
     break;
   case DRIVE_STATE_ALIGN:
@@ -1051,19 +1015,21 @@ void drive_isr(drive_t *drv) {
     if (!enable) {
       drive_gates_off(drv);
       protect_safe_leave_gates(&drv->safe);
+      if (drv->proc != NULL) {
+        drive_proc_abort(drv);
+      }
       drv->state = DRIVE_STATE_IDLE;
     } else if (drv->state == DRIVE_STATE_ALIGN) {
-      if (drv->cfg.start_mode == 1u) {
-        drive_hold(drv, i, &s);
-      } else {
-        drive_align(drv, i, &s);
-      }
+      drive_proc_step(drv, i, &s); /* the alignment or the held start */
     } else {
       drive_run(drv, i, &s);
     }
     break;
   case DRIVE_STATE_FAULT:
   default:
+    if (drv->proc != NULL) { /* tripped by another cause during a procedure */
+      drive_proc_abort(drv);
+    }
     break; /* all off or shorted: drive_safe */
   }
   if (!gates_on_state(drv->state)) {

@@ -48,6 +48,7 @@
 #include "hal.h"
 #include "model/machine.h"
 #include "pos_source.h"
+#include "proc.h"
 /* the protections, each an owned part (docs/architecture.md, "Adding a
  * protection"); lc_monitor.h defines the DRIVE_LC_* causes */
 #include "protect/drive_phase_check.h"
@@ -90,6 +91,7 @@ typedef struct {
   uint32_t armed;        /* drive_t.armed, written where it changes (a trip, a clear that
                             cleared a fault, an enable command after them) */
   ctrl_telemetry_t law_tm;
+  proc_telemetry_t proc;  /* the procedure in force or the last one: progress, results (proc.h) */
   uint32_t isr_count_end; /* ... and last: equal to isr_count in a consistent copy */
 } drive_telemetry_t;
 
@@ -124,15 +126,17 @@ typedef struct drive_s {
   drive_mode_t mode;  /* the mode in force: cmd.mode unless the law lacks it (drive_mode_refresh) */
   uint32_t lc_checks; /* PROTECT_LC_CHECK_* with this law and mode (drive_mode_refresh) */
 
-  /* offset calibration */
+  /* the current offsets in force (the offset procedure's, proc_offset.c) */
   float offset[3];
-  float offset_acc[3];
-  uint32_t offset_n;
 
-  /* alignment (state align): d current along theta = 0 (an encoder's:
-   * damped by its speed, held until the rotor has settled) */
-  current_ctrl_t align_cc;
-  uint32_t align_n;
+  /* the procedure in force (proc.h: offset calibration, alignment, held
+   * start), its place in the start sequence and its state: 84 B on the
+   * Cortex-M, what the offset calibration's and the alignment's fields took
+   * here before, so the periodic path's fields after them keep their
+   * offsets (and the PIL counts; a larger union moves them) */
+  const proc_row_t *proc; /* NULL: none (idle, run, fault) */
+  uint32_t proc_k;        /* its index in proc_start_sequence() */
+  proc_state_t proc_st;
 
   /* position */
   const pos_source_row_t *pos_src;
@@ -158,6 +162,8 @@ typedef struct drive_s {
   float v_lin_k;          /* linear voltage range per volt of DC link */
   unsigned dfc_leg;       /* leg of the next DFC test vector (0: v1, 1: v3, 2: v5) */
   bool gated;             /* the position source measures through the DFC window */
+  bool plain;             /* the pattern without the DFC window: a procedure's clean sample
+                             (the held start's pulses, proc_hold.c) */
   float win_m[3];         /* the window pattern in force: phase moments (dfc_window.h) */
   float win_k;            /* Ts / L of their current correction [s/H] */
 
@@ -217,26 +223,6 @@ typedef struct drive_s {
   float flux_scale;          /* flux amplitude on MTPA at i_max [Vs] */
   float psi_pm;              /* |flux linkage at zero current| of the model [Vs] */
   dq_t psi0;                 /* that flux linkage [Vs] */
-  /* the alignment's settling (drive_align; an encoder's: damped by its
-   * speed, held until the rotor has settled) */
-  uint32_t align_calm_n;     /* periods the encoder's speed has stayed below align_w_calm */
-  float align_kd;            /* the damping: angle of the current per electrical rad/s [s] */
-  float align_w_calm;        /* settled: |speed| below this [rad/s electrical] ... */
-  uint32_t align_calm_need;  /* ... for this many periods */
-  uint32_t align_still_need; /* ... or from the start for this many */
-  uint32_t align_n_timeout;  /* not settled after this many periods: position fault */
-
-  /* the held start (start_mode 1, state align; drive_hold.c) */
-  struct {
-    uint8_t phase;           /* DRIVE_HOLD_* */
-    uint16_t n;              /* periods into the phase */
-    float theta;             /* the estimate's angle the pulses are applied along [rad] */
-    float i0;                /* the d current when a pulse began [A] */
-    float di[2];             /* the d current each pulse built, along theta and theta + pi [A] */
-    uint8_t n_pulse, n_zero; /* periods of each pulse and of the way back (drive_hold.c) */
-    dq_t v_prev;             /* the voltage asked last period, in the estimate's frame [V] */
-    bool plain;              /* the pattern without the DFC window (a pulse's clean sample) */
-  } hold;
 } drive_t;
 
 /* The layout rules the ISR's instruction counts depend on (docs/pil.md),
@@ -261,7 +247,7 @@ _Static_assert(offsetof(drive_t, cfg) > offsetof(drive_t, win_k) &&
                    offsetof(drive_t, pos_st) > offsetof(drive_t, win_k),
                "drive_t: the parts reached through a pointer after the per-period scalars");
 _Static_assert(offsetof(drive_t, clear_seen) > offsetof(drive_t, host) &&
-                   offsetof(drive_t, hold) > offsetof(drive_t, clear_seen),
+                   offsetof(drive_t, psi0) > offsetof(drive_t, clear_seen),
                "drive_t: the slow-rate and command fields last");
 
 /* Validates cfg, initialises everything and latches DRIVE_FAULT_WATCHDOG

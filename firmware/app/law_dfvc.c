@@ -109,7 +109,11 @@ static void dfvc_law_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in
   tm->obs_err = d.obs_err;
 }
 
-const ctrl_law_t ctrl_law_pi_dfvc = {
-    "pi_dfvc", CTRL_CAP_FLUX | CTRL_CAP_DELTA, dfvc_check, pi_init, dfvc_law_reset, dfvc_law_step};
-const ctrl_law_t ctrl_law_db_dfvc = {
-    "db_dfvc", CTRL_CAP_FLUX | CTRL_CAP_DELTA, dfvc_check, db_init, dfvc_law_reset, dfvc_law_step};
+const ctrl_law_t ctrl_law_pi_dfvc = {"pi_dfvc",      CTRL_CAP_FLUX | CTRL_CAP_DELTA,
+                                     dfvc_check,     pi_init,
+                                     dfvc_law_reset, dfvc_law_step,
+                                     NULL,           0u};
+const ctrl_law_t ctrl_law_db_dfvc = {"db_dfvc",      CTRL_CAP_FLUX | CTRL_CAP_DELTA,
+                                     dfvc_check,     db_init,
+                                     dfvc_law_reset, dfvc_law_step,
+                                     NULL,           0u};

@@ -86,6 +86,35 @@ static void dfvc_sat_law_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctr
   tm->obs_err = d.obs_err;
 }
 
-const ctrl_law_t ctrl_law_dfvc_decoupled = {"dfvc_decoupled",   CTRL_CAP_FLUX,
-                                            dfvc_sat_check,     dfvc_sat_law_init,
-                                            dfvc_sat_law_reset, dfvc_sat_law_step};
+/* Its signals (signal_row.h): what the last step found, dfvc_sat_tm_t. */
+#define SAT_SIG(field)                                                                             \
+  FD_COLD static double sig_##field(const void *owner) {                                           \
+    return (double)((const ctrl_state_t *)owner)->dfvc_sat.tm.field;                               \
+  }
+SAT_SIG(flux_mtpa)
+SAT_SIG(torque_mtpv)
+SAT_SIG(gain_a)
+SAT_SIG(gain_b)
+SAT_SIG(mtpa_angle)
+SAT_SIG(mtpv_angle)
+#undef SAT_SIG
+
+static const signal_row_t sat_signals[] = {
+    {"flux_mtpa", SIGNAL_F32, "Vs", "MTPA flux, table (29) or adapted online (32)", sig_flux_mtpa},
+    {"torque_mtpv", SIGNAL_F32, "N m", "MTPV torque limit, (31) or (34), margin k_T included",
+     sig_torque_mtpv},
+    {"gain_a", SIGNAL_F32, "1/H", "a_hat of the transformation (23) in use", sig_gain_a},
+    {"gain_b", SIGNAL_F32, "1/H", "b_hat of the transformation (23) in use", sig_gain_b},
+    {"mtpa_angle", SIGNAL_F32, "1",
+     "sine of the phase of lambda^a from i, on the line (0 on MTPA, (7))", sig_mtpa_angle},
+    {"mtpv_angle", SIGNAL_F32, "rad",
+     "phase of i^a from lambda, on the line (0 on MTPV, (10)); 0 with LUT references (not "
+     "computed)",
+     sig_mtpv_angle},
+};
+
+const ctrl_law_t ctrl_law_dfvc_decoupled = {
+    "dfvc_decoupled",   CTRL_CAP_FLUX,
+    dfvc_sat_check,     dfvc_sat_law_init,
+    dfvc_sat_law_reset, dfvc_sat_law_step,
+    sat_signals,        sizeof sat_signals / sizeof sat_signals[0]};

@@ -107,4 +107,5 @@ static void foc_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *i
   tm->obs_err = 0.0f;
 }
 
-const ctrl_law_t ctrl_law_foc = {"foc", CTRL_CAP_CURRENT, foc_check, foc_init, foc_reset, foc_step};
+const ctrl_law_t ctrl_law_foc = {"foc",     CTRL_CAP_CURRENT, foc_check, foc_init,
+                                 foc_reset, foc_step,         NULL,      0u};

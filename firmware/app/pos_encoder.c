@@ -17,16 +17,16 @@
 
 #include "math/fd_math.h"
 #include "math/frames.h"
-#include "pos_source.h"
+#include "pos_encoder.h"
 
-FD_COLD static void enc_init(pos_state_t *s, const drive_config_t *cfg) {
+FD_COLD void pos_encoder_init(pos_state_t *s, const drive_config_t *cfg) {
   angle_pll_init(&s->enc.pll, cfg->pll_bw, cfg->ts);
   s->enc.offset = cfg->enc_offset;
   s->enc.half = cfg->enc_cpr > 0u ? FRAMES_PI / (float)cfg->enc_cpr : 0.0f;
   s->enc.started = false;
 }
 
-static void enc_reset(pos_state_t *s) {
+void pos_encoder_reset(pos_state_t *s) {
   s->enc.started = false;
 }
 
@@ -35,8 +35,8 @@ static float enc_electrical(const pos_state_t *s, const drive_config_t *cfg,
   return frames_wrap_pi(cfg->pole_pairs * (smp->enc_angle + s->enc.half) - s->enc.offset);
 }
 
-static void enc_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
-                       pos_io_t *io) {
+void pos_encoder_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
+                        pos_io_t *io) {
   const pos_input_t *in = &io->in;
   pos_estimate_t *out = &io->out;
   (void)in;
@@ -67,8 +67,8 @@ static void enc_update(pos_state_t *s, const drive_config_t *cfg, const hal_samp
 }
 
 /* Held at electrical angle theta: offset = measured - theta. */
-static void enc_align(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
-                      float theta) {
+void pos_encoder_align(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,
+                       float theta) {
   s->enc.offset = frames_wrap_pi(s->enc.offset + enc_electrical(s, cfg, smp) - theta);
   s->enc.started = false;
 }
@@ -78,7 +78,7 @@ static void enc_align(pos_state_t *s, const drive_config_t *cfg, const hal_sampl
  * encoder of 16 counts on Rubino's 21 pole pairs has less than one count
  * per electrical revolution: the drive cannot even tell the sector. */
 #define ENC_MIN_COUNTS_PER_E_REV 8.0f
-FD_COLD static const char *enc_check(const drive_config_t *cfg, const char **field) {
+FD_COLD const char *pos_encoder_check(const drive_config_t *cfg, const char **field) {
   if (cfg->enc_cpr > 0u && (float)cfg->enc_cpr < ENC_MIN_COUNTS_PER_E_REV * cfg->pole_pairs) {
     *field = "enc_cpr";
     return "too few encoder counts to commutate: at least 8 per electrical revolution "
@@ -86,7 +86,3 @@ FD_COLD static const char *enc_check(const drive_config_t *cfg, const char **fie
   }
   return NULL;
 }
-
-/* no angle at standstill: no held start */
-const pos_source_row_t pos_source_encoder = {POS_CAP_ALIGN, enc_init,  enc_reset, enc_update,
-                                             enc_align,     enc_check, NULL};

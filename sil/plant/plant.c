@@ -142,7 +142,7 @@ int plant_check(const plant_params_t *p, const char **field) {
 }
 
 static double wrap_2pi(double a) {
-  a -= PLANT_TWO_PI * floor(a * (1.0 / PLANT_TWO_PI));
+  a -= PLANT_TWO_PI * plant_floor(a * (1.0 / PLANT_TWO_PI));
   return a >= PLANT_TWO_PI ? 0.0 : a;
 }
 
@@ -232,7 +232,7 @@ void plant_step_pattern(plant_t *pl, const double on_in[3], const double off_in[
   plant_dclink_chopper(pl);
   double x[X_N] = {pl->lambda_d, pl->lambda_q, pl->theta_m, pl->omega_m, pl->v_dc, 0, 0, 0, 0};
   const int avg = pl->p.inverter.model == PLANT_INV_AVERAGE;
-  double cs_end[2] = {NAN, NAN}; /* cos, sin of the end angle (average model) */
+  double cs_end[2] = {NAN, NAN}; /* cos, sin of the end angle (both models) */
   if (gates_on && avg && !pl->aux.pf_any) {
     plant_inverter_avg_period(pl, d, x, cs_end);
     for (int j = 0; j < 3; j++) {
@@ -241,7 +241,7 @@ void plant_step_pattern(plant_t *pl, const double on_in[3], const double off_in[
     pl->aux.all_zero = 0;
     pl->aux.gates_prev = 1;
   } else {
-    plant_inverter_sw_period(pl, on, off, gates_on, x);
+    plant_inverter_sw_period(pl, on, off, gates_on, x, cs_end);
   }
   plant_faults_period_end(pl, x, cs_end);
   const double inv_ts = pl->aux.inv_ts;

@@ -8,6 +8,7 @@
 
 #include "plant.h"
 
+#include <math.h>
 #include <stddef.h>
 
 #define PLANT_PI        3.14159265358979323846
@@ -19,6 +20,51 @@
  * recomputes them: each carry adds ~2 ulp, so they stay within ~1e-14 of
  * libm's values. */
 #define PLANT_CARRY_MAX 16
+
+/* cos and sin of an angle th near a reference angle th_ref whose cos and
+ * sin (c_ref, s_ref) are known: angle addition with the Taylor series of
+ * dt = th - th_ref (|dt| <= 0.3 rad: truncation < 3e-17, a few ulp from
+ * libm), libm beyond. Both inverter models carry the rotor angle of their
+ * stages this way from one reference per period (issue 24: libm sin/cos at
+ * every derivative was 31-54 % of a switching run). */
+static inline void plant_cos_sin_near(double th_ref, double c_ref, double s_ref, double th,
+                                      double *c, double *s) {
+  const double dt = th - th_ref;
+  if (dt > 0.3 || dt < -0.3) {
+    *c = cos(th);
+    *s = sin(th);
+    return;
+  }
+  const double z = dt * dt, z2 = z * z, z4 = z2 * z2;
+  /* Taylor coefficients, Estrin evaluation (short dependency chains); for
+   * |dt| <= 1/16 (a switching period's stages at speed) the terms up to
+   * dt^7 and dt^8 suffice (truncation < 5e-17, below half an ulp of 1) */
+  double sd, cd;
+  if (z <= 1.0 / 256.0) {
+    sd = dt * ((1.0 - z * (1.0 / 6.0)) + z2 * ((1.0 / 120.0) - z * (1.0 / 5040.0)));
+    cd = (1.0 - z * 0.5) + z2 * ((1.0 / 24.0) - z * (1.0 / 720.0)) + z4 * (1.0 / 40320.0);
+  } else {
+    sd = dt * ((1.0 - z * (1.0 / 6.0)) + z2 * ((1.0 / 120.0) - z * (1.0 / 5040.0)) +
+               z4 * ((1.0 / 362880.0) - z * (1.0 / 39916800.0)));
+    cd = (1.0 - z * 0.5) + z2 * ((1.0 / 24.0) - z * (1.0 / 720.0)) +
+         z4 * ((1.0 / 40320.0) - z * (1.0 / 3628800.0) + z2 * (1.0 / 479001600.0));
+  }
+  *c = c_ref * cd - s_ref * sd;
+  *s = s_ref * cd + c_ref * sd;
+}
+
+/* floor(y), bit for bit, without the libm call (x86-64 without SSE4.1 has no
+ * rounding instruction: floor is a call on every period's wraps, ADC codes
+ * and encoder count): the truncation, one lower for a negative fraction;
+ * libm for |y| >= 2^52 (already an integer) and NaN; -0.0 gives +0.0, which
+ * every caller adds to or scales. */
+static inline double plant_floor(double y) {
+  if (!(y > -4503599627370496.0 && y < 4503599627370496.0)) {
+    return floor(y);
+  }
+  const double t = (double)(long long)y;
+  return t > y ? t - 1.0 : t;
+}
 
 /* Integration state vector. The last four entries are integrals over the
  * period (reset to 0 at its start) from which the period averages are taken. */
@@ -132,14 +178,15 @@ static inline const plant_cur_cache_t *plant_machine_cur(plant_t *pl) {
   }
   return &pl->aux.cur;
 }
-void plant_machine_zero_phase_current(const plant_t *pl, double *x, int leg);
+/* c, s: cos and sin of pole_pairs * x[X_TH] */
+void plant_machine_zero_phase_current_cs(const plant_t *pl, double *x, int leg, double c, double s);
 
 /* plant_inverter.c, plant_inverter_avg.c, plant_inverter_sw.c */
 int plant_inverter_check(const plant_inverter_t *inv, double ts, const char **field);
 void plant_inverter_init(plant_t *pl);
 void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, double cs_end[2]);
 void plant_inverter_sw_period(plant_t *pl, const double on[3], const double off[3], bool gates_on,
-                              double *x);
+                              double *x, double cs_end[2]);
 
 /* plant_dclink.c */
 int plant_dclink_check(const plant_dclink_t *d, const char **field);
@@ -165,11 +212,12 @@ int plant_sensors_check(const plant_sensors_t *s, const char **field);
 void plant_sensors_init(plant_t *pl);
 
 /* plant_star.c: the star point w.r.t. the negative rail for leg
- * potentials v, phase currents i, electrical angle and speed, the q
+ * potentials v, phase currents i, electrical angle (its cos and sin) and
+ * speed, the q
  * current (load shift) and back-EMF e; the measurement circuit over a step
  * of length h whose input went linearly from v0 to v1. */
-double plant_star_vn(const plant_t *pl, const double v[3], const double i[3], double th_e,
-                     double we, double i_q, const double e[3]);
+double plant_star_vn(const plant_t *pl, const double v[3], const double i[3], double c_e,
+                     double s_e, double we, double i_q, const double e[3]);
 void plant_star_filter(plant_t *pl, double v0, double v1, double h);
 /* plant_sensors.c: one standard normal number from the plant's generator */
 double plant_sensors_normal(plant_t *pl);

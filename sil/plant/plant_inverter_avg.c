@@ -35,30 +35,16 @@ static inline double eff_duty(double d, double kd, double i_norm) {
 
 /* Rotor angle reference: the stage angles differ from the reference angle
  * by dth <= w_e h, so cos/sin are obtained by angle addition with a Taylor
- * series of dth (|dth| < 0.3 rad: truncation < 3e-17), and libm is called
- * once per period (the reference is carried from step to step the same
- * way; its rounding error grows by ~1e-16 per substep and restarts each
- * period). */
+ * series of dth (plant_cos_sin_near), and libm is called once per period
+ * (the reference is carried from step to step the same way; its rounding
+ * error grows by ~1e-16 per substep and restarts each period). */
 typedef struct {
   double th, c, s;
   const double *i_known; /* currents of the first stage's state, or NULL */
 } angle_ref_t;
 
 static inline void stage_cos_sin(const angle_ref_t *r, double th, double *c, double *s) {
-  const double dt = th - r->th;
-  if (dt > 0.3 || dt < -0.3) {
-    *c = cos(th);
-    *s = sin(th);
-    return;
-  }
-  const double z = dt * dt, z2 = z * z, z4 = z2 * z2;
-  /* Taylor coefficients, Estrin evaluation (short dependency chains) */
-  const double sd = dt * ((1.0 - z * (1.0 / 6.0)) + z2 * ((1.0 / 120.0) - z * (1.0 / 5040.0)) +
-                          z4 * ((1.0 / 362880.0) - z * (1.0 / 39916800.0)));
-  const double cd = (1.0 - z * 0.5) + z2 * ((1.0 / 24.0) - z * (1.0 / 720.0)) +
-                    z4 * ((1.0 / 40320.0) - z * (1.0 / 3628800.0) + z2 * (1.0 / 479001600.0));
-  *c = r->c * cd - r->s * sd;
-  *s = r->s * cd + r->c * sd;
+  plant_cos_sin_near(r->th, r->c, r->s, th, c, s);
 }
 
 /* Constants of one period, in locals (no reloads through pl in the stages). */

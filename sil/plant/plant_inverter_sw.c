@@ -70,7 +70,18 @@ typedef struct {
   double rl[3]; /* a floating leg's rails, in units of v_dc: 0 and 1 but */
   double rh[3]; /* for leg z of a floating shorted pair (header comment) */
   int node;     /* that leg z, else -1 */
+  /* the rotor angle pole_pairs theta_m at the period start and its cos,
+   * sin: every stage's cos, sin by angle addition from these
+   * (plant_cos_sin_near), libm once per period at most */
+  double th_ref, c_ref, s_ref;
 } sw_cfg_t;
+
+/* cos and sin of the electrical angle of state x (near the reference). */
+static inline void sw_cos_sin(const plant_t *pl, const sw_cfg_t *cf, const double *x, double *c,
+                              double *s) {
+  const double th = pl->p.machine.pole_pairs * x[X_TH];
+  plant_cos_sin_near(cf->th_ref, cf->c_ref, cf->s_ref, th, c, s);
+}
 
 typedef struct {
   double u;   /* voltage of the blocked leg [V] */
@@ -80,10 +91,10 @@ typedef struct {
   double vdc;
 } sw_out_t;
 
-static void phase_currents(const plant_t *pl, const double *x, double i[3], double *ial,
-                           double *ibe) {
-  const double th = pl->p.machine.pole_pairs * x[X_TH];
-  const double c = cos(th), s = sin(th);
+static void phase_currents(const plant_t *pl, const sw_cfg_t *cf, const double *x, double i[3],
+                           double *ial, double *ibe) {
+  double c, s;
+  sw_cos_sin(pl, cf, x, &c, &s);
   double id, iq;
   plant_mag_current(&pl->aux.mag, x[X_LD], x[X_LQ], &id, &iq);
   *ial = id * c - iq * s;
@@ -119,13 +130,12 @@ static double node_offset(const sw_cfg_t *cf, double w, double vdc) {
   return w <= 0.0 ? -w : vdc - w;
 }
 
-static void backemf(const plant_t *pl, const double *x, double w, double e[3]) {
+/* c, s: cos and sin of the electrical angle */
+static void backemf(const plant_t *pl, double c, double s, double w, double e[3]) {
   const double pp = (double)pl->p.machine.pole_pairs;
-  const double th = pp * x[X_TH];
   /* zero current: the flux is lambda(0) turning with the rotor, e = w_e J lambda */
   double l0d, l0q;
   plant_mag_flux0(&pl->aux.mag, &l0d, &l0q);
-  const double c = cos(th), s = sin(th);
   const double lal = l0d * c - l0q * s, lbe = l0d * s + l0q * c;
   const double we = pp * w;
   const double eal = -we * lbe, ebe = we * lal;
@@ -142,9 +152,11 @@ static void sw_deriv(const plant_t *pl, const sw_cfg_t *cf, const double *x, dou
   const double w = plant_mech_speed(pl, x, m);
   const double we = pp * w;
   double te = 0.0, idc = 0.0, vn0, id_now = 0.0, iq_now = 0.0;
+  double c, s;
+  sw_cos_sin(pl, cf, x, &c, &s);
   if (cf->all_zero) {
     double e[3], lo_max = -1e300, hi_min = 1e300;
-    backemf(pl, x, w, e);
+    backemf(pl, c, s, w, e);
     for (int j = 0; j < 3; j++) {
       double lo, hi;
       leg_range(cf, j, vdc, &lo, &hi);
@@ -160,8 +172,6 @@ static void sw_deriv(const plant_t *pl, const sw_cfg_t *cf, const double *x, dou
     dx[X_VA] = e[0];
     dx[X_VB] = e[1];
   } else {
-    const double th = pp * x[X_TH];
-    const double c = cos(th), s = sin(th);
     double id, iq;
     plant_mag_current(&pl->aux.mag, x[X_LD], x[X_LQ], &id, &iq);
     const double ial = id * c - iq * s, ibe = id * s + iq * c;
@@ -210,8 +220,8 @@ static void sw_deriv(const plant_t *pl, const sw_cfg_t *cf, const double *x, dou
     o->vns = vn0;
     if (pl->p.machine.aniso.enabled && pl->aux.star_n > 0) {
       double e[3];
-      backemf(pl, x, w, e);
-      o->vns = plant_star_vn(pl, v, i, th, we, iq, e);
+      backemf(pl, c, s, w, e);
+      o->vns = plant_star_vn(pl, v, i, c, s, we, iq, e);
     }
     dx[X_LD] = dld;
     dx[X_LQ] = dlq;
@@ -267,7 +277,9 @@ static void sw_rk4(const plant_t *pl, const sw_cfg_t *cf, double t, const double
   }
   plant_mech_end_step(pl, x1, t + h);
   if (!cf->all_zero && cf->blocked >= 0) {
-    plant_machine_zero_phase_current(pl, x1, cf->blocked);
+    double c, s;
+    sw_cos_sin(pl, cf, x1, &c, &s);
+    plant_machine_zero_phase_current_cs(pl, x1, cf->blocked, c, s);
   }
 }
 
@@ -285,7 +297,7 @@ static void sw_events(const plant_t *pl, const sw_cfg_t *cf, double t, const dou
     return;
   }
   double i[3], ial, ibe;
-  phase_currents(pl, x, i, &ial, &ibe);
+  phase_currents(pl, cf, x, i, &ial, &ibe);
   for (int j = 0; j < 3; j++) {
     if (cf->type[j] == LEG_FLOAT && cf->cond[j] == COND_LO) {
       z[EV_CUR0 + j] = -i[j];
@@ -306,7 +318,9 @@ static void exit_all_zero(const plant_t *pl, sw_cfg_t *cf, double t, const doubl
   double e[3], lo, hi, best_lo = -1e300, best_hi = 1e300;
   int jx = 0, jy = 1;
   const double vdc = plant_dclink_voltage(pl, x);
-  backemf(pl, x, plant_mech_speed(pl, x, plant_mech_input(pl, t)), e);
+  double c, s;
+  sw_cos_sin(pl, cf, x, &c, &s);
+  backemf(pl, c, s, plant_mech_speed(pl, x, plant_mech_input(pl, t)), e);
   for (int j = 0; j < 3; j++) {
     leg_range(cf, j, vdc, &lo, &hi);
     if (lo - e[j] > best_lo) {
@@ -350,7 +364,9 @@ static void sw_transition(const plant_t *pl, sw_cfg_t *cf, double t, double *x, 
     cf->blocked = -1;
   } else {
     const int j = ev - EV_CUR0;
-    plant_machine_zero_phase_current(pl, x, j);
+    double c, s;
+    sw_cos_sin(pl, cf, x, &c, &s);
+    plant_machine_zero_phase_current_cs(pl, x, j, c, s);
     if (cf->blocked >= 0) {
       enter_all_zero(pl, cf, x); /* two phases blocked: all three currents are zero */
       return;
@@ -419,12 +435,24 @@ static void sw_integrate(plant_t *pl, sw_cfg_t *cf, double *t, double *x, double
   const double hmax = pl->p.ts / pl->aux.steps; /* more at speed (plant.h) */
   const int nsub = (int)ceil(len / hmax - 1e-9);
   const double h = len / (nsub > 0 ? nsub : 1);
+  /* the event functions and the star point at the end of a step without
+   * event are those at the start of the next one (same t, x and leg
+   * configuration) */
+  double z_next[EV_N], vs_next = 0.0;
+  int z_known = 0;
   for (int k = 0; k < (nsub > 0 ? nsub : 1); k++) {
     double rem = h;
     for (int guard = 0; rem > 1e-12 * pl->p.ts; guard++) {
       double x1[X_N], z0[EV_N], z1[EV_N];
-      const double vs0 = star ? sw_star(pl, cf, *t, x) : 0.0;
-      sw_events(pl, cf, *t, x, z0);
+      double vs0 = 0.0;
+      if (z_known) {
+        memcpy(z0, z_next, sizeof z0);
+        vs0 = vs_next;
+      } else {
+        sw_events(pl, cf, *t, x, z0);
+        vs0 = star ? sw_star(pl, cf, *t, x) : 0.0;
+      }
+      z_known = 0;
       sw_rk4(pl, cf, *t, x, rem, x1);
       sw_events(pl, cf, *t + rem, x1, z1);
       int best = -1;
@@ -440,9 +468,12 @@ static void sw_integrate(plant_t *pl, sw_cfg_t *cf, double *t, double *x, double
       }
       if (best < 0) {
         memcpy(x, x1, sizeof x1);
+        memcpy(z_next, z1, sizeof z1);
+        z_known = 1;
         *t += rem;
         if (star) {
-          plant_star_filter(pl, vs0, sw_star(pl, cf, *t, x), rem);
+          vs_next = sw_star(pl, cf, *t, x);
+          plant_star_filter(pl, vs0, vs_next, rem);
         }
         break;
       }
@@ -475,7 +506,7 @@ typedef struct {
 static void sw_setup(const plant_t *pl, sw_cfg_t *cf, double *x, const sw_legs_t *lg) {
   const int *type = lg->type;
   double i[3], ial, ibe;
-  phase_currents(pl, x, i, &ial, &ibe);
+  phase_currents(pl, cf, x, i, &ial, &ibe);
   cf->node = lg->node;
   for (int j = 0; j < 3; j++) {
     cf->rl[j] = lg->rl[j];
@@ -506,7 +537,9 @@ static void sw_setup(const plant_t *pl, sw_cfg_t *cf, double *x, const sw_legs_t
     enter_all_zero(pl, cf, x);
   } else if (nb == 1) {
     cf->blocked = jb;
-    plant_machine_zero_phase_current(pl, x, jb);
+    double c, s;
+    sw_cos_sin(pl, cf, x, &c, &s);
+    plant_machine_zero_phase_current_cs(pl, x, jb, c, s);
   } else {
     cf->blocked = -1;
   }
@@ -596,7 +629,7 @@ static void sw_fault_legs(plant_aux_t *a, sw_legs_t *lg) {
 }
 
 void plant_inverter_sw_period(plant_t *pl, const double on[3], const double off[3], bool gates_on,
-                              double *x) {
+                              double *x, double cs_end[2]) {
   plant_aux_t *a = &pl->aux;
   const double ts = pl->p.ts, td = pl->p.inverter.dead_time;
   edges_t ed[3];
@@ -660,6 +693,16 @@ void plant_inverter_sw_period(plant_t *pl, const double on[3], const double off[
   cf.node = -1;
   cf.all_zero = a->all_zero;
   cf.blocked = -1;
+  if (x[X_TH] == pl->theta_m) { /* always, from plant_step: the current cache's angle */
+    const plant_cur_cache_t *cc = plant_machine_cur(pl);
+    cf.th_ref = cc->th_e;
+    cf.c_ref = cc->c;
+    cf.s_ref = cc->s;
+  } else {
+    cf.th_ref = pl->p.machine.pole_pairs * x[X_TH];
+    cf.c_ref = cos(cf.th_ref);
+    cf.s_ref = sin(cf.th_ref);
+  }
   double t = pl->t;
   int ks = 0;      /* next star-point sample */
   int vf_init = 0; /* the circuit's state set (settled in the zero vector) */
@@ -701,4 +744,5 @@ void plant_inverter_sw_period(plant_t *pl, const double on[3], const double off[
   sw_out_t o;
   sw_deriv(pl, &cf, x, plant_mech_input(pl, pl->t + ts), dx, &o);
   a->v_star = o.vn0 - 0.5 * o.vdc;
+  sw_cos_sin(pl, &cf, x, &cs_end[0], &cs_end[1]); /* the end angle's, for the current cache */
 }

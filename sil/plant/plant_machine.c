@@ -73,11 +73,11 @@ void plant_machine_cur_compute(const plant_t *pl, plant_cur_cache_t *c) {
  * lambda_dq along the gradient of that current (smallest change), a Newton
  * step: exact for the linear model. Used when a free-wheeling diode blocks:
  * i_x = p . i_dq(lambda) with p = R(-theta_e) c_x, gradient k = G^T p,
- * G = d i / d lambda (plant_magnetics.h). */
-void plant_machine_zero_phase_current(const plant_t *pl, double *x, int leg) {
+ * G = d i / d lambda (plant_magnetics.h); c, s: cos and sin of the
+ * electrical angle pole_pairs * x[X_TH] (the caller's, carried). */
+void plant_machine_zero_phase_current_cs(const plant_t *pl, double *x, int leg, double c,
+                                         double s) {
   static const double cx[3][2] = {{1.0, 0.0}, {-0.5, PLANT_SQRT3_2}, {-0.5, -PLANT_SQRT3_2}};
-  const double th = pl->p.machine.pole_pairs * x[X_TH];
-  const double c = cos(th), s = sin(th);
   const double p1 = cx[leg][0] * c + cx[leg][1] * s;
   const double p2 = -cx[leg][0] * s + cx[leg][1] * c;
   double id, iq, G[2][2];

@@ -173,7 +173,7 @@ void plant_sensors_init(plant_t *pl) {
 }
 
 static double adc_round(double x, double lsb, double code_min, double code_max, double code_off) {
-  double code = floor(x / lsb + 0.5) + code_off;
+  double code = plant_floor(x / lsb + 0.5) + code_off;
   code = code < code_min ? code_min : (code > code_max ? code_max : code);
   return (code - code_off) * lsb;
 }
@@ -202,7 +202,7 @@ void plant_sample(plant_t *pl, plant_adc_t *out) {
   out->v_star = pl->aux.v_star;
   if (s->encoder_cpr > 0) {
     const double step = a->enc_step;
-    double cnt = floor(pl->theta_m / step);
+    double cnt = plant_floor(pl->theta_m / step);
     cnt = cnt >= s->encoder_cpr ? 0.0 : (cnt < 0.0 ? 0.0 : cnt);
     out->enc_angle = cnt * step;
   } else {

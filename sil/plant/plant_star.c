@@ -30,20 +30,26 @@
 
 /* The (3.3) matrix, its self terms at xs = 2 theta_e (+ their load
  * shift), its mutual terms at xm, and its derivative with respect to
- * theta_e. */
-static void star_matrix_of(double l0, double l2, double m0, double m2, double xs, double xm,
-                           double L[3][3], double dL[3][3]) {
-  const double q = 2.0 * PLANT_PI / 3.0;
-  const double self[3] = {xs, xs + q, xs + 2.0 * q};
-  const double mut[3] = {xm - q, xm + q, xm}; /* ab, ac, bc */
+ * theta_e; xs and xm given by their cos and sin. The other phases' angles
+ * are xs + q, xs + 2 q, xm +- q (q = 2 pi / 3) by angle addition with
+ * cos q = -1/2, sin q = sqrt(3)/2: two angles instead of twelve libm
+ * calls per derivative of the switching model. */
+static void star_matrix_of(double l0, double l2, double m0, double m2, double cs, double ss,
+                           double cm, double sm, double L[3][3], double dL[3][3]) {
+  const double h = PLANT_SQRT3_2;
+  const double c_self[3] = {cs, -0.5 * cs - h * ss, -0.5 * cs + h * ss};
+  const double s_self[3] = {ss, -0.5 * ss + h * cs, -0.5 * ss - h * cs};
+  /* ab at xm - q, ac at xm + q, bc at xm */
+  const double c_mut[3] = {-0.5 * cm + h * sm, -0.5 * cm - h * sm, cm};
+  const double s_mut[3] = {-0.5 * sm - h * cm, -0.5 * sm + h * cm, sm};
   for (int k = 0; k < 3; k++) {
-    L[k][k] = l0 + l2 * cos(self[k]);
-    dL[k][k] = -2.0 * l2 * sin(self[k]);
+    L[k][k] = l0 + l2 * c_self[k];
+    dL[k][k] = -2.0 * l2 * s_self[k];
   }
   const int r[3] = {0, 0, 1}, c[3] = {1, 2, 2};
   for (int k = 0; k < 3; k++) {
-    L[r[k]][c[k]] = L[c[k]][r[k]] = m0 + m2 * cos(mut[k]);
-    dL[r[k]][c[k]] = dL[c[k]][r[k]] = -2.0 * m2 * sin(mut[k]);
+    L[r[k]][c[k]] = L[c[k]][r[k]] = m0 + m2 * c_mut[k];
+    dL[r[k]][c[k]] = dL[c[k]][r[k]] = -2.0 * m2 * s_mut[k];
   }
 }
 
@@ -61,13 +67,30 @@ static double star_k(const plant_aniso_t *an, double i_q) {
 }
 
 /* at 2 (theta_e + shift) + phi_self i_q (self terms), + phi_mut i_q
- * (mutual terms), the 2theta terms scaled by the load */
-static void star_matrix(const plant_t *pl, double th_e, double i_q, double L[3][3],
+ * (mutual terms), the 2theta terms scaled by the load; c, s: cos and sin
+ * of theta_e. 2 theta_e by the double angle, turned by the shift and the
+ * load's angles only when they are not zero (libm then, once each). */
+static void star_matrix(const plant_t *pl, double c, double s, double i_q, double L[3][3],
                         double dL[3][3]) {
   const plant_aniso_t *an = &pl->p.machine.aniso;
-  const double k = star_k(an, i_q), x = 2.0 * (th_e + an->shift);
-  star_matrix_of(pl->aux.l0, k * pl->aux.l2, an->m0, k * an->m2, x + an->phi_self * i_q,
-                 x + an->phi_mut * i_q, L, dL);
+  const double k = star_k(an, i_q);
+  const double c2 = c * c - s * s, s2 = 2.0 * c * s;
+  const double rs = 2.0 * an->shift + an->phi_self * i_q, rm = 2.0 * an->shift + an->phi_mut * i_q;
+  double cs = c2, ss = s2, cm = c2, sm = s2;
+  if (rs != 0.0) {
+    const double cr = cos(rs), sr = sin(rs);
+    cs = c2 * cr - s2 * sr;
+    ss = s2 * cr + c2 * sr;
+  }
+  if (rm == rs) {
+    cm = cs;
+    sm = ss;
+  } else if (rm != 0.0) {
+    const double cr = cos(rm), sr = sin(rm);
+    cm = c2 * cr - s2 * sr;
+    sm = s2 * cr + c2 * sr;
+  }
+  star_matrix_of(pl->aux.l0, k * pl->aux.l2, an->m0, k * an->m2, cs, ss, cm, sm, L, dL);
 }
 
 /* The (3.3) matrix with its 2theta terms scaled by k and the mutual ones
@@ -77,7 +100,7 @@ static int star_pd(double l0, double l2, double m0, double m2, double k, double 
   for (int d = 0; d < 360; d++) {
     double L[3][3], dL[3][3];
     const double x = d * (PLANT_PI / 180.0);
-    star_matrix_of(l0, k * l2, m0, k * m2, x, x + dx, L, dL);
+    star_matrix_of(l0, k * l2, m0, k * m2, cos(x), sin(x), cos(x + dx), sin(x + dx), L, dL);
     const double d2 = L[0][0] * L[1][1] - L[0][1] * L[1][0];
     const double d3 = L[0][0] * (L[1][1] * L[2][2] - L[1][2] * L[2][1]) -
                       L[0][1] * (L[1][0] * L[2][2] - L[1][2] * L[2][0]) +
@@ -149,17 +172,17 @@ void plant_star_gain(const plant_t *pl, double theta_e, double i_q, double g[3])
     return;
   }
   double L[3][3], dL[3][3];
-  star_matrix(pl, theta_e, i_q, L, dL);
+  star_matrix(pl, cos(theta_e), sin(theta_e), i_q, L, dL);
   star_divider(L, g);
 }
 
-double plant_star_vn(const plant_t *pl, const double v[3], const double i[3], double th_e,
-                     double we, double i_q, const double e[3]) {
+double plant_star_vn(const plant_t *pl, const double v[3], const double i[3], double c_e,
+                     double s_e, double we, double i_q, const double e[3]) {
   if (!pl->p.machine.aniso.enabled) {
     return (v[0] + v[1] + v[2]) * (1.0 / 3.0);
   }
   double L[3][3], dL[3][3], g[3];
-  star_matrix(pl, th_e, i_q, L, dL);
+  star_matrix(pl, c_e, s_e, i_q, L, dL);
   star_divider(L, g);
   double vn = 0.0;
   for (int k = 0; k < 3; k++) {

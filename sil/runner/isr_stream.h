@@ -18,6 +18,7 @@
 #ifndef FD_ISR_STREAM_H
 #define FD_ISR_STREAM_H
 
+#include <stddef.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -95,9 +96,32 @@ typedef struct {
   uint32_t state;  /* drive_state_t after the ISR */
 } isr_stream_out_t;
 
+/* Its fields, in order, each named after the signal it carries (the log's
+ * column: docs/log-format.md; gates: ISR_OUT_GATES_ON only, the active
+ * short circuit is not told apart): X(signal, type, member). The PIL tool
+ * reads this list (`fluxdrive-sil --print-signals`, pil.py) and
+ * signals/agreement checks every name is a signal of the tables. */
+#define ISR_STREAM_OUT_FIELDS(X)                                                                   \
+  X(duty_a, F32, duty[0])                                                                          \
+  X(duty_b, F32, duty[1])                                                                          \
+  X(duty_c, F32, duty[2])                                                                          \
+  X(gates, U32, flags)                                                                             \
+  X(faults, U32, faults)                                                                           \
+  X(state, U32, state)
+
+#define ISR_OUT_INDEX(n, t, m) ISR_OUT_FIELD_##n,
+enum { ISR_STREAM_OUT_FIELDS(ISR_OUT_INDEX) ISR_OUT_FIELD_COUNT };
+#undef ISR_OUT_INDEX
+#define ISR_OUT_AT(n, t, m)                                                                        \
+  _Static_assert(offsetof(isr_stream_out_t, m) == sizeof(uint32_t) * (size_t)ISR_OUT_FIELD_##n,    \
+                 "isr_stream_out_t: the field of " #n);
+ISR_STREAM_OUT_FIELDS(ISR_OUT_AT)
+#undef ISR_OUT_AT
+
 _Static_assert(sizeof(isr_stream_header_t) == 36, "isr_stream_header_t layout");
 _Static_assert(sizeof(isr_stream_in_t) == 240, "isr_stream_in_t layout");
-_Static_assert(sizeof(isr_stream_out_t) == 24, "isr_stream_out_t layout");
+_Static_assert(sizeof(isr_stream_out_t) == sizeof(uint32_t) * (size_t)ISR_OUT_FIELD_COUNT,
+               "isr_stream_out_t layout: ISR_STREAM_OUT_FIELDS");
 _Static_assert(DRIVE_FAULT_COUNT <= ISR_STREAM_FAULT_WORDS, "fault counters");
 
 enum { ISR_STREAM_CONFIG_WORDS = DRIVE_PARAM_COUNT };

@@ -1,8 +1,8 @@
 /*
  * log_npy.h - the SIL log: a NumPy .npy file (format 1.0) holding a 1-D
  * structured array of little-endian float64 named fields, so that
- * np.load(path)['speed'] works directly. Signals are listed in
- * docs/log-format.md and in log_npy.c.
+ * np.load(path)['speed'] works directly. The columns are the signal
+ * tables' (log_columns.h), listed in docs/log-format.md (generated).
  */
 #ifndef FD_SIL_LOG_NPY_H
 #define FD_SIL_LOG_NPY_H
@@ -10,6 +10,7 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "log_columns.h"
 #include "sil_run.h"
 
 typedef struct {
@@ -17,6 +18,7 @@ typedef struct {
   uint64_t rows;
   int decimation;
   int failed;
+  log_columns_t cols;
 } log_npy_t;
 
 /* Opens the file and writes a provisional header. Returns 0 or -1. */

@@ -1,30 +1,28 @@
 /*
  * main.c - fluxdrive-sil: run one scenario.
  *
- *   fluxdrive-sil SCENARIO.json [--log PATH.npy] [--summary PATH.json]
- *                 [--decimate N] [--bench] [--print-config]
+ *   fluxdrive-sil SCENARIO.json [options]     (fluxdrive-sil --help: the options)
  *
- * --print-config prints the resolved parameters (JSON) and exits.
- * --print-params prints the parameter table and the drive's named values
- * (JSON; no scenario needed) and exits.
- * --preempt PERIODS [--seed N] [--max-gap-us U] runs PERIODS ISRs of the
- * scenario's plant and drive with the ISR preempting the main loop at
- * random points (sil/runner/sil_preempt.h; at most 600 s of wall time) and
- * prints the result (JSON); exit code 3 when an invariant was violated.
- * --record-isr PATH.bin records every ISR's inputs and outputs for the PIL
- * replay (sil/runner/isr_record.h, docs/pil.md).
- * --can socketcand:PORT | socketcan:IFACE [--node N] [--can-timeout MS]:
- * the drive is commanded over CAN (docs/can.md) and the scenario's
- * references are not applied. socketcand listens on 127.0.0.1:PORT (0: a
- * free port, printed on stderr); the simulation starts when the first
- * client is in raw mode. --realtime paces the simulation to the wall clock
- * (interactive use, the CAN tests); without it the simulation runs as fast
- * as it can and all CAN times (timestamps, timeout) are simulated time.
+ * The options are one table (`options` below: name, argument, help,
+ * handler); --help is printed from it.
+ * --preempt runs the scenario's plant and drive with the ISR preempting the
+ * main loop at random points (sil/runner/sil_preempt.h; at most 600 s of
+ * wall time) and prints the result (JSON); exit code 3 when an invariant
+ * was violated. --record-isr records every ISR's inputs and outputs for
+ * the PIL replay (sil/runner/isr_record.h, docs/pil.md).
+ * --can socketcand:PORT | socketcan:IFACE: the drive is commanded over CAN
+ * (docs/can.md) and the scenario's references are not applied. socketcand
+ * listens on 127.0.0.1:PORT (0: a free port, printed on stderr); the
+ * simulation starts when the first client is in raw mode. --realtime paces
+ * the simulation to the wall clock (interactive use, the CAN tests);
+ * without it the simulation runs as fast as it can and all CAN times
+ * (timestamps, timeout) are simulated time.
  * SIGINT/SIGTERM end the run early (the summary is still printed).
  * Exit codes: 0 ran (faults are results, reported in the summary),
  * 1 I/O error, 2 bad scenario or usage.
  */
 #include <signal.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -35,20 +33,11 @@
 #include "isr_record.h"
 #include "log_npy.h"
 #include "scenario.h"
+#include "scenario_keys.h"
 #include "sil_preempt.h"
+#include "signals_json.h"
 #include "sil_run.h"
 #include "summary.h"
-
-static int usage(void) {
-  fprintf(stderr,
-          "usage: fluxdrive-sil SCENARIO.json [--log PATH.npy] [--summary PATH.json]\n"
-          "                     [--decimate N] [--bench] [--print-config] [--print-params]\n"
-          "                     [--record-isr PATH.bin] [--realtime]\n"
-          "                     [--preempt PERIODS [--seed N] [--max-gap-us U]]\n"
-          "                     [--can socketcand:PORT | --can socketcan:IFACE]\n"
-          "                     [--node N] [--can-timeout MS]\n");
-  return 2;
-}
 
 static volatile int stop_flag;
 
@@ -93,69 +82,141 @@ static int parse_long(const char *opt, const char *s, long lo, long hi, long *ou
   return 0;
 }
 
-int main(int argc, char **argv) {
-  const char *scenario = NULL, *log_path = NULL, *summary_path = NULL, *record_path = NULL;
-  int decimate = 0, bench = 0, print_config = 0, print_params = 0, realtime = 0;
-  const char *can = NULL;
-  long preempt_n = 0;
-  double max_gap_us = 20.0;
-  long seed = 1;
-  long node = -1, can_timeout = -1;
+/* What the command line asks for. */
+typedef struct {
+  const char *scenario, *log_path, *summary_path, *record_path, *dump_path, *can;
+  const char *keys_doc, *keys_doc_write;
+  int bench, print_config, print_params, print_signals, realtime, keys, help;
+  long decimate, preempt_n, seed, node, can_timeout, max_gap_us;
+} cli_t;
+
+/* An option: its handler stores into the cli_t field at `at` (a path, a
+ * flag set to 1, or an integer in [lo, hi]). */
+typedef struct option option_t;
+struct option {
+  const char *name;
+  const char *arg; /* the argument's name, NULL for a flag */
+  const char *help;
+  int (*handler)(cli_t *o, const option_t *op, const char *arg); /* 0, or -1: usage error */
+  size_t at;
+  long lo, hi;
+};
+
+static int set_path(cli_t *o, const option_t *op, const char *arg) {
+  *(const char **)(void *)((char *)o + op->at) = arg;
+  return 0;
+}
+
+static int set_flag(cli_t *o, const option_t *op, const char *arg) {
+  (void)arg;
+  *(int *)(void *)((char *)o + op->at) = 1;
+  return 0;
+}
+
+static int set_long(cli_t *o, const option_t *op, const char *arg) {
+  return parse_long(op->name, arg, op->lo, op->hi, (long *)(void *)((char *)o + op->at));
+}
+
+#define PATH(f)         set_path, offsetof(cli_t, f), 0, 0
+#define FLAG(f)         set_flag, offsetof(cli_t, f), 0, 0
+#define LONG(f, lo, hi) set_long, offsetof(cli_t, f), (lo), (hi)
+static const option_t options[] = {
+    {"--log", "PATH.npy", "write the log (docs/log-format.md)", PATH(log_path)},
+    {"--summary", "PATH.json", "write the summary too (it is printed)", PATH(summary_path)},
+    {"--decimate", "N", "log every N-th period (overrides log.decimation)",
+     LONG(decimate, 1, 1000000)},
+    {"--bench", NULL, "no log; print steps, wall time and the real-time factor", FLAG(bench)},
+    {"--print-config", NULL, "print the resolved parameters (JSON) and exit", FLAG(print_config)},
+    {"--print-params", NULL, "print the parameter table (JSON; no scenario needed) and exit",
+     FLAG(print_params)},
+    {"--print-signals", NULL,
+     "print the signal tables (log columns, CAN signals, PIL fields: JSON; no scenario needed, "
+     "signals_json.h) and exit",
+     FLAG(print_signals)},
+    {"--dump-scenario", "PATH", "write the parsed scenario's bytes (scripts/scenario_equiv.py)",
+     PATH(dump_path)},
+    {"--record-isr", "PATH.bin", "record every ISR for the PIL replay (docs/pil.md)",
+     PATH(record_path)},
+    {"--realtime", NULL, "pace the simulation to the wall clock", FLAG(realtime)},
+    {"--preempt", "PERIODS", "race check: the ISR preempts the main loop at random points",
+     LONG(preempt_n, 1, 100000000)},
+    {"--seed", "N", "--preempt: the interrupt times' seed", LONG(seed, 0, 0x7fffffff)},
+    {"--max-gap-us", "U", "--preempt: at most U us between interrupts",
+     LONG(max_gap_us, 1, 100000)},
+    {"--can", "SPEC", "socketcand:PORT or socketcan:IFACE: the drive over CAN (docs/can.md)",
+     PATH(can)},
+    {"--node", "N", "--can: the drive's node id", LONG(node, 0, CAN_NODE_MAX)},
+    {"--can-timeout", "MS", "--can: the command timeout", LONG(can_timeout, 0, 60000)},
+    {"--keys", NULL, "print the scenario key reference (Markdown) and exit", FLAG(keys)},
+    {"--keys-doc", "DOC.md", "check DOC.md's scenario key reference against the table",
+     PATH(keys_doc)},
+    {"--keys-doc-write", "DOC.md", "write it into DOC.md", PATH(keys_doc_write)},
+    {"--help", NULL, "this help", FLAG(help)},
+};
+
+static int usage(FILE *f, int code) {
+  fprintf(f, "usage: fluxdrive-sil SCENARIO.json [options]\n");
+  for (size_t i = 0; i < sizeof options / sizeof options[0]; ++i) {
+    char left[64];
+    snprintf(left, sizeof left, "%s%s%s", options[i].name, options[i].arg ? " " : "",
+             options[i].arg ? options[i].arg : "");
+    fprintf(f, "  %-24s %s\n", left, options[i].help);
+  }
+  return code;
+}
+
+/* The command line into o; 0, or -1 on a usage error (reported). */
+static int parse_cli(int argc, char **argv, cli_t *o) {
   for (int i = 1; i < argc; ++i) {
-    if (strcmp(argv[i], "--log") == 0 && i + 1 < argc) {
-      log_path = argv[++i];
-    } else if (strcmp(argv[i], "--summary") == 0 && i + 1 < argc) {
-      summary_path = argv[++i];
-    } else if (strcmp(argv[i], "--decimate") == 0 && i + 1 < argc) {
-      char *end = NULL;
-      long v = strtol(argv[++i], &end, 10);
-      if (end == NULL || *end != '\0' || v < 1 || v > 1000000) {
-        fprintf(stderr, "fluxdrive-sil: --decimate: must be an integer in [1, 1000000]\n");
-        return 2;
+    const option_t *op = NULL;
+    for (size_t k = 0; k < sizeof options / sizeof options[0] && op == NULL; ++k) {
+      op = strcmp(argv[i], options[k].name) == 0 ? &options[k] : NULL;
+    }
+    if (op != NULL && (op->arg == NULL || i + 1 < argc)) {
+      if (op->handler(o, op, op->arg != NULL ? argv[++i] : NULL) != 0) {
+        return -1;
       }
-      decimate = (int)v;
-    } else if (strcmp(argv[i], "--record-isr") == 0 && i + 1 < argc) {
-      record_path = argv[++i];
-    } else if (strcmp(argv[i], "--bench") == 0) {
-      bench = 1;
-    } else if (strcmp(argv[i], "--realtime") == 0) {
-      realtime = 1;
-    } else if (strcmp(argv[i], "--can") == 0 && i + 1 < argc) {
-      can = argv[++i];
-    } else if (strcmp(argv[i], "--node") == 0 && i + 1 < argc) {
-      if (parse_long("--node", argv[++i], 0, CAN_NODE_MAX, &node) != 0) {
-        return 2;
-      }
-    } else if (strcmp(argv[i], "--can-timeout") == 0 && i + 1 < argc) {
-      if (parse_long("--can-timeout", argv[++i], 0, 60000, &can_timeout) != 0) {
-        return 2;
-      }
-    } else if (strcmp(argv[i], "--print-config") == 0) {
-      print_config = 1;
-    } else if (strcmp(argv[i], "--print-params") == 0) {
-      print_params = 1;
-    } else if (strcmp(argv[i], "--preempt") == 0 && i + 1 < argc) {
-      if (parse_long("--preempt", argv[++i], 1, 100000000, &preempt_n) != 0) {
-        return 2;
-      }
-    } else if (strcmp(argv[i], "--seed") == 0 && i + 1 < argc) {
-      if (parse_long("--seed", argv[++i], 0, 0x7fffffff, &seed) != 0) {
-        return 2;
-      }
-    } else if (strcmp(argv[i], "--max-gap-us") == 0 && i + 1 < argc) {
-      long g;
-      if (parse_long("--max-gap-us", argv[++i], 1, 100000, &g) != 0) {
-        return 2;
-      }
-      max_gap_us = (double)g;
-    } else if (argv[i][0] == '-' || scenario != NULL) {
-      return usage();
+    } else if (argv[i][0] == '-' || o->scenario != NULL) {
+      usage(stderr, 2);
+      return -1;
     } else {
-      scenario = argv[i];
+      o->scenario = argv[i];
     }
   }
-  if (print_params) {
-    char *js = params_json();
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  cli_t cli = {.max_gap_us = 20, .seed = 1, .node = -1, .can_timeout = -1};
+  if (parse_cli(argc, argv, &cli) != 0) {
+    return 2;
+  }
+  if (cli.help) {
+    return usage(stdout, 0);
+  }
+  if (cli.keys) {
+    char *md = scenario_keys_markdown();
+    if (md == NULL) {
+      return 1;
+    }
+    fputs(md, stdout);
+    free(md);
+    return 0;
+  }
+  if (cli.keys_doc != NULL || cli.keys_doc_write != NULL) {
+    char msg[600];
+    const int w = cli.keys_doc_write != NULL;
+    const int r = scenario_keys_doc(w ? cli.keys_doc_write : cli.keys_doc, w, msg, sizeof msg);
+    if (r != 0) {
+      fprintf(stderr, "fluxdrive-sil: %s\n", msg);
+    }
+    return r == 0 ? 0 : 1;
+  }
+  const char *const scenario = cli.scenario, *const log_path = cli.log_path;
+  const char *const summary_path = cli.summary_path, *const record_path = cli.record_path;
+  const char *const can = cli.can;
+  if (cli.print_params || cli.print_signals) {
+    char *js = cli.print_params ? params_json() : signals_json();
     if (js == NULL) {
       return 1;
     }
@@ -164,7 +225,7 @@ int main(int argc, char **argv) {
     return 0;
   }
   if (scenario == NULL) {
-    return usage();
+    return usage(stderr, 2);
   }
   static scenario_t sc;
   char err[512];
@@ -172,7 +233,14 @@ int main(int argc, char **argv) {
     fprintf(stderr, "fluxdrive-sil: %s\n", err);
     return 2;
   }
-  if (print_config) {
+  if (cli.dump_path != NULL) {
+    if (scenario_dump(&sc, cli.dump_path) != 0) {
+      fprintf(stderr, "fluxdrive-sil: %s: cannot write the dump\n", cli.dump_path);
+      return 1;
+    }
+    return 0;
+  }
+  if (cli.print_config) {
     char *js = config_json(&sc);
     if (js == NULL) {
       return 1;
@@ -181,8 +249,9 @@ int main(int argc, char **argv) {
     free(js);
     return 0;
   }
-  if (preempt_n > 0) {
-    const sil_preempt_opts_t po = {(uint64_t)preempt_n, 600.0, (uint32_t)seed, max_gap_us};
+  if (cli.preempt_n > 0) {
+    const sil_preempt_opts_t po = {(uint64_t)cli.preempt_n, 600.0, (uint32_t)cli.seed,
+                                   (double)cli.max_gap_us};
     static sil_preempt_result_t pr;
     if (sil_preempt_run(&sc, &po, &pr, err, sizeof err) != 0) {
       fprintf(stderr, "fluxdrive-sil: %s\n", err);
@@ -196,19 +265,19 @@ int main(int argc, char **argv) {
     free(js);
     return pr.violations != 0u || pr.tm_torn != 0u ? 3 : 0;
   }
-  if (decimate > 0) {
-    sc.log_decimation = decimate;
+  if (cli.decimate > 0) {
+    sc.log_decimation = (int)cli.decimate;
   }
   sil_opts_t opts = {0};
   can_proto_cfg_t pcfg;
   can_proto_cfg_default(&pcfg);
-  if (node >= 0) {
-    pcfg.node = (uint8_t)node;
+  if (cli.node >= 0) {
+    pcfg.node = (uint8_t)cli.node;
   }
-  if (can_timeout >= 0) {
-    pcfg.timeout_ms = (uint16_t)can_timeout;
+  if (cli.can_timeout >= 0) {
+    pcfg.timeout_ms = (uint16_t)cli.can_timeout;
   }
-  opts.realtime = realtime != 0;
+  opts.realtime = cli.realtime != 0;
   opts.stop = &stop_flag;
   if (can != NULL) {
     opts.can = &pcfg;
@@ -249,7 +318,7 @@ int main(int argc, char **argv) {
   signal(SIGINT, on_signal);
   signal(SIGTERM, on_signal);
   log_npy_t lg;
-  int logging = log_path != NULL && !bench;
+  int logging = log_path != NULL && !cli.bench;
   if (logging && log_npy_open(&lg, log_path, sc.log_decimation) != 0) {
     fprintf(stderr, "fluxdrive-sil: %s: cannot write the log\n", log_path);
     return 1;
@@ -297,7 +366,7 @@ int main(int argc, char **argv) {
     fprintf(stderr, "fluxdrive-sil: %s: %s\n", scenario, err);
     return 2;
   }
-  if (bench) {
+  if (cli.bench) {
     printf("steps: %llu\nwall: %.3f s\nreal-time factor: %.1f\n", (unsigned long long)res.steps,
            res.wall_time, res.real_time_factor);
     return 0;

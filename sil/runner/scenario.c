@@ -1,16 +1,17 @@
 /*
  * scenario.c - JSON scenario loading (schema: docs/scenarios.md).
  *
- * Every object is checked for unknown keys, every number for type, finiteness
- * and range; the first error is reported as "<file>: <field path>: <reason>".
- * The parameter sets are then validated as a whole by plant_check() and
- * drive_config_check(), whose field names are reported the same way.
+ * The keys are a table (scenario_keys.h, scenario_key_table.h) the parser
+ * walks: every object is checked for unknown keys, every value for its
+ * row's type and range (numbers also for finiteness); the first error is
+ * reported as "<file>: <field path>: <reason>". The rules between keys are
+ * the object rows' hooks (the section "the hooks" below). The parameter sets are then validated as
+ * a whole by plant_check() and drive_config_check(), whose field names are reported the same way.
  */
 #include "scenario.h"
 
 #include <cjson/cJSON.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -19,300 +20,17 @@
 #include "drive.h"
 #include "map_load.h"
 #include "presets.h"
+#include "scenario_key_table.h"
+#include "scenario_keys.h"
+#include "scenario_read.h"
 
-#define PI 3.14159265358979323846
 /* the load grid (0 .. i_trip) Theorem 1 is checked on (check_star) */
 #define STAR_LOAD_STEPS 256
 /* star_tau at most this share of the sample's settling time (dfc_t_meas -
  * dead time): measured on the fabbri2022 presets, docs/dfc.md */
 #define STAR_TAU_SHARE 0.2
 
-typedef struct {
-  char *err;
-  size_t errlen;
-  const char *origin;
-  int failed;
-  int ls_given; /* machine.ls set both inductances (for the error's key) */
-  /* the machine key that set the star point's p = b/a (3.7) the drive's
-   * dfc_b follows, when controller.dfc_b is not given ("" otherwise) */
-  char p_key[32];
-} ctx_t;
-
-static void utf8_clean(char *s);
-
-/* The first error, as "<origin>: <path>: <reason>", made valid UTF-8 (a key
- * or a string from the file may carry any bytes; the summary is JSON). */
-static int fail(ctx_t *c, const char *path, const char *fmt, ...) {
-  if (c->failed) {
-    return -1;
-  }
-  c->failed = 1;
-  char reason[400];
-  va_list ap;
-  va_start(ap, fmt);
-  /* the analyzer misses va_start on this path (LLVM 14) */
-  vsnprintf(reason, sizeof reason, fmt, ap); // NOLINT(clang-analyzer-valist.Uninitialized)
-  va_end(ap);
-  snprintf(c->err, c->errlen, "%s: %s: %s", c->origin, path, reason);
-  utf8_clean(c->err);
-  return -1;
-}
-
-static void join(char *out, size_t n, const char *path, const char *key) {
-  int r = path[0] == '\0' ? snprintf(out, n, "%s", key) : snprintf(out, n, "%s.%s", path, key);
-  if (r < 0 || (size_t)r >= n) {
-    out[n - 1] = '\0';
-  }
-}
-
-/* A key given twice in one object (JSON leaves it open; cJSON keeps both and
- * the lookups see the first): refused, with its path, anywhere in the
- * tree. Depth is bounded by cJSON's nesting limit. */
-static int check_duplicates(ctx_t *c, const cJSON *node, const char *path) {
-  for (const cJSON *it = node->child; it != NULL; it = it->next) {
-    char p[160];
-    if (cJSON_IsObject(node)) {
-      for (const cJSON *jt = it->next; jt != NULL; jt = jt->next) {
-        if (strcmp(it->string, jt->string) == 0) {
-          join(p, sizeof p, path, it->string);
-          return fail(c, p, "given twice (a key may appear once)");
-        }
-      }
-      join(p, sizeof p, path, it->string);
-    } else {
-      int k = 0;
-      for (const cJSON *jt = node->child; jt != it; jt = jt->next) {
-        ++k;
-      }
-      snprintf(p, sizeof p, "%s[%d]", path, k);
-    }
-    if ((cJSON_IsObject(it) || cJSON_IsArray(it)) && check_duplicates(c, it, p) != 0) {
-      return -1;
-    }
-  }
-  return 0;
-}
-
-/* s made valid UTF-8 in place: a sequence cut by a truncation at the end is
- * dropped, any other invalid byte becomes '?' (the summary is JSON, and
- * JSON is UTF-8). */
-static void utf8_clean(char *s) {
-  size_t i = 0;
-  const size_t n = strlen(s);
-  while (i < n) {
-    const unsigned char b = (unsigned char)s[i];
-    size_t len = b < 0x80u                    ? 1u
-                 : (b >= 0xC2u && b <= 0xDFu) ? 2u
-                 : (b >= 0xE0u && b <= 0xEFu) ? 3u
-                 : (b >= 0xF0u && b <= 0xF4u) ? 4u
-                                              : 0u;
-    /* the second byte's range: no overlong forms, no surrogates, nothing
-     * beyond U+10FFFF (RFC 3629) */
-    const unsigned char lo = b == 0xE0u ? 0xA0u : (b == 0xF0u ? 0x90u : 0x80u);
-    const unsigned char hi = b == 0xEDu ? 0x9Fu : (b == 0xF4u ? 0x8Fu : 0xBFu);
-    size_t k = 1u;
-    while (len > 1u && k < len && i + k < n) {
-      const unsigned char x = (unsigned char)s[i + k];
-      if (k == 1u ? (x < lo || x > hi) : (x & 0xC0u) != 0x80u) {
-        break;
-      }
-      ++k;
-    }
-    if (len > 1u && k < len && i + k == n) {
-      s[i] = '\0'; /* cut at the end: drop the partial sequence */
-      return;
-    }
-    if (len == 0u || k < len) {
-      s[i] = '?';
-      len = 1u;
-    }
-    i += len;
-  }
-}
-
-/* Rejects keys of obj that are not in the NULL-terminated list. */
-static int check_keys(ctx_t *c, const cJSON *obj, const char *path, const char *const *allowed) {
-  if (!cJSON_IsObject(obj)) {
-    return fail(c, path[0] ? path : "(top level)", "must be an object");
-  }
-  for (const cJSON *it = obj->child; it != NULL; it = it->next) {
-    int ok = 0;
-    for (const char *const *a = allowed; *a != NULL; ++a) {
-      ok |= strcmp(*a, it->string) == 0;
-    }
-    if (!ok) {
-      char p[160];
-      join(p, sizeof p, path, it->string);
-      return fail(c, p, "unknown field");
-    }
-  }
-  return 0;
-}
-
-/* Optional number in [lo, hi]; leaves *out unchanged when absent. */
-static int get_num(ctx_t *c, const cJSON *obj, const char *path, const char *key, double lo,
-                   double hi, double *out) {
-  const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
-  if (it == NULL) {
-    return 0;
-  }
-  char p[160];
-  join(p, sizeof p, path, key);
-  if (!cJSON_IsNumber(it)) {
-    return fail(c, p, "must be a number");
-  }
-  double v = it->valuedouble;
-  if (!isfinite(v) || v < lo || v > hi) {
-    return fail(c, p, "must be in [%g, %g] (got %g)", lo, hi, v);
-  }
-  *out = v;
-  return 0;
-}
-
-static int get_int(ctx_t *c, const cJSON *obj, const char *path, const char *key, int lo, int hi,
-                   int *out) {
-  double v = (double)*out;
-  if (get_num(c, obj, path, key, lo, hi, &v) != 0) {
-    return -1;
-  }
-  if (floor(v) != v) {
-    char p[160];
-    join(p, sizeof p, path, key);
-    return fail(c, p, "must be an integer (got %g)", v);
-  }
-  *out = (int)v;
-  return 0;
-}
-
-/* Optional number for a key that also sets drive parameter `param`: its
- * range is the parameter's (drive_param_table.h), one range for plant and
- * drive. */
-static int get_param_num(ctx_t *c, const cJSON *obj, const char *path, const char *key,
-                         const char *param, double *out) {
-  const drive_param_t *p = drive_params_by_name(param);
-  return get_num(c, obj, path, key, (double)p->min, (double)p->max, out);
-}
-
-/* Optional string from a list; returns its index in *out. */
-static int get_enum(ctx_t *c, const cJSON *obj, const char *path, const char *key,
-                    const char *const *names, int *out) {
-  const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
-  if (it == NULL) {
-    return 0;
-  }
-  char p[160];
-  join(p, sizeof p, path, key);
-  char list[200] = "";
-  for (int i = 0; names[i] != NULL; ++i) {
-    if (cJSON_IsString(it) && strcmp(it->valuestring, names[i]) == 0) {
-      *out = i;
-      return 0;
-    }
-    strncat(list, i ? ", " : "", sizeof list - strlen(list) - 1);
-    strncat(list, names[i], sizeof list - strlen(list) - 1);
-  }
-  return fail(c, p, "must be one of: %s", list);
-}
-
-/* ---- profiles ---------------------------------------------------------- */
-
-static int parse_term(ctx_t *c, const cJSON *t, const char *path, double scale, profile_t *pr) {
-  static const char *const kinds[] = {"const", "step", "ramp", "sine", NULL};
-  static const char *const keys[] = {"type", "value", "t",         "t0", "t1",
-                                     "freq", "phase", "amplitude", NULL};
-  if (check_keys(c, t, path, keys) != 0) {
-    return -1;
-  }
-  int kind = -1;
-  if (get_enum(c, t, path, "type", kinds, &kind) != 0) {
-    return -1;
-  }
-  if (kind < 0) {
-    char p[160];
-    join(p, sizeof p, path, "type");
-    return fail(c, p, "missing (const, step, ramp or sine)");
-  }
-  profile_term_t term = {.kind = (profile_kind_t)kind};
-  const double big = 1e9;
-  if (get_num(c, t, path, kind == PROFILE_SINE ? "amplitude" : "value", -big, big, &term.value) ||
-      get_num(c, t, path, kind == PROFILE_STEP ? "t" : "t0", 0.0, big, &term.t0) ||
-      get_num(c, t, path, "t1", 0.0, big, &term.t1) ||
-      get_num(c, t, path, "freq", 0.0, 1e6, &term.freq) ||
-      get_num(c, t, path, "phase", -1e3, 1e3, &term.phase)) {
-    return -1;
-  }
-  if (kind == PROFILE_RAMP && !(term.t1 > term.t0)) {
-    char p[160];
-    join(p, sizeof p, path, "t1");
-    return fail(c, p, "a ramp needs t1 > t0");
-  }
-  if (kind == PROFILE_SINE && !(term.freq > 0.0)) {
-    char p[160];
-    join(p, sizeof p, path, "freq");
-    return fail(c, p, "a sine needs freq > 0");
-  }
-  term.value *= scale;
-  if (profile_add(pr, term) != 0) {
-    return fail(c, path, "too many terms (at most %d)", PROFILE_MAX_TERMS);
-  }
-  return 0;
-}
-
-/* A profile: a number (constant), an array of terms, or
- * {"unit": "...", "terms": [...]} with unit conversion to SI. */
-static int get_profile(ctx_t *c, const cJSON *obj, const char *path, const char *key,
-                       profile_t *pr) {
-  const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
-  if (it == NULL) {
-    return 0;
-  }
-  char p[160];
-  join(p, sizeof p, path, key);
-  *pr = (profile_t){0};
-  double scale = 1.0;
-  if (cJSON_IsNumber(it)) {
-    if (!isfinite(it->valuedouble)) {
-      return fail(c, p, "must be finite");
-    }
-    return profile_add(pr, (profile_term_t){.kind = PROFILE_CONST, .value = it->valuedouble});
-  }
-  const cJSON *terms = it;
-  if (cJSON_IsObject(it)) {
-    static const char *const keys[] = {"unit", "terms", NULL};
-    static const char *const units[] = {"si", "rpm", "deg", NULL};
-    if (check_keys(c, it, p, keys) != 0) {
-      return -1;
-    }
-    int u = 0;
-    if (get_enum(c, it, p, "unit", units, &u) != 0) {
-      return -1;
-    }
-    scale = u == 1 ? PI / 30.0 : (u == 2 ? PI / 180.0 : 1.0);
-    terms = cJSON_GetObjectItemCaseSensitive(it, "terms");
-    char tp[160];
-    join(tp, sizeof tp, p, "terms");
-    if (!cJSON_IsArray(terms)) {
-      return fail(c, tp, "must be an array of profile terms");
-    }
-    memcpy(p, tp, sizeof p);
-  }
-  if (!cJSON_IsArray(terms)) {
-    return fail(c, p, "must be a number, an array of terms or {\"unit\", \"terms\"}");
-  }
-  int i = 0;
-  for (const cJSON *t = terms->child; t != NULL; t = t->next, ++i) {
-    char tp[176];
-    if (snprintf(tp, sizeof tp, "%s[%d]", p, i) >= (int)sizeof tp) {
-      tp[sizeof tp - 1] = '\0';
-    }
-    if (parse_term(c, t, tp, scale, pr) != 0) {
-      return -1;
-    }
-  }
-  return 0;
-}
-
-/* ---- sections ---------------------------------------------------------- */
+/* ---- machines ---------------------------------------------------------- */
 
 /* A flux map into plant and drive: the pole pairs are the map's; pp > 0,
  * the scenario's machine.pole_pairs: a map file without them takes them,
@@ -322,14 +40,14 @@ static int use_map(ctx_t *c, const char *key, const char *file, int pp, scenario
   const map_load_t *e = map_load(file, c->origin, pp, why, sizeof why);
   if (e == NULL) {
     if (strstr(why, ": pole pairs: ") != NULL) { /* the map tool's check (fluxmap/io.py) */
-      return pp > 0 ? fail(c, "machine.pole_pairs", "%d: %s", pp, why)
-                    : fail(c, "machine.pole_pairs", "required: %s", why);
+      return pp > 0 ? scn_fail(c, "machine.pole_pairs", "%d: %s", pp, why)
+                    : scn_fail(c, "machine.pole_pairs", "required: %s", why);
     }
-    return fail(c, key, "%s", why);
+    return scn_fail(c, key, "%s", why);
   }
   if (pp > 0 && e->map.pole_pairs != (float)pp) {
-    return fail(c, "machine.pole_pairs", "%d, but the map file %s has %g", pp, file,
-                (double)e->map.pole_pairs);
+    return scn_fail(c, "machine.pole_pairs", "%d, but the map file %s has %g", pp, file,
+                    (double)e->map.pole_pairs);
   }
   sc->plant.machine.map = e->plant;
   snprintf(sc->map_file, sizeof sc->map_file, "%s", e->path);
@@ -351,293 +69,6 @@ static const char *star_key_given(const cJSON *m) {
     }
   }
   return NULL;
-}
-
-static int parse_machine(ctx_t *c, const cJSON *m, scenario_t *sc) {
-  static const char *const keys[] = {"preset",
-                                     "pole_pairs",
-                                     "rs",
-                                     "ld",
-                                     "lq",
-                                     "ls",
-                                     "lambda_m",
-                                     "map",
-                                     "star_m0",
-                                     "star_m2",
-                                     "star_phi_iq",
-                                     "star_amp_iq",
-                                     "star_p",
-                                     "star_phi_self",
-                                     "star_phi_mutual",
-                                     "ld_sat",
-                                     "i_sat",
-                                     NULL};
-  if (check_keys(c, m, "machine", keys) != 0) {
-    return -1;
-  }
-  /* the scenario's pole pairs first: a map file may need them */
-  double pp_given = 0.0;
-  if (get_param_num(c, m, "machine", "pole_pairs", "pole_pairs", &pp_given) != 0) {
-    return -1;
-  }
-  if (floor(pp_given) != pp_given) {
-    return fail(c, "machine.pole_pairs", "must be an integer (got %g)", pp_given);
-  }
-  const cJSON *pre = cJSON_GetObjectItemCaseSensitive(m, "preset");
-  if (pre != NULL) {
-    const machine_preset_t *p = cJSON_IsString(pre) ? preset_find(pre->valuestring) : NULL;
-    if (p == NULL) {
-      return fail(c, "machine.preset", "unknown preset (known: %s)", preset_names());
-    }
-    preset_apply(p, &sc->plant, &sc->drive);
-    if (p->map != NULL && use_map(c, "machine.preset", p->map, (int)pp_given, sc) != 0) {
-      return -1;
-    }
-  }
-  const cJSON *map = cJSON_GetObjectItemCaseSensitive(m, "map");
-  if (map != NULL) {
-    if (!cJSON_IsString(map) || map->valuestring[0] == '\0') {
-      return fail(c, "machine.map", "must be a file name (.fdmap, .npz, .csv)");
-    }
-    if (use_map(c, "machine.map", map->valuestring, (int)pp_given, sc) != 0) {
-      return -1;
-    }
-  }
-  if (sc->plant.machine.map != NULL) {
-    static const char *const linear_only[] = {"ld",     "lq",    "ls", "lambda_m",
-                                              "ld_sat", "i_sat", NULL};
-    for (int k = 0; linear_only[k] != NULL; ++k) {
-      if (cJSON_GetObjectItemCaseSensitive(m, linear_only[k]) != NULL) {
-        char key[32];
-        snprintf(key, sizeof key, "machine.%s", linear_only[k]);
-        return fail(c, key, "a flux-map machine takes its inductances and PM flux from the map");
-      }
-    }
-  }
-  plant_machine_t *pm = &sc->plant.machine;
-  double ls = -1.0, pp = pm->pole_pairs;
-  const char *M = "machine";
-  if (get_param_num(c, m, M, "pole_pairs", "pole_pairs", &pp) ||
-      get_param_num(c, m, M, "rs", "rs", &pm->rs) || get_param_num(c, m, M, "ls", "ld", &ls) ||
-      get_param_num(c, m, M, "ld", "ld", &pm->ld) || get_param_num(c, m, M, "lq", "lq", &pm->lq) ||
-      get_param_num(c, m, M, "lambda_m", "lambda_m", &pm->lambda_m)) {
-    return -1;
-  }
-  if (floor(pp) != pp) {
-    return fail(c, "machine.pole_pairs", "must be an integer (got %g)", pp);
-  }
-  pm->pole_pairs = (int)pp;
-  if (ls > 0.0) {
-    if (cJSON_GetObjectItemCaseSensitive(m, "ld") || cJSON_GetObjectItemCaseSensitive(m, "lq")) {
-      return fail(c, "machine.ls", "give either ls (SPM) or ld and lq, not both");
-    }
-    pm->ld = pm->lq = ls;
-    c->ls_given = 1;
-  }
-  /* the magnet's d-axis saturation (plant.h, plant_magnetics.h) */
-  if (get_num(c, m, M, "ld_sat", 0.0, 0.5, &pm->ld_sat) ||
-      get_num(c, m, M, "i_sat", 1e-3, 1e4, &pm->i_sat)) {
-    return -1;
-  }
-  if (pm->ld_sat > 0.0 && !(pm->i_sat > 0.0)) {
-    return fail(c, "machine.i_sat", "must be given (> 0 A) with machine.ld_sat > 0");
-  }
-  /* the star point's inductance matrix (3.3), plant.h */
-  const char *star = star_key_given(m);
-  if (star != NULL && sc->plant.machine.map != NULL) {
-    return fail(c, star, "the star-point model needs a linear machine (no map)");
-  }
-  if (get_num(c, m, M, "star_m0", -1.0, 1.0, &pm->aniso.m0) ||
-      get_num(c, m, M, "star_m2", -1.0, 1.0, &pm->aniso.m2) ||
-      get_num(c, m, M, "star_phi_self", -1.0, 1.0, &pm->aniso.phi_self) ||
-      get_num(c, m, M, "star_phi_mutual", -1.0, 1.0, &pm->aniso.phi_mut) ||
-      get_num(c, m, M, "star_amp_iq", -0.5, 1.0, &pm->aniso.amp_iq)) {
-    return -1;
-  }
-  /* star_phi_iq: both terms' shift (a turned saliency axis: phi_a = phi_iq,
-   * phi_b = 2 phi_iq of (3.97)), an alias of the pair */
-  if (cJSON_GetObjectItemCaseSensitive(m, "star_phi_iq") != NULL) {
-    if (cJSON_GetObjectItemCaseSensitive(m, "star_phi_self") ||
-        cJSON_GetObjectItemCaseSensitive(m, "star_phi_mutual")) {
-      return fail(c, "machine.star_phi_iq",
-                  "sets star_phi_self and star_phi_mutual both: give either it or them");
-    }
-    if (get_num(c, m, M, "star_phi_iq", -1.0, 1.0, &pm->aniso.phi_self)) {
-      return -1;
-    }
-    pm->aniso.phi_mut = pm->aniso.phi_self;
-  }
-  /* star_p: the anisotropy p of (3.7) with L0, M0, L2 kept (Fig. 3.3):
-   * gamma0 = L0 - M0, gamma2 = p gamma0 = L2/2 + M2, ld, lq = gamma0 +- gamma2 */
-  if (cJSON_GetObjectItemCaseSensitive(m, "star_p") != NULL) {
-    double p = 0.0;
-    if (get_num(c, m, M, "star_p", -0.999999, 0.999999, &p)) {
-      return -1;
-    }
-    if (cJSON_GetObjectItemCaseSensitive(m, "ld") || cJSON_GetObjectItemCaseSensitive(m, "lq") ||
-        cJSON_GetObjectItemCaseSensitive(m, "star_m2")) {
-      return fail(c, "machine.star_p", "sets ld, lq and star_m2: give none of them with it");
-    }
-    const double l0 = 0.5 * (pm->ld + pm->lq) + pm->aniso.m0;
-    const double l2 = (pm->ld - pm->lq) - 2.0 * pm->aniso.m2;
-    const double g0 = l0 - pm->aniso.m0, g2 = p * g0;
-    pm->ld = g0 + g2;
-    pm->lq = g0 - g2;
-    pm->aniso.m2 = g2 - 0.5 * l2;
-  }
-  if (star != NULL) {
-    pm->aniso.enabled = 1; /* checked with the whole scenario known (check_star) */
-  }
-  if (pm->aniso.enabled) { /* the controller's DFC model (3.7), unless set */
-    double a, b;
-    plant_aniso_ab(pm, &a, &b);
-    sc->drive.dfc_a = (float)a;
-    sc->drive.dfc_b = (float)b;
-  }
-  sc->drive.pole_pairs = (float)pm->pole_pairs;
-  sc->drive.rs = (float)pm->rs;
-  sc->drive.ld = (float)pm->ld;
-  sc->drive.lq = (float)pm->lq;
-  sc->drive.lambda_m = (float)pm->lambda_m;
-  return 0;
-}
-
-static int parse_inverter(ctx_t *c, const cJSON *o, scenario_t *sc) {
-  static const char *const keys[] = {"model",         "dead_time", "substeps",
-                                     "pwm_frequency", "hw_trip",   NULL};
-  static const char *const models[] = {"average", "switching", NULL};
-  if (check_keys(c, o, "inverter", keys) != 0) {
-    return -1;
-  }
-  int model = (int)sc->plant.inverter.model;
-  double f = 1.0 / sc->plant.ts;
-  const drive_param_t *pts = drive_params_by_name("ts");
-  if (get_enum(c, o, "inverter", "model", models, &model) ||
-      get_param_num(c, o, "inverter", "dead_time", "dead_time", &sc->plant.inverter.dead_time) ||
-      get_int(c, o, "inverter", "substeps", 1, PLANT_SUBSTEPS_MAX, &sc->plant.inverter.substeps) ||
-      get_num(c, o, "inverter", "pwm_frequency", 1.0 / (double)pts->max, 1.0 / (double)pts->min,
-              &f) ||
-      get_num(c, o, "inverter", "hw_trip", 0.0, 1e5, &sc->hw_trip)) {
-    return -1;
-  }
-  sc->plant.inverter.model = (plant_inverter_model_t)model;
-  sc->plant.ts = 1.0 / f;
-  sc->drive.ts = (float)sc->plant.ts;
-  sc->drive.dead_time = (float)sc->plant.inverter.dead_time;
-  return 0;
-}
-
-static int parse_dclink(ctx_t *c, const cJSON *o, scenario_t *sc) {
-  static const char *const keys[] = {"kind",      "voltage",    "r",           "c",
-                                     "chopper_r", "chopper_on", "chopper_off", NULL};
-  static const char *const kinds[] = {"ideal", "rc", "rectifier", NULL};
-  if (check_keys(c, o, "dc_link", keys) != 0) {
-    return -1;
-  }
-  int kind = (int)sc->plant.dclink.kind;
-  if (get_enum(c, o, "dc_link", "kind", kinds, &kind) ||
-      get_profile(c, o, "dc_link", "voltage", &sc->v_source) ||
-      get_num(c, o, "dc_link", "r", 0.0, 1e6, &sc->plant.dclink.r) ||
-      get_num(c, o, "dc_link", "c", 0.0, 10.0, &sc->plant.dclink.c) ||
-      get_num(c, o, "dc_link", "chopper_r", 0.0, 1e6, &sc->plant.dclink.r_chop) ||
-      get_num(c, o, "dc_link", "chopper_on", 0.0, 1e4, &sc->plant.dclink.v_chop_on) ||
-      get_num(c, o, "dc_link", "chopper_off", 0.0, 1e4, &sc->plant.dclink.v_chop_off)) {
-    return -1;
-  }
-  sc->plant.dclink.kind = (plant_dc_kind_t)kind;
-  return 0;
-}
-
-static int parse_mechanics(ctx_t *c, const cJSON *o, scenario_t *sc) {
-  static const char *const keys[] = {"mode",  "j",      "b",      "load_torque",
-                                     "speed", "theta0", "speed0", NULL};
-  static const char *const modes[] = {"free", "imposed", NULL};
-  if (check_keys(c, o, "mechanics", keys) != 0) {
-    return -1;
-  }
-  plant_mech_t *m = &sc->plant.mech;
-  int mode = (int)m->mode;
-  if (get_enum(c, o, "mechanics", "mode", modes, &mode) ||
-      get_param_num(c, o, "mechanics", "j", "inertia", &m->j) ||
-      get_param_num(c, o, "mechanics", "b", "friction", &m->b) ||
-      get_profile(c, o, "mechanics", "load_torque", &m->load_torque) ||
-      get_profile(c, o, "mechanics", "speed", &m->speed) ||
-      get_num(c, o, "mechanics", "theta0", -1e3, 1e3, &m->theta0) ||
-      get_num(c, o, "mechanics", "speed0", -1e5, 1e5, &m->omega0)) {
-    return -1;
-  }
-  m->mode = (plant_mech_mode_t)mode;
-  if (m->mode == PLANT_MECH_IMPOSED && !cJSON_GetObjectItemCaseSensitive(o, "speed")) {
-    return fail(c, "mechanics.speed", "required when mode is \"imposed\"");
-  }
-  sc->drive.inertia = (float)m->j;
-  sc->drive.friction = (float)m->b;
-  return 0;
-}
-
-static int parse_sensors(ctx_t *c, const cJSON *o, scenario_t *sc) {
-  static const char *const keys[] = {
-      "adc_bits",   "i_full_scale",    "v_full_scale", "gain_error", "offset_error",
-      "i_noise",    "v_noise",         "encoder_cpr",  "seed",       "star_full_scale",
-      "star_noise", "star_gain_error", "star_offset",  "star_tau",   NULL};
-  if (check_keys(c, o, "sensors", keys) != 0) {
-    return -1;
-  }
-  plant_sensors_t *s = &sc->plant.sensors;
-  int seed = (int)s->seed;
-  if (get_int(c, o, "sensors", "adc_bits", 8, 24, &s->adc_bits) ||
-      get_num(c, o, "sensors", "i_full_scale", 1e-3, 1e5, &s->i_full_scale) ||
-      get_num(c, o, "sensors", "v_full_scale", 1e-3, 1e5, &s->v_full_scale) ||
-      get_num(c, o, "sensors", "i_noise", 0.0, 1e3, &s->i_noise) ||
-      get_num(c, o, "sensors", "v_noise", 0.0, 1e3, &s->v_noise) ||
-      get_int(c, o, "sensors", "encoder_cpr", 0, (int)drive_params_by_name("enc_cpr")->max,
-              &s->encoder_cpr) ||
-      get_int(c, o, "sensors", "seed", 0, 0x7fffffff, &seed) ||
-      get_num(c, o, "sensors", "star_full_scale", 0.0, 1e5, &s->star_full_scale) ||
-      get_num(c, o, "sensors", "star_noise", 0.0, 1e3, &s->star_noise) ||
-      get_num(c, o, "sensors", "star_gain_error", -0.49, 0.49, &s->star_gain_error) ||
-      get_num(c, o, "sensors", "star_offset", -1e3, 1e3, &s->star_offset) ||
-      get_num(c, o, "sensors", "star_tau", 0.0, 1e-4, &s->star_tau)) {
-    return -1;
-  }
-  s->seed = (uint32_t)seed;
-  sc->drive.enc_cpr = (uint32_t)s->encoder_cpr;
-  const char *arrays[2] = {"gain_error", "offset_error"};
-  double *dst[2] = {s->gain_error, s->offset_error};
-  for (int a = 0; a < 2; ++a) {
-    const cJSON *arr = cJSON_GetObjectItemCaseSensitive(o, arrays[a]);
-    if (arr == NULL) {
-      continue;
-    }
-    char p[64];
-    join(p, sizeof p, "sensors", arrays[a]);
-    if (!cJSON_IsArray(arr) || cJSON_GetArraySize(arr) != 3) {
-      return fail(c, p, "must be an array of 3 numbers (phases a, b, c)");
-    }
-    for (int i = 0; i < 3; ++i) {
-      const cJSON *v = cJSON_GetArrayItem(arr, i);
-      if (!cJSON_IsNumber(v) || !isfinite(v->valuedouble) || fabs(v->valuedouble) > 1e3) {
-        return fail(c, p, "element %d must be a finite number", i);
-      }
-      dst[a][i] = v->valuedouble;
-    }
-  }
-  return 0;
-}
-
-/* The keys of the "controller" section: every parameter whose scenario key
- * is "controller.<name>" (drive_param_table.h), and "estimates". */
-static int controller_keys(const char **keys, unsigned max) {
-  unsigned n, k = 0;
-  const drive_param_t *t = drive_params_table(&n);
-  for (unsigned i = 0; i < n && k + 2u < max; ++i) {
-    if (strncmp(t[i].scenario, "controller.", 11) == 0) {
-      keys[k++] = t[i].scenario + 11;
-    }
-  }
-  keys[k++] = "estimates";
-  keys[k] = NULL;
-  return 0;
 }
 
 /* One controller parameter, by its type: a number in the table's range,
@@ -663,478 +94,649 @@ static int get_param(ctx_t *c, const cJSON *o, const drive_param_t *p, drive_con
                                                  : drive_pos_source_name(v);
     }
     names[n] = NULL;
-    if (get_enum(c, o, "controller", key, names, &idx) != 0) {
+    if (scn_get_enum(c, o, "controller", key, names, &idx) != 0) {
       return -1;
     }
     drive_param_set(d, p, (float)idx);
     return 0;
   }
   double v = (double)drive_param_get(d, p);
-  if (get_num(c, o, "controller", key, (double)p->min, (double)p->max, &v) != 0) {
+  if (scn_get_num(c, o, "controller", key, (double)p->min, (double)p->max, &v) != 0) {
     return -1;
   }
   if (p->type != DRIVE_PARAM_F32 && floor(v) != v) {
-    return fail(c, p->scenario, "must be an integer (got %g)", v);
+    return scn_fail(c, p->scenario, "must be an integer (got %g)", v);
   }
   drive_param_set(d, p, (float)v);
   return 0;
 }
 
-static int parse_controller(ctx_t *c, const cJSON *o, scenario_t *sc) {
-  const char *keys[DRIVE_PARAM_COUNT + 2];
-  controller_keys(keys, DRIVE_PARAM_COUNT + 2);
-  if (check_keys(c, o, "controller", keys) != 0) {
+/* ---- the key table -------------------------------------------------------- */
+
+#define DEFAULT_BOARD       "g474_nucleo"
+#define FAULT_NAME(E, n, d) #n,
+static const char *const inverter_models[] = {"average", "switching", NULL};
+static const char *const dc_kinds[] = {"ideal", "rc", "rectifier", NULL};
+static const char *const mech_modes[] = {"free", "imposed", NULL};
+static const char *const fault_names[] = {DRIVE_FAULT_LIST(FAULT_NAME) NULL};
+static const char *const switch_names[] = {"a_low", "a_high", "b_low", "b_high",
+                                           "c_low", "c_high", NULL};
+static const char *const phase_names[] = {"a", "b", "c", NULL};
+static const char *const pair_names[] = {"ab", "bc", "ca", NULL};
+
+/* the enumerations stored as int (SK_AT_INT) */
+_Static_assert(sizeof(plant_inverter_model_t) == sizeof(int) &&
+                   sizeof(plant_dc_kind_t) == sizeof(int) &&
+                   sizeof(plant_mech_mode_t) == sizeof(int) &&
+                   sizeof(sil_adc_kind_t) == sizeof(int),
+               "an enumeration the key table stores as int is not int-sized");
+
+static int root_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int set_name(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int machine_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int machine_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int inverter_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int set_pwm_frequency(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int mechanics_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int sensors_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int controller_params(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int estimates_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int inject_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int current_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int current_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int encoder_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int can_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int can_dir_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int passive_load_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int board_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+
+#define SK_ID(id, ...) id,
+enum { SCENARIO_KEYS(SK_ID) K_COUNT };
+#define SK_ROW(id, ...) [id] = {__VA_ARGS__},
+static const scenario_key_t rows[K_COUNT] = {SCENARIO_KEYS(SK_ROW)};
+
+const scenario_key_t *scenario_keys(unsigned *count) {
+  *count = K_COUNT;
+  return rows;
+}
+
+void scenario_key_path(unsigned id, char *out, size_t n) {
+  char up[160] = "";
+  const scenario_key_t *k = &rows[id];
+  if (k->parent > K_ROOT) {
+    scenario_key_path((unsigned)k->parent, up, sizeof up);
+    if (rows[k->parent].type == SK_OBJECTS) {
+      strncat(up, "[]", sizeof up - strlen(up) - 1);
+    }
+  }
+  scn_join(out, n, up, k->key);
+}
+
+void scenario_key_range(const scenario_key_t *k, double *lo, double *hi) {
+  const drive_param_t *p = k->param != NULL ? drive_params_by_name(k->param) : NULL;
+  *lo = k->lo;
+  *hi = k->hi;
+  if (p != NULL && k->range == SK_RANGE_PARAM) {
+    *lo = (double)p->min;
+    *hi = (double)p->max;
+  } else if (p != NULL && k->range == SK_RANGE_PARAM_INV) {
+    *lo = 1.0 / (double)p->max;
+    *hi = 1.0 / (double)p->min;
+  } else if (p != NULL && k->range == SK_RANGE_PARAM_HI) {
+    *hi = (double)p->max;
+  }
+}
+
+/* The names of an SK_ENUM row, NULL-terminated, in names[max]. */
+static const char *const *enum_names(const scenario_key_t *k, const char **names, int max) {
+  if (k->names != NULL) {
+    return k->names;
+  }
+  int n = 0;
+  for (; n + 1 < max && k->name_of(n) != NULL; ++n) {
+    names[n] = k->name_of(n);
+  }
+  names[n] = NULL;
+  return names;
+}
+
+/* Stores a number (or an enumeration's index) where the row says. */
+static int store(ctx_t *c, scenario_t *sc, const scenario_key_t *k, const sk_val_t *v) {
+  if (k->set != NULL) {
+    return k->set(c, sc, v);
+  }
+  char *at = (k->at >= SK_AT_CTX_F64 ? (char *)c : (char *)sc) + k->offset + v->shift;
+  switch (k->at) {
+  case SK_AT_F64:
+  case SK_AT_CTX_F64:
+    *(double *)(void *)at = v->num;
+    break;
+  case SK_AT_F32:
+    *(float *)(void *)at = (float)v->num;
+    break;
+  case SK_AT_INT:
+  case SK_AT_CTX_INT:
+    *(int *)(void *)at = (int)v->num;
+    break;
+  case SK_AT_U32:
+    *(uint32_t *)(void *)at = (uint32_t)(int)v->num;
+    break;
+  case SK_AT_BOOL:
+    *(bool *)(void *)at = v->num != 0.0;
+    break;
+  default:
+    break;
+  }
+  return 0;
+}
+
+/* A row's number: its type (SK_NUM, SK_INT) and range checked. */
+static int read_num(ctx_t *c, const cJSON *obj, const char *path, unsigned id, double *out) {
+  const scenario_key_t *k = &rows[id];
+  double lo, hi;
+  scenario_key_range(k, &lo, &hi);
+  if (scn_get_num(c, obj, path, k->key, lo, hi, out) != 0) {
     return -1;
   }
-  drive_config_t *d = &sc->drive;
-  unsigned n;
-  const drive_param_t *t = drive_params_table(&n);
-  for (unsigned i = 0; i < n; ++i) {
-    if (strncmp(t[i].scenario, "controller.", 11) == 0 && get_param(c, o, &t[i], d) != 0) {
-      return -1;
-    }
+  if (k->type == SK_INT && floor(*out) != *out) {
+    char p[160];
+    scn_join(p, sizeof p, path, k->key);
+    return scn_fail(c, p, "must be an integer (got %g)", *out);
   }
+  return 0;
+}
 
-  /* Detuning: the controller's machine estimates as factors of the plant's. */
-  const cJSON *e = cJSON_GetObjectItemCaseSensitive(o, "estimates");
-  if (e != NULL) {
-    static const char *const ekeys[] = {"rs_scale", "ls_scale",       "ld_scale",
-                                        "lq_scale", "lambda_m_scale", NULL};
-    const char *E = "controller.estimates";
-    double rs = 1.0, ls = 1.0, ld = 1.0, lq = 1.0, lm = 1.0;
-    if (check_keys(c, e, E, ekeys) || get_num(c, e, E, "rs_scale", 0.1, 10.0, &rs) ||
-        get_num(c, e, E, "ls_scale", 0.1, 10.0, &ls) ||
-        get_num(c, e, E, "ld_scale", 0.1, 10.0, &ld) ||
-        get_num(c, e, E, "lq_scale", 0.1, 10.0, &lq) ||
-        get_num(c, e, E, "lambda_m_scale", 0.1, 10.0, &lm)) {
-      return -1;
+/* An array of 3 numbers (phases a, b, c) in the row's range. */
+static int read_array3(ctx_t *c, const cJSON *arr, const char *p, const scenario_key_t *k,
+                       double *dst) {
+  if (!cJSON_IsArray(arr) || cJSON_GetArraySize(arr) != 3) {
+    return scn_fail(c, p, "must be an array of 3 numbers (phases a, b, c)");
+  }
+  for (int i = 0; i < 3; ++i) {
+    const cJSON *v = cJSON_GetArrayItem(arr, i);
+    if (!cJSON_IsNumber(v) || !isfinite(v->valuedouble) || v->valuedouble < k->lo ||
+        v->valuedouble > k->hi) {
+      return scn_fail(c, p, "element %d must be a finite number", i);
     }
-    if (sc->plant.machine.map != NULL) {
-      /* a map machine's model is its map: these factors would act on
-       * nothing (scaling the controller's map comes with the decoupled DFVC) */
-      for (int k = 1; ekeys[k] != NULL; ++k) {
-        if (cJSON_GetObjectItemCaseSensitive(e, ekeys[k]) != NULL) {
-          char key[64];
-          snprintf(key, sizeof key, "%s.%s", E, ekeys[k]);
-          return fail(c, key, "a flux-map machine's model is its map (only rs_scale applies)");
-        }
+    dst[i] = v->valuedouble;
+  }
+  return 0;
+}
+
+/* Rejects the keys of obj that are not rows of object `id` (nor, for
+ * the controller, drive parameters "<path>.<name>"). */
+static int check_keys(ctx_t *c, const cJSON *obj, const char *path, unsigned id) {
+  if (!cJSON_IsObject(obj)) {
+    char list[300] = "";
+    for (unsigned k = 0; k < K_COUNT && !rows[id].params; ++k) {
+      if (rows[k].parent == (int)id) {
+        strncat(list, list[0] ? ", " : " (", sizeof list - strlen(list) - 1);
+        strncat(list, rows[k].key, sizeof list - strlen(list) - 1);
       }
     }
-    d->rs = (float)(sc->plant.machine.rs * rs);
-    d->ld = (float)(sc->plant.machine.ld * ld * ls);
-    d->lq = (float)(sc->plant.machine.lq * lq * ls);
-    d->lambda_m = (float)(sc->plant.machine.lambda_m * lm);
+    strncat(list, list[0] ? ")" : "", sizeof list - strlen(list) - 1);
+    return scn_fail(c, path[0] ? path : "(top level)", "must be an object%s", list);
+  }
+  for (const cJSON *it = obj->child; it != NULL; it = it->next) {
+    int ok = 0;
+    for (unsigned k = 0; k < K_COUNT && !ok; ++k) {
+      ok = rows[k].parent == (int)id && strcmp(rows[k].key, it->string) == 0;
+    }
+    if (!ok && rows[id].params) {
+      char p[160];
+      scn_join(p, sizeof p, path, it->string);
+      unsigned n;
+      const drive_param_t *t = drive_params_table(&n);
+      for (unsigned i = 0; i < n && !ok; ++i) {
+        ok = strcmp(t[i].scenario, p) == 0;
+      }
+    }
+    if (!ok) {
+      char p[160];
+      scn_join(p, sizeof p, path, it->string);
+      return scn_fail(c, p, "unknown field");
+    }
   }
   return 0;
 }
 
-static int parse_references(ctx_t *c, const cJSON *o, scenario_t *sc) {
-  static const char *const keys[] = {"enable_at", "disable_at", "torque", "speed",
-                                     "id",        "iq",         "flux",   NULL};
-  const char *P = "references";
-  if (check_keys(c, o, P, keys) || get_num(c, o, P, "enable_at", 0.0, 1e6, &sc->enable_at) ||
-      get_num(c, o, P, "disable_at", 0.0, 1e6, &sc->disable_at) ||
-      get_profile(c, o, P, "torque", &sc->ref.torque) ||
-      get_profile(c, o, P, "speed", &sc->ref.speed) || get_profile(c, o, P, "id", &sc->ref.id) ||
-      get_profile(c, o, P, "iq", &sc->ref.iq) || get_profile(c, o, P, "flux", &sc->ref.flux)) {
-    return -1;
-  }
-  return 0;
-}
+static int walk(ctx_t *c, scenario_t *sc, const cJSON *o, const char *path, unsigned id,
+                size_t shift, int index);
 
-/* A profile whose every value (its terms' bounds, profile_bounds) lies in
- * [lo, hi] ((lo, hi] with lo_open). */
-static int get_bounded_profile(ctx_t *c, const cJSON *o, const char *path, const char *key,
-                               double lo, int lo_open, double hi, profile_t *pr) {
-  if (get_profile(c, o, path, key, pr) != 0) {
-    return -1;
+/* One key of object `id`'s row k: read by its type, stored or set. */
+static int read_key(ctx_t *c, scenario_t *sc, const cJSON *o, const char *path, unsigned kid,
+                    size_t shift, int index) {
+  const scenario_key_t *k = &rows[kid];
+  const cJSON *it = cJSON_GetObjectItemCaseSensitive(o, k->key);
+  char p[160];
+  scn_join(p, sizeof p, path, k->key);
+  if (it == NULL) {
+    return k->req != NULL ? scn_fail(c, p, "required (%s)", k->req) : 0;
   }
-  if (cJSON_GetObjectItemCaseSensitive(o, key) == NULL) {
+  if (k->by_hook) {
     return 0;
   }
-  double l, h;
-  profile_bounds(pr, &l, &h);
-  if ((lo_open ? !(l > lo) : !(l >= lo)) || !(h <= hi)) {
-    char p[160];
-    join(p, sizeof p, path, key);
-    return fail(c, p, "must stay in %s%g, %g] at all times (its terms reach [%g, %g])",
-                lo_open ? "(" : "[", lo, hi, l, h);
-  }
-  return 0;
-}
-
-/* inject.current: an array of current-ADC channel faults. */
-static int parse_current_faults(ctx_t *c, const cJSON *arr, scenario_t *sc) {
-  static const char *const keys[] = {"channel", "kind", "active", "value", NULL};
-  static const char *const channels[] = {"a", "b", "c", NULL};
-  const char *kinds[SIL_ADC_KIND_COUNT + 1];
-  for (int k = 0; k <= (int)SIL_ADC_KIND_COUNT; ++k) {
-    kinds[k] = sil_adc_kind_name(k);
-  }
-  if (!cJSON_IsArray(arr)) {
-    return fail(c, "inject.current", "must be an array of channel faults");
-  }
-  sil_adc_faults_t *fs = &sc->current_faults;
-  const double fsc = sc->plant.sensors.i_full_scale;
-  int i = 0;
-  for (const cJSON *it = arr->child; it != NULL; it = it->next, ++i) {
-    char p[64];
-    snprintf(p, sizeof p, "inject.current[%d]", i);
-    if (i >= SIL_ADC_FAULTS_MAX) {
-      return fail(c, p, "too many channel faults (at most %d)", SIL_ADC_FAULTS_MAX);
-    }
-    sil_adc_fault_t *f = &fs->f[i];
-    *f = (sil_adc_fault_t){.channel = -1, .kind = SIL_ADC_KIND_COUNT};
-    int ch = -1, kind = -1;
-    if (check_keys(c, it, p, keys) || get_enum(c, it, p, "channel", channels, &ch) ||
-        get_enum(c, it, p, "kind", kinds, &kind) || get_profile(c, it, p, "active", &f->active)) {
+  sk_val_t v = {it, p, 0.0, index, shift, k};
+  char *base = (char *)sc + k->offset + shift;
+  switch (k->type) {
+  case SK_NUM:
+  case SK_INT:
+    return read_num(c, o, path, kid, &v.num) ? -1 : store(c, sc, k, &v);
+  case SK_ENUM: {
+    const char *buf[20];
+    int idx = -1;
+    if (scn_get_enum(c, o, path, k->key, enum_names(k, buf, 20), &idx) != 0) {
       return -1;
     }
-    char q[80];
-    if (ch < 0) {
-      join(q, sizeof q, p, "channel");
-      return fail(c, q, "required (a, b or c)");
+    v.num = idx;
+    return store(c, sc, k, &v);
+  }
+  case SK_PROFILE:
+    return scn_get_profile(c, o, path, k->key, (profile_t *)(void *)base);
+  case SK_BOUNDED:
+    return scn_get_bounded_profile(c, o, path, k->key, k->lo, k->lo_open, k->hi,
+                                   (profile_t *)(void *)base);
+  case SK_STRING:
+    if (!cJSON_IsString(it)) {
+      return scn_fail(c, p, "must be a string");
     }
-    if (kind < 0) {
-      join(q, sizeof q, p, "kind");
-      return fail(c, q, "required (stuck, frozen, nan, invalid, offset or gain)");
+    return k->set != NULL ? k->set(c, sc, &v) : 0;
+  case SK_ARRAY3:
+    return read_array3(c, it, p, k, (double *)(void *)base);
+  case SK_OBJECT:
+    return walk(c, sc, it, p, kid, shift, index);
+  case SK_OBJECTS: {
+    if (!cJSON_IsArray(it)) {
+      return scn_fail(c, p, "must be an array of %s", k->doc);
     }
-    f->channel = ch;
-    f->kind = (sil_adc_kind_t)kind;
-    const bool has = cJSON_GetObjectItemCaseSensitive(it, "value") != NULL;
-    join(q, sizeof q, p, "value");
-    if (sil_adc_kind_has_value(f->kind) != has) {
-      return fail(c, q, has ? "not taken by kind \"%s\"" : "required for kind \"%s\"",
-                  sil_adc_kind_name(kind));
-    }
-    if (has) {
-      const bool gain = f->kind == SIL_ADC_GAIN;
-      /* a stuck or drifting channel reads within its ADC's range; a gain
-       * from 0 (dead) to 10 times */
-      if (get_bounded_profile(c, it, p, "value", gain ? -1.0 : -fsc, 0, gain ? 9.0 : fsc,
-                              &f->value) != 0) {
+    int i = 0;
+    for (const cJSON *e = it->child; e != NULL; e = e->next, ++i) {
+      char ep[176];
+      if (snprintf(ep, sizeof ep, "%s[%d]", p, i) >= (int)sizeof ep) {
+        ep[sizeof ep - 1] = '\0';
+      }
+      /* the element's shift: at most k->max of them (its pre hook refuses more) */
+      const size_t s = shift + (size_t)(i < k->max ? i : 0) * k->stride;
+      if (walk(c, sc, e, ep, kid, s, i) != 0) {
         return -1;
       }
     }
-    fs->n = i + 1;
-  }
-  return 0;
-}
-
-/* inject.encoder: the encoder's faults (sil_enc_faults.h). */
-static int parse_encoder_faults(ctx_t *c, const cJSON *o, scenario_t *sc) {
-  static const char *const keys[] = {"frozen", "reversed", "jitter", "missing", "seed", NULL};
-  const char *E = "inject.encoder";
-  sil_enc_faults_t *f = &sc->encoder_faults;
-  int seed = 1;
-  if (check_keys(c, o, E, keys) || get_profile(c, o, E, "frozen", &f->frozen) ||
-      get_profile(c, o, E, "reversed", &f->reversed) ||
-      get_num(c, o, E, "jitter", 0.0, 1e-3, &f->jitter) ||
-      get_num(c, o, E, "missing", 0.0, 0.5, &f->missing) ||
-      get_int(c, o, E, "seed", 0, 2147483647, &seed)) {
-    return -1;
-  }
-  f->seed = (uint32_t)seed;
-  if (f->missing > 0.0 && sc->plant.sensors.encoder_cpr <= 0) {
-    return fail(c, "inject.encoder.missing",
-                "needs counts to lose: sensors.encoder_cpr > 0 (0 is an ideal encoder)");
-  }
-  return 0;
-}
-
-/* inject.can: CAN frame loss and delay per direction (socketcand). */
-static int parse_can_dir(ctx_t *c, const cJSON *o, const char *path, sil_can_dir_t *d) {
-  static const char *const keys[] = {"loss", "every", "delay", "jitter", NULL};
-  int every = 0;
-  if (!cJSON_IsObject(o)) {
-    return fail(c, path, "must be an object (loss, every, delay, jitter)");
-  }
-  if (check_keys(c, o, path, keys) ||
-      get_bounded_profile(c, o, path, "loss", 0.0, 0, 1.0, &d->loss) ||
-      get_int(c, o, path, "every", 0, 1000000, &every) ||
-      get_bounded_profile(c, o, path, "delay", 0.0, 0, SIL_CAN_DELAY_MAX, &d->delay) ||
-      get_bounded_profile(c, o, path, "jitter", 0.0, 0, SIL_CAN_DELAY_MAX, &d->jitter)) {
-    return -1;
-  }
-  if (every == 1) {
-    char p[160];
-    join(p, sizeof p, path, "every");
-    return fail(c, p, "must be 0 (none) or at least 2 (1 would lose every frame: use loss 1)");
-  }
-  d->every = (uint32_t)every;
-  return 0;
-}
-
-static int parse_can_faults(ctx_t *c, const cJSON *o, scenario_t *sc) {
-  static const char *const keys[] = {"seed", "rx", "tx", NULL};
-  const char *P = "inject.can";
-  sil_can_faults_t *f = &sc->can_faults;
-  int seed = 1;
-  if (!cJSON_IsObject(o)) {
-    return fail(c, P, "must be an object (seed, rx, tx)");
-  }
-  if (check_keys(c, o, P, keys) || get_int(c, o, P, "seed", 0, 0x7fffffff, &seed)) {
-    return -1;
-  }
-  const cJSON *rx = cJSON_GetObjectItemCaseSensitive(o, "rx");
-  const cJSON *tx = cJSON_GetObjectItemCaseSensitive(o, "tx");
-  if ((rx != NULL && parse_can_dir(c, rx, "inject.can.rx", &f->rx) != 0) ||
-      (tx != NULL && parse_can_dir(c, tx, "inject.can.tx", &f->tx) != 0)) {
-    return -1;
-  }
-  f->seed = (uint32_t)seed;
-  f->on = true;
-  return 0;
-}
-
-/* A power-stage fault: {"switch" | "phase" | "phases": name, "active":
- * profile}; it acts on the switch-level circuit (the switching inverter
- * model). kind: PF_PHASE, PF_SWITCH, PF_PAIR (target: the pair's index in
- * "ab", "bc", "ca"). */
-enum { PF_PHASE, PF_SWITCH, PF_PAIR };
-static int parse_power_fault(ctx_t *c, const cJSON *o, const char *key, int kind, int *target,
-                             profile_t *active) {
-  static const char *const switches[] = {"a_low", "a_high", "b_low", "b_high",
-                                         "c_low", "c_high", NULL};
-  static const char *const phases[] = {"a", "b", "c", NULL};
-  static const char *const pairs[] = {"ab", "bc", "ca", NULL};
-  static const char *const sels[] = {"phase", "switch", "phases"};
-  static const char *const names[] = {"a, b or c", "a_low, a_high, b_low, b_high, c_low or c_high",
-                                      "ab, bc or ca"};
-  const char *const *const choices[] = {phases, switches, pairs};
-  const cJSON *f = cJSON_GetObjectItemCaseSensitive(o, key);
-  if (f == NULL) {
     return 0;
   }
-  char p[160];
-  join(p, sizeof p, "inject", key);
-  const char *sel = sels[kind];
-  const char *const keys[] = {sel, "active", NULL};
-  if (check_keys(c, f, p, keys) != 0) {
-    return -1;
-  }
-  if (cJSON_GetObjectItemCaseSensitive(f, sel) == NULL) {
-    char q[160];
-    join(q, sizeof q, p, sel);
-    return fail(c, q, "required (%s)", names[kind]);
-  }
-  if (cJSON_GetObjectItemCaseSensitive(f, "active") == NULL) {
-    char q[160];
-    join(q, sizeof q, p, "active");
-    return fail(c, q, "required (a profile: the fault acts while it is > 0.5)");
-  }
-  if (get_enum(c, f, p, sel, choices[kind], target) || get_profile(c, f, p, "active", active)) {
-    return -1;
   }
   return 0;
 }
 
-#define FAULT_NAME(E, n, d) #n,
-static int parse_inject(ctx_t *c, const cJSON *o, scenario_t *sc) {
-  static const char *const keys[] = {
-      "encoder_error", "encoder_invalid", "main_stall",   "isr_stall",      "cm_scale_d",
-      "cm_scale_q",    "current",         "rs_scale",     "lambda_m_scale", "c_scale",
-      "passive_load",  "trip_at",         "trip_cause",   "encoder",        "can",
-      "isr_overrun",   "gate_driver",     "switch_open",  "switch_closed",  "phase_lost",
-      "phase_open",    "phase_short",     "ground_short", "star_shift",     NULL};
-  static const char *const faults[] = {DRIVE_FAULT_LIST(FAULT_NAME) NULL};
-  const char *P = "inject";
-  plant_faults_t *pf = &sc->plant.faults;
-  int cause = -1;
-  if (check_keys(c, o, P, keys) || get_num(c, o, P, "trip_at", 0.0, 1e6, &sc->trip_at) ||
-      get_enum(c, o, P, "trip_cause", faults, &cause)) {
+/* Object `id` at path: its keys checked, its nested defaults stored, its
+ * hooks around its keys read in the table's order. */
+static int walk(ctx_t *c, scenario_t *sc, const cJSON *o, const char *path, unsigned id,
+                size_t shift, int index) {
+  if (check_keys(c, o, path, id) != 0) {
     return -1;
   }
+  const scenario_key_t *obj = &rows[id];
+  const sk_val_t v = {o, path, 0.0, index, shift, obj};
+  /* the defaults of a nested object (the top level's: scenario_defaults) */
+  for (unsigned k = 0; k < K_COUNT && id != K_ROOT && obj->parent != K_ROOT; ++k) {
+    if (rows[k].parent == (int)id && rows[k].has_def) {
+      const sk_val_t d = {NULL, path, rows[k].def, index, shift, &rows[k]};
+      store(c, sc, &rows[k], &d);
+    }
+  }
+  if (obj->set != NULL && obj->set(c, sc, &v) != 0) {
+    return -1;
+  }
+  for (unsigned k = 0; k < K_COUNT; ++k) {
+    if (rows[k].parent == (int)id && read_key(c, sc, o, path, k, shift, index) != 0) {
+      return -1;
+    }
+  }
+  return obj->post != NULL ? obj->post(c, sc, &v) : 0;
+}
+
+/* ---- the hooks: rules between keys --------------------------------------- */
+
+static int root_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  (void)sc;
+  return scn_check_duplicates(c, v->it, "");
+}
+
+static int set_name(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  (void)c;
+  snprintf(sc->name, sizeof sc->name, "%s", ((const cJSON *)v->it)->valuestring);
+  scn_utf8_clean(sc->name);
+  return 0;
+}
+
+/* The scenario's pole pairs first (a map file may need them), then the
+ * preset and the map; what a flux-map machine cannot take. */
+static int machine_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  const cJSON *m = v->it;
+  double pp_given = 0.0;
+  if (read_num(c, m, "machine", K_M_POLE_PAIRS, &pp_given) != 0) {
+    return -1;
+  }
+  const cJSON *pre = cJSON_GetObjectItemCaseSensitive(m, "preset");
+  if (pre != NULL) {
+    const machine_preset_t *p = cJSON_IsString(pre) ? preset_find(pre->valuestring) : NULL;
+    if (p == NULL) {
+      return scn_fail(c, "machine.preset", "unknown preset (known: %s)", preset_names());
+    }
+    preset_apply(p, &sc->plant, &sc->drive);
+    if (p->map != NULL && use_map(c, "machine.preset", p->map, (int)pp_given, sc) != 0) {
+      return -1;
+    }
+  }
+  const cJSON *map = cJSON_GetObjectItemCaseSensitive(m, "map");
+  if (map != NULL) {
+    if (!cJSON_IsString(map) || map->valuestring[0] == '\0') {
+      return scn_fail(c, "machine.map", "must be a file name (.fdmap, .npz, .csv)");
+    }
+    if (use_map(c, "machine.map", map->valuestring, (int)pp_given, sc) != 0) {
+      return -1;
+    }
+  }
+  if (sc->plant.machine.map != NULL) {
+    static const char *const linear_only[] = {"ld",     "lq",    "ls", "lambda_m",
+                                              "ld_sat", "i_sat", NULL};
+    for (int k = 0; linear_only[k] != NULL; ++k) {
+      if (cJSON_GetObjectItemCaseSensitive(m, linear_only[k]) != NULL) {
+        char key[32];
+        snprintf(key, sizeof key, "machine.%s", linear_only[k]);
+        return scn_fail(c, key,
+                        "a flux-map machine takes its inductances and PM flux from the map");
+      }
+    }
+  }
+  /* the star point's inductance matrix (3.3), plant.h */
+  const char *star = star_key_given(m);
+  if (star != NULL && sc->plant.machine.map != NULL) {
+    return scn_fail(c, star, "the star-point model needs a linear machine (no map)");
+  }
+  c->ls = -1.0;
+  return 0;
+}
+
+/* ls for ld and lq; the magnet's saturation; the star point's aliases
+ * (star_phi_iq, star_p); the drive's machine from the plant's. */
+static int machine_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  const cJSON *m = v->it;
+  plant_machine_t *pm = &sc->plant.machine;
+  if (c->ls > 0.0) {
+    if (cJSON_GetObjectItemCaseSensitive(m, "ld") || cJSON_GetObjectItemCaseSensitive(m, "lq")) {
+      return scn_fail(c, "machine.ls", "give either ls (SPM) or ld and lq, not both");
+    }
+    pm->ld = pm->lq = c->ls;
+    c->ls_given = 1;
+  }
+  /* the magnet's d-axis saturation (plant.h, plant_magnetics.h) */
+  if (pm->ld_sat > 0.0 && !(pm->i_sat > 0.0)) {
+    return scn_fail(c, "machine.i_sat", "must be given (> 0 A) with machine.ld_sat > 0");
+  }
+  /* star_phi_iq: both terms' shift (a turned saliency axis: phi_a = phi_iq,
+   * phi_b = 2 phi_iq of (3.97)), an alias of the pair */
+  if (cJSON_GetObjectItemCaseSensitive(m, "star_phi_iq") != NULL) {
+    if (cJSON_GetObjectItemCaseSensitive(m, "star_phi_self") ||
+        cJSON_GetObjectItemCaseSensitive(m, "star_phi_mutual")) {
+      return scn_fail(c, "machine.star_phi_iq",
+                      "sets star_phi_self and star_phi_mutual both: give either it or them");
+    }
+    pm->aniso.phi_self = c->star_phi_iq;
+    pm->aniso.phi_mut = pm->aniso.phi_self;
+  }
+  /* star_p: the anisotropy p of (3.7) with L0, M0, L2 kept (Fig. 3.3):
+   * gamma0 = L0 - M0, gamma2 = p gamma0 = L2/2 + M2, ld, lq = gamma0 +- gamma2 */
+  if (cJSON_GetObjectItemCaseSensitive(m, "star_p") != NULL) {
+    const double p = c->star_p;
+    if (cJSON_GetObjectItemCaseSensitive(m, "ld") || cJSON_GetObjectItemCaseSensitive(m, "lq") ||
+        cJSON_GetObjectItemCaseSensitive(m, "star_m2")) {
+      return scn_fail(c, "machine.star_p", "sets ld, lq and star_m2: give none of them with it");
+    }
+    const double l0 = 0.5 * (pm->ld + pm->lq) + pm->aniso.m0;
+    const double l2 = (pm->ld - pm->lq) - 2.0 * pm->aniso.m2;
+    const double g0 = l0 - pm->aniso.m0, g2 = p * g0;
+    pm->ld = g0 + g2;
+    pm->lq = g0 - g2;
+    pm->aniso.m2 = g2 - 0.5 * l2;
+  }
+  if (star_key_given(m) != NULL) {
+    pm->aniso.enabled = 1; /* checked with the whole scenario known (check_star) */
+  }
+  if (pm->aniso.enabled) { /* the controller's DFC model (3.7), unless set */
+    double a, b;
+    plant_aniso_ab(pm, &a, &b);
+    sc->drive.dfc_a = (float)a;
+    sc->drive.dfc_b = (float)b;
+  }
+  sc->drive.pole_pairs = (float)pm->pole_pairs;
+  sc->drive.rs = (float)pm->rs;
+  sc->drive.ld = (float)pm->ld;
+  sc->drive.lq = (float)pm->lq;
+  sc->drive.lambda_m = (float)pm->lambda_m;
+  return 0;
+}
+
+static int set_pwm_frequency(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  (void)c;
+  sc->plant.ts = 1.0 / v->num;
+  return 0;
+}
+
+static int inverter_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  (void)c;
+  (void)v;
+  sc->drive.ts = (float)sc->plant.ts;
+  sc->drive.dead_time = (float)sc->plant.inverter.dead_time;
+  return 0;
+}
+
+static int mechanics_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  plant_mech_t *m = &sc->plant.mech;
+  if (m->mode == PLANT_MECH_IMPOSED && !cJSON_GetObjectItemCaseSensitive(v->it, "speed")) {
+    return scn_fail(c, "mechanics.speed", "required when mode is \"imposed\"");
+  }
+  sc->drive.inertia = (float)m->j;
+  sc->drive.friction = (float)m->b;
+  return 0;
+}
+
+static int sensors_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  (void)c;
+  (void)v;
+  sc->drive.enc_cpr = (uint32_t)sc->plant.sensors.encoder_cpr;
+  return 0;
+}
+
+/* The drive's parameters "controller.<name>" (drive_param_table.h). */
+static int controller_params(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  unsigned n;
+  const drive_param_t *t = drive_params_table(&n);
+  for (unsigned i = 0; i < n; ++i) {
+    if (strncmp(t[i].scenario, "controller.", 11) == 0 &&
+        get_param(c, v->it, &t[i], &sc->drive) != 0) {
+      return -1;
+    }
+  }
+  return 0;
+}
+
+/* Detuning: the controller's machine estimates as factors of the plant's. */
+static int estimates_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  drive_config_t *d = &sc->drive;
+  if (sc->plant.machine.map != NULL) {
+    /* a map machine's model is its map: these factors would act on
+     * nothing (scaling the controller's map comes with the decoupled DFVC) */
+    for (unsigned k = K_C_E_LS; k <= K_C_E_LAMBDA_M; ++k) {
+      if (cJSON_GetObjectItemCaseSensitive(v->it, rows[k].key) != NULL) {
+        char key[64];
+        scn_join(key, sizeof key, v->path, rows[k].key);
+        return scn_fail(c, key, "a flux-map machine's model is its map (only rs_scale applies)");
+      }
+    }
+  }
+  d->rs = (float)(sc->plant.machine.rs * c->est[0]);
+  d->ld = (float)(sc->plant.machine.ld * c->est[2] * c->est[1]);
+  d->lq = (float)(sc->plant.machine.lq * c->est[3] * c->est[1]);
+  d->lambda_m = (float)(sc->plant.machine.lambda_m * c->est[4]);
+  return 0;
+}
+
+/* trip_at with trip_cause; the power-stage faults' rules; what each
+ * plant fault needs of the machine and the link. */
+static int inject_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  const cJSON *o = v->it;
+  const plant_faults_t *pf = &sc->plant.faults;
+  const int cause = c->cause;
   if ((cause >= 0) != (sc->trip_at > 0.0)) {
-    return fail(c, cause >= 0 ? "inject.trip_at" : "inject.trip_cause",
-                "trip_at (> 0) and trip_cause go together");
+    return scn_fail(c, cause >= 0 ? "inject.trip_at" : "inject.trip_cause",
+                    "trip_at (> 0) and trip_cause go together");
   }
   sc->trip_cause = cause >= 0 ? 1u << (unsigned)cause : 0u;
-  if (get_profile(c, o, P, "encoder_error", &sc->encoder_error) ||
-      get_profile(c, o, P, "encoder_invalid", &sc->encoder_invalid) ||
-      get_profile(c, o, P, "main_stall", &sc->main_stall) ||
-      get_profile(c, o, P, "isr_stall", &sc->isr_stall) ||
-      get_profile(c, o, P, "isr_overrun", &sc->isr_overrun) ||
-      get_profile(c, o, P, "cm_scale_d", &sc->cm_scale_d) ||
-      get_profile(c, o, P, "cm_scale_q", &sc->cm_scale_q) ||
-      get_bounded_profile(c, o, P, "rs_scale", 0.0, 1, PLANT_RS_SCALE_MAX, &pf->rs_scale) ||
-      get_bounded_profile(c, o, P, "lambda_m_scale", 0.0, 0, PLANT_LAMBDA_M_SCALE_MAX,
-                          &pf->lambda_m_scale) ||
-      get_bounded_profile(c, o, P, "c_scale", 0.0, 1, PLANT_C_SCALE_MAX, &pf->c_scale) ||
-      get_bounded_profile(c, o, P, "star_shift", -PLANT_STAR_SHIFT_MAX, 0, PLANT_STAR_SHIFT_MAX,
-                          &pf->star_shift) ||
-      get_profile(c, o, P, "gate_driver", &sc->gate_driver) ||
-      parse_power_fault(c, o, "switch_open", PF_SWITCH, &sc->switch_open.target,
-                        &sc->switch_open.active) ||
-      parse_power_fault(c, o, "switch_closed", PF_SWITCH, &sc->switch_closed.target,
-                        &sc->switch_closed.active) ||
-      parse_power_fault(c, o, "phase_lost", PF_PHASE, &sc->phase_lost.target,
-                        &sc->phase_lost.active) ||
-      parse_power_fault(c, o, "phase_open", PF_PHASE, &sc->phase_open.target,
-                        &sc->phase_open.active) ||
-      parse_power_fault(c, o, "phase_short", PF_PAIR, &sc->phase_short.target,
-                        &sc->phase_short.active) ||
-      parse_power_fault(c, o, "ground_short", PF_PHASE, &sc->ground_short.target,
-                        &sc->ground_short.active)) {
-    return -1;
-  }
   if (cJSON_GetObjectItemCaseSensitive(o, "phase_short") != NULL &&
       cJSON_GetObjectItemCaseSensitive(o, "phase_open") != NULL &&
       (sc->phase_open.target == sc->phase_short.target ||
        sc->phase_open.target == (sc->phase_short.target + 1) % 3)) {
-    return fail(c, "inject.phase_short",
-                "shares a lead with inject.phase_open (an open lead cannot be shorted)");
+    return scn_fail(c, "inject.phase_short",
+                    "shares a lead with inject.phase_open (an open lead cannot be shorted)");
   }
-  static const char *const power[] = {"switch_open", "switch_closed", "phase_lost",
-                                      "phase_open",  "phase_short",   "ground_short"};
+  static const unsigned power[] = {K_I_SWITCH_OPEN, K_I_SWITCH_CLOSED, K_I_PHASE_LOST,
+                                   K_I_PHASE_OPEN,  K_I_PHASE_SHORT,   K_I_GROUND_SHORT};
   for (size_t k = 0; k < sizeof power / sizeof power[0]; ++k) {
-    if (cJSON_GetObjectItemCaseSensitive(o, power[k]) == NULL) {
+    if (cJSON_GetObjectItemCaseSensitive(o, rows[power[k]].key) == NULL) {
       continue;
     }
     sc->power_faults = 1;
     if (sc->plant.inverter.model != PLANT_INV_SWITCHING) {
       char p[160];
-      join(p, sizeof p, P, power[k]);
-      return fail(c, p, "needs inverter.model: switching (a fault of the switch-level circuit)");
-    }
-  }
-  const cJSON *cur = cJSON_GetObjectItemCaseSensitive(o, "current");
-  if (cur != NULL && parse_current_faults(c, cur, sc) != 0) {
-    return -1;
-  }
-  const cJSON *enc = cJSON_GetObjectItemCaseSensitive(o, "encoder");
-  if (enc != NULL && parse_encoder_faults(c, enc, sc) != 0) {
-    return -1;
-  }
-  const cJSON *cf = cJSON_GetObjectItemCaseSensitive(o, "can");
-  if (cf != NULL && parse_can_faults(c, cf, sc) != 0) {
-    return -1;
-  }
-  const cJSON *pl = cJSON_GetObjectItemCaseSensitive(o, "passive_load");
-  if (pl != NULL) {
-    static const char *const lkeys[] = {"coulomb", "viscous", NULL};
-    const char *L = "inject.passive_load";
-    if (check_keys(c, pl, L, lkeys) ||
-        get_bounded_profile(c, pl, L, "coulomb", 0.0, 0, 1e6, &pf->coulomb) ||
-        get_bounded_profile(c, pl, L, "viscous", 0.0, 0, 1e6, &pf->viscous)) {
-      return -1;
-    }
-    if (sc->plant.mech.mode != PLANT_MECH_FREE) {
-      return fail(c, L, "needs mechanics.mode \"free\" (a dynamometer imposes the speed)");
+      scn_join(p, sizeof p, v->path, rows[power[k]].key);
+      return scn_fail(c, p,
+                      "needs inverter.model: switching (a fault of the switch-level circuit)");
     }
   }
   if (pf->lambda_m_scale.n > 0 && sc->plant.machine.map != NULL) {
-    return fail(c, "inject.lambda_m_scale",
-                "a flux-map machine's PM flux is inside its map (saturated with the currents): "
-                "give the demagnetised machine as its own map (machine.map)");
+    return scn_fail(c, "inject.lambda_m_scale",
+                    "a flux-map machine's PM flux is inside its map (saturated with the currents): "
+                    "give the demagnetised machine as its own map (machine.map)");
   }
   if (pf->star_shift.n > 0 && !sc->plant.machine.aniso.enabled) {
-    return fail(c, "inject.star_shift",
-                "needs a star-point machine (machine.star_m0, star_m2 or a star-point preset)");
+    return scn_fail(c, "inject.star_shift",
+                    "needs a star-point machine (machine.star_m0, star_m2 or a star-point preset)");
   }
   if (pf->c_scale.n > 0 && sc->plant.dclink.kind == PLANT_DC_IDEAL) {
-    return fail(c, "inject.c_scale",
-                "needs dc_link.kind \"rc\" or \"rectifier\" (an ideal link has no capacitor)");
+    return scn_fail(c, "inject.c_scale",
+                    "needs dc_link.kind \"rc\" or \"rectifier\" (an ideal link has no capacitor)");
   }
   return 0;
 }
 
-/* The board the SIL HAL models: a preset (its board header's numbers) and
- * overrides. Parsed after the inverter (period and dead time). */
-#define DEFAULT_BOARD "g474_nucleo"
-static int parse_board(ctx_t *c, const cJSON *o, scenario_t *sc) {
-  static const char *const keys[] = {"preset",      "duty_min",   "duty_max", "timer_counts",
-                                     "watchdog_ms", "asym_edges", NULL};
-  const char *P = "board";
-  if (check_keys(c, o, P, keys) != 0) {
-    return -1;
+/* inject.current[i]: at most SIL_ADC_FAULTS_MAX, each from a clean slate. */
+static int current_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  if (v->index >= SIL_ADC_FAULTS_MAX) {
+    return scn_fail(c, v->path, "too many channel faults (at most %d)", SIL_ADC_FAULTS_MAX);
   }
-  const cJSON *pre = cJSON_GetObjectItemCaseSensitive(o, "preset");
+  sc->current_faults.f[v->index] = (sil_adc_fault_t){.channel = -1, .kind = SIL_ADC_KIND_COUNT};
+  return 0;
+}
+
+/* Its value, by its kind: a stuck or drifting channel reads within its
+ * ADC's range; a gain from 0 (dead) to 10 times. */
+static int current_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  sil_adc_fault_t *f = &sc->current_faults.f[v->index];
+  const bool has = cJSON_GetObjectItemCaseSensitive(v->it, "value") != NULL;
+  char q[190];
+  scn_join(q, sizeof q, v->path, "value");
+  if (sil_adc_kind_has_value(f->kind) != has) {
+    return scn_fail(c, q, has ? "not taken by kind \"%s\"" : "required for kind \"%s\"",
+                    sil_adc_kind_name((int)f->kind));
+  }
+  if (has) {
+    const bool gain = f->kind == SIL_ADC_GAIN;
+    const double fsc = sc->plant.sensors.i_full_scale;
+    if (scn_get_bounded_profile(c, v->it, v->path, "value", gain ? -1.0 : -fsc, 0, gain ? 9.0 : fsc,
+                                &f->value) != 0) {
+      return -1;
+    }
+  }
+  sc->current_faults.n = v->index + 1;
+  return 0;
+}
+
+static int encoder_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  (void)v;
+  if (sc->encoder_faults.missing > 0.0 && sc->plant.sensors.encoder_cpr <= 0) {
+    return scn_fail(c, "inject.encoder.missing",
+                    "needs counts to lose: sensors.encoder_cpr > 0 (0 is an ideal encoder)");
+  }
+  return 0;
+}
+
+static int can_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  (void)c;
+  (void)v;
+  sc->can_faults.on = true;
+  return 0;
+}
+
+static int can_dir_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  const sil_can_dir_t *d = (const sil_can_dir_t *)(const void *)((char *)sc + v->row->offset);
+  if (d->every == 1u) {
+    char p[160];
+    scn_join(p, sizeof p, v->path, "every");
+    return scn_fail(c, p, "must be 0 (none) or at least 2 (1 would lose every frame: use loss 1)");
+  }
+  return 0;
+}
+
+static int passive_load_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  if (sc->plant.mech.mode != PLANT_MECH_FREE) {
+    return scn_fail(c, v->path, "needs mechanics.mode \"free\" (a dynamometer imposes the speed)");
+  }
+  return 0;
+}
+
+/* The board the SIL HAL models: a preset (its board header's numbers),
+ * which the keys then override. Read after the inverter (period and dead
+ * time). */
+static int board_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  const cJSON *pre = cJSON_GetObjectItemCaseSensitive(v->it, "preset");
   const sil_board_preset_t *bp =
       pre == NULL ? sil_board_find(DEFAULT_BOARD)
                   : (cJSON_IsString(pre) ? sil_board_find(pre->valuestring) : NULL);
   if (bp == NULL) {
-    return fail(c, "board.preset", "unknown board (known: %s)", sil_board_names());
+    return scn_fail(c, "board.preset", "unknown board (known: %s)", sil_board_names());
   }
-  hal_sil_board_t *b = &sc->board;
-  sil_board_apply(bp, sc->plant.ts, sc->plant.inverter.dead_time, b);
-  double dmin = b->duty_min, dmax = b->duty_max, counts = b->timer_counts, wd = b->watchdog_ms;
-  int asym = b->asym_edges ? 1 : 0;
-  if (get_num(c, o, P, "duty_min", 0.0, 0.5, &dmin) ||
-      get_num(c, o, P, "duty_max", 0.5, 1.0, &dmax) ||
-      get_num(c, o, P, "timer_counts", 0.0, 1e6, &counts) ||
-      get_num(c, o, P, "watchdog_ms", 0.0, 60000.0, &wd) ||
-      get_int(c, o, P, "asym_edges", 0, 1, &asym)) {
-    return -1;
-  }
-  if (floor(counts) != counts || floor(wd) != wd) {
-    return fail(c, floor(counts) != counts ? "board.timer_counts" : "board.watchdog_ms",
-                "must be an integer");
-  }
-  b->duty_min = (float)dmin;
-  b->duty_max = (float)dmax;
-  b->timer_counts = (uint32_t)counts;
-  b->watchdog_ms = (uint32_t)wd;
-  b->asym_edges = asym != 0;
+  sil_board_apply(bp, sc->plant.ts, sc->plant.inverter.dead_time, &sc->board);
   return 0;
 }
 
-static int parse_log(ctx_t *c, const cJSON *o, scenario_t *sc) {
-  static const char *const keys[] = {"decimation", NULL};
-  if (check_keys(c, o, "log", keys) != 0) {
-    return -1;
-  }
-  return get_int(c, o, "log", "decimation", 1, 1000000, &sc->log_decimation);
-}
-
-static void scenario_defaults(scenario_t *sc) {
+/* The defaults: the preset rubino2020_spm's, then the table's for the
+ * top-level sections' keys. */
+static void scenario_defaults(ctx_t *c, scenario_t *sc) {
   memset(sc, 0, sizeof *sc);
   snprintf(sc->name, sizeof sc->name, "unnamed");
   drive_config_default(&sc->drive);
   preset_apply(preset_find("rubino2020_spm"), &sc->plant, &sc->drive);
-  sc->plant.ts = 1.0 / 16000.0;
-  /* substeps 0: chosen from the machine after parsing (resolve_substeps) */
-  sc->plant.inverter = (plant_inverter_t){PLANT_INV_AVERAGE, 1e-6, 0};
-  sc->plant.dclink.kind = PLANT_DC_IDEAL;
-  sc->plant.dclink.r = 0.1;
-  sc->plant.dclink.c = 470e-6;
-  sc->plant.mech.mode = PLANT_MECH_FREE;
-  sc->plant.sensors.adc_bits = 12;
-  sc->plant.sensors.i_noise = 0.0;
-  sc->plant.sensors.v_noise = 0.0;
-  sc->plant.sensors.encoder_cpr = 4096;
-  sc->plant.sensors.seed = 1;
+  for (unsigned k = 0; k < K_COUNT; ++k) {
+    if (rows[k].has_def && rows[k].parent > K_ROOT && rows[rows[k].parent].parent == K_ROOT) {
+      const sk_val_t d = {NULL, "", rows[k].def, 0, 0, &rows[k]};
+      store(c, sc, &rows[k], &d);
+    }
+  }
   sc->drive.ts = (float)sc->plant.ts;
-  sc->log_decimation = 16;
 }
 
 /* The scenario key of a plant parameter plant_check names (its fields are
- * the plant's struct members; errors name what the user wrote). */
+ * the plant's struct members; errors name what the user wrote): the row's
+ * plant_field, else the same name (machine.*, inverter.*, sensors.*). */
 static const char *scenario_key_of(const char *plant_field) {
-  static const char *const map[][2] = {{"ts", "inverter.pwm_frequency"},
-                                       {"dclink.kind", "dc_link.kind"},
-                                       {"dclink.v_source", "dc_link.voltage"},
-                                       {"dclink.r", "dc_link.r"},
-                                       {"dclink.c", "dc_link.c"},
-                                       {"dclink.r_chop", "dc_link.chopper_r"},
-                                       {"dclink.v_chop_on", "dc_link.chopper_on"},
-                                       {"mech.b", "mechanics.b"},
-                                       {"mech.j", "mechanics.j"},
-                                       {"mech.mode", "mechanics.mode"},
-                                       {"mech.omega0", "mechanics.speed0"},
-                                       {"mech.theta0", "mechanics.theta0"},
-                                       {"faults.rs_scale", "inject.rs_scale"},
-                                       {"faults.lambda_m_scale", "inject.lambda_m_scale"},
-                                       {"faults.c_scale", "inject.c_scale"},
-                                       {"faults.star_shift", "inject.star_shift"},
-                                       {"faults.coulomb", "inject.passive_load.coulomb"},
-                                       {"faults.viscous", "inject.passive_load.viscous"}};
-  for (size_t i = 0; i < sizeof map / sizeof map[0]; ++i) {
-    if (strcmp(plant_field, map[i][0]) == 0) {
-      return map[i][1];
+  static char out[160];
+  for (unsigned k = 0; k < K_COUNT; ++k) {
+    if (rows[k].plant_field != NULL && strcmp(rows[k].plant_field, plant_field) == 0) {
+      scenario_key_path(k, out, sizeof out);
+      return out;
     }
   }
-  return plant_field; /* machine.*, inverter.*, sensors.*: the same names */
+  return plant_field;
 }
 
 /* The plant's integration steps per period: the fewest that keep it stable
@@ -1149,11 +751,12 @@ static int resolve_substeps(ctx_t *c, scenario_t *sc) {
                           : (p->machine.ld < p->machine.lq ? p->machine.ld : p->machine.lq);
   if (p->inverter.substeps == 0) {
     if (need > PLANT_SUBSTEPS_MAX && plant_substeps_link(p) >= need) {
-      return fail(c, p->faults.c_scale.n > 0 ? "inject.c_scale" : "dc_link.c",
-                  "the plant cannot integrate this DC link at this PWM period: its time constant "
-                  "R C (at the smallest capacitance) needs %d integration steps per period, at "
-                  "most %d",
-                  need, PLANT_SUBSTEPS_MAX);
+      return scn_fail(
+          c, p->faults.c_scale.n > 0 ? "inject.c_scale" : "dc_link.c",
+          "the plant cannot integrate this DC link at this PWM period: its time constant "
+          "R C (at the smallest capacitance) needs %d integration steps per period, at "
+          "most %d",
+          need, PLANT_SUBSTEPS_MAX);
     }
     if (need > PLANT_SUBSTEPS_MAX && plant_substeps_mech(p) >= need) {
       /* the inertia the mechanical share allows with PLANT_SUBSTEPS_MAX
@@ -1164,30 +767,32 @@ static int resolve_substeps(ctx_t *c, scenario_t *sc) {
         j_min *= 1.1;
         q.mech.j = j_min;
       }
-      return fail(c, "mechanics.j",
-                  "the plant cannot integrate this inertia at this PWM period: the rotor against "
-                  "the PM flux (and the friction) needs %d integration steps per period, at most "
-                  "%d: at least %.3g kg m^2 (got %.3g)",
-                  need, PLANT_SUBSTEPS_MAX, j_min, p->mech.j);
+      return scn_fail(
+          c, "mechanics.j",
+          "the plant cannot integrate this inertia at this PWM period: the rotor against "
+          "the PM flux (and the friction) needs %d integration steps per period, at most "
+          "%d: at least %.3g kg m^2 (got %.3g)",
+          need, PLANT_SUBSTEPS_MAX, j_min, p->mech.j);
     }
     if (need > PLANT_SUBSTEPS_MAX) {
       const char *key = p->machine.map != NULL           ? "machine.map"
                         : c->ls_given                    ? "machine.ls"
                         : p->machine.ld <= p->machine.lq ? "machine.ld"
                                                          : "machine.lq";
-      return fail(c, key,
-                  "the plant cannot integrate this machine at this PWM period: its electrical "
-                  "time constant L/R_s (%.3g s with L = %.3g H) needs %d integration steps per "
-                  "period, at most %d",
-                  lmin / p->machine.rs, lmin, need, PLANT_SUBSTEPS_MAX);
+      return scn_fail(c, key,
+                      "the plant cannot integrate this machine at this PWM period: its electrical "
+                      "time constant L/R_s (%.3g s with L = %.3g H) needs %d integration steps per "
+                      "period, at most %d",
+                      lmin / p->machine.rs, lmin, need, PLANT_SUBSTEPS_MAX);
     }
     p->inverter.substeps = need;
   } else if (p->inverter.substeps < need) {
-    return fail(c, "inverter.substeps",
-                "%d steps per period are unstable for this machine (h R_s / L_min = %.2f > %g): "
-                "at least %d, or leave it out (chosen automatically)",
-                p->inverter.substeps, p->ts / p->inverter.substeps * p->machine.rs / lmin,
-                PLANT_HR_MAX, need);
+    return scn_fail(
+        c, "inverter.substeps",
+        "%d steps per period are unstable for this machine (h R_s / L_min = %.2f > %g): "
+        "at least %d, or leave it out (chosen automatically)",
+        p->inverter.substeps, p->ts / p->inverter.substeps * p->machine.rs / lmin, PLANT_HR_MAX,
+        need);
   }
   return 0;
 }
@@ -1265,31 +870,33 @@ static int check_star(ctx_t *c, const cJSON *root, scenario_t *sc) {
    * 3.3's machine: 1.15) */
   if (!(lz > 0.0 && lz <= 2.0 * g0)) {
     static const char *const k0[] = {"star_m0", NULL};
-    return fail(c, machine_key(m, k0),
-                "%g H gives the zero-sequence inductance L0 + 2 M0 = (ld + lq)/2 + 3 M0 = %.4g H, "
-                "%.3g times (ld + lq)/2 (%.4g H): a star winding's is leakage and harmonics only, "
-                "in (0, 2] times (M0 in (%.4g, %.4g] H; a unit error?)",
-                m0, lz, lz / g0, g0, -g0 / 3.0, g0 / 3.0);
+    return scn_fail(
+        c, machine_key(m, k0),
+        "%g H gives the zero-sequence inductance L0 + 2 M0 = (ld + lq)/2 + 3 M0 = %.4g H, "
+        "%.3g times (ld + lq)/2 (%.4g H): a star winding's is leakage and harmonics only, "
+        "in (0, 2] times (M0 in (%.4g, %.4g] H; a unit error?)",
+        m0, lz, lz / g0, g0, -g0 / 3.0, g0 / 3.0);
   }
   plant_machine_t q = *pm;
   q.aniso.amp_iq = 0.0;
   if (!(fabs(l2 - m2) > 1e-9 * l0)) {
     static const char *const k2[] = {"star_p", "star_m2", "ld", "lq", NULL};
-    return fail(c, machine_key(m, k2),
-                "the (3.3) matrix carries no position: L2 = M2 (%.4g H) makes a = b = 0 in (3.7)",
-                m2);
+    return scn_fail(
+        c, machine_key(m, k2),
+        "the (3.3) matrix carries no position: L2 = M2 (%.4g H) makes a = b = 0 in (3.7)", m2);
   }
   if (!plant_aniso_ok(&q)) {
     double lo, hi;
     if (star_p && star_p_range(pm, l2, &lo, &hi)) {
-      return fail(c, "machine.star_p",
-                  "%.3g: with L0 %.4g, M0 %.4g, L2 %.4g H kept (Fig. 3.3's split) the (3.3) matrix "
-                  "is not positive definite at every angle (no inductance matrix): star_p in "
-                  "(%.3f, %.3f) with these",
-                  (pm->ld - pm->lq) / (pm->ld + pm->lq), l0, m0, l2, lo, hi);
+      return scn_fail(
+          c, "machine.star_p",
+          "%.3g: with L0 %.4g, M0 %.4g, L2 %.4g H kept (Fig. 3.3's split) the (3.3) matrix "
+          "is not positive definite at every angle (no inductance matrix): star_p in "
+          "(%.3f, %.3f) with these",
+          (pm->ld - pm->lq) / (pm->ld + pm->lq), l0, m0, l2, lo, hi);
     }
     static const char *const km[] = {"star_p", "star_m2", "star_m0", "ld", "lq", "ls", NULL};
-    return fail(
+    return scn_fail(
         c, machine_key(m, km),
         "the (3.3) matrix of ld %.4g, lq %.4g, star_m0 %.4g, star_m2 %.4g H is not positive "
         "definite at every angle (no inductance matrix)",
@@ -1314,11 +921,12 @@ static int check_star(ctx_t *c, const cJSON *root, scenario_t *sc) {
         bad = i_q;
       }
     }
-    return fail(c, "machine.star_amp_iq",
-                "%g 1/A scales L2 and M2 by 1 + %g |i_q|: the (3.3) matrix stops being positive "
-                "definite at |i_q| = %.3g A, below controller.i_trip (%g A), the current the plant "
-                "may carry before the drive trips: lower star_amp_iq or i_trip",
-                amp, amp, ok, i_lim);
+    return scn_fail(
+        c, "machine.star_amp_iq",
+        "%g 1/A scales L2 and M2 by 1 + %g |i_q|: the (3.3) matrix stops being positive "
+        "definite at |i_q| = %.3g A, below controller.i_trip (%g A), the current the plant "
+        "may carry before the drive trips: lower star_amp_iq or i_trip",
+        amp, amp, ok, i_lim);
   }
   /* the self and mutual terms turned apart by the load: an inductance
    * matrix at every load up to i_trip */
@@ -1327,12 +935,12 @@ static int check_star(ctx_t *c, const cJSON *root, scenario_t *sc) {
       const double i_q = i_lim * k / STAR_LOAD_STEPS;
       if (!plant_aniso_ok_at(pm, i_q)) {
         static const char *const ks[] = {"star_phi_self", "star_phi_mutual", NULL};
-        return fail(c, machine_key(m, ks),
-                    "star_phi_self %g, star_phi_mutual %g rad/A turn the self and mutual terms "
-                    "apart by %.3g rad at |i_q| = %.3g A, within controller.i_trip (%g A): the "
-                    "(3.3) matrix is not positive definite there (no inductance matrix)",
-                    pm->aniso.phi_self, pm->aniso.phi_mut,
-                    (pm->aniso.phi_self - pm->aniso.phi_mut) * i_q, i_q, i_lim);
+        return scn_fail(c, machine_key(m, ks),
+                        "star_phi_self %g, star_phi_mutual %g rad/A turn the self and mutual terms "
+                        "apart by %.3g rad at |i_q| = %.3g A, within controller.i_trip (%g A): the "
+                        "(3.3) matrix is not positive definite there (no inductance matrix)",
+                        pm->aniso.phi_self, pm->aniso.phi_mut,
+                        (pm->aniso.phi_self - pm->aniso.phi_mut) * i_q, i_q, i_lim);
       }
     }
   }
@@ -1364,13 +972,13 @@ static int check_star(ctx_t *c, const cJSON *root, scenario_t *sc) {
     if (fabs(p0) < 0.5 && !(fabs(p_max) < 0.5)) {
       static const char *const kl[] = {"star_amp_iq", "star_phi_self", "star_phi_mutual",
                                        "star_phi_iq", NULL};
-      return fail(c, machine_key(m, kl),
-                  "the star point's p = b/a reaches %.3g (3.7) at |i_q| = %.3g A (load scale "
-                  "%.3g, phase shifts phi_a %.3g, phi_b %.3g rad of (3.97)), |p| >= 1/2 from "
-                  "%.3g A, within controller.i_trip (%g A): the IVD needs |p| < 1/2 at every "
-                  "load (Theorem 1: no convergence otherwise; the drive's dfc_b holds the "
-                  "unloaded p %.3g): lower the load's scale or i_trip",
-                  p_max, i_at, k_at, pa_at, pb_at, i_half, i_lim, p0);
+      return scn_fail(c, machine_key(m, kl),
+                      "the star point's p = b/a reaches %.3g (3.7) at |i_q| = %.3g A (load scale "
+                      "%.3g, phase shifts phi_a %.3g, phi_b %.3g rad of (3.97)), |p| >= 1/2 from "
+                      "%.3g A, within controller.i_trip (%g A): the IVD needs |p| < 1/2 at every "
+                      "load (Theorem 1: no convergence otherwise; the drive's dfc_b holds the "
+                      "unloaded p %.3g): lower the load's scale or i_trip",
+                      p_max, i_at, k_at, pa_at, pb_at, i_half, i_lim, p0);
     }
   }
   /* the drive's a against the matrix's: a's sign is L2 - M2's (3.7); the
@@ -1380,10 +988,11 @@ static int check_star(ctx_t *c, const cJSON *root, scenario_t *sc) {
   plant_aniso_ab(pm, &a, &b);
   const double da = (double)sc->drive.dfc_a;
   if (ctl != NULL && cJSON_GetObjectItemCaseSensitive(ctl, "dfc_a") != NULL && da * a <= 0.0) {
-    return fail(c, "controller.dfc_a",
-                "%g has the opposite sign of the machine's star-point a = %.4g ((3.7): the sign of "
-                "L2 - M2 = %.4g H): the angle would be 90 degrees (electrical) off with no fault",
-                da, a, l2 - m2);
+    return scn_fail(
+        c, "controller.dfc_a",
+        "%g has the opposite sign of the machine's star-point a = %.4g ((3.7): the sign of "
+        "L2 - M2 = %.4g H): the angle would be 90 degrees (electrical) off with no fault",
+        da, a, l2 - m2);
   }
   if (ctl == NULL || cJSON_GetObjectItemCaseSensitive(ctl, "dfc_b") == NULL) {
     static const char *const kp[] = {"star_p", "star_m2", "ld", "lq", "star_m0", NULL};
@@ -1410,29 +1019,31 @@ static int check_map_range(ctx_t *c, const scenario_t *sc, const char *map_key) 
   const double id_lo = (double)fm.id0, id_hi = (double)fm.id0 + (double)fm.did * (fm.nd - 1u);
   const double iq_lo = (double)fm.iq0, iq_hi = (double)fm.iq0 + (double)fm.diq * (fm.nq - 1u);
   if (id_lo > -i_max + tol || id_hi < -tol || iq_lo > -i_max + tol || iq_hi < i_max - tol) {
-    return fail(c, "controller.i_max",
-                "%g A reaches beyond the flux map %s (i_d %g .. %g A, i_q %g .. %g A): the drive "
-                "needs i_d from -i_max to 0 and i_q from -i_max to i_max inside it (the tables "
-                "would be extrapolated): at most %g A with this map%s",
-                i_max, map_key, id_lo, id_hi, iq_lo, iq_hi, fmin(fmin(-id_lo, -iq_lo), iq_hi),
-                id_hi < -tol ? " (and the map must reach i_d = 0)" : "");
+    return scn_fail(
+        c, "controller.i_max",
+        "%g A reaches beyond the flux map %s (i_d %g .. %g A, i_q %g .. %g A): the drive "
+        "needs i_d from -i_max to 0 and i_q from -i_max to i_max inside it (the tables "
+        "would be extrapolated): at most %g A with this map%s",
+        i_max, map_key, id_lo, id_hi, iq_lo, iq_hi, fmin(fmin(-id_lo, -iq_lo), iq_hi),
+        id_hi < -tol ? " (and the map must reach i_d = 0)" : "");
   }
   /* the unit check of `fluxdrive map check --i-max` (docs/flux-maps.md): a
    * grid a hundred times beyond the current limit is a unit error (mA) */
   const double i_grid = fmax(fmax(-id_lo, id_hi), fmax(-iq_lo, iq_hi));
   if (i_grid > 100.0 * i_max) {
-    return fail(c, map_key,
-                "currents implausible (unit?): the grid reaches %g A, %g times controller.i_max "
-                "(%g A): currents in mA? state current_unit \"mA\" in the file (or convert it "
-                "with fluxdrive map convert --current-unit mA)",
-                i_grid, i_grid / i_max, i_max);
+    return scn_fail(
+        c, map_key,
+        "currents implausible (unit?): the grid reaches %g A, %g times controller.i_max "
+        "(%g A): currents in mA? state current_unit \"mA\" in the file (or convert it "
+        "with fluxdrive map convert --current-unit mA)",
+        i_grid, i_grid / i_max, i_max);
   }
   return 0;
 }
 
 int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *err, size_t errlen) {
-  ctx_t c = {err, errlen, origin, 0, 0, ""};
-  scenario_defaults(sc);
+  ctx_t c = {err, errlen, origin, 0, 0, "", -1.0, 0.0, 0.0, {1.0, 1.0, 1.0, 1.0, 1.0}, -1};
+  scenario_defaults(&c, sc);
   /* the whole text is the one object: nothing but white space after it */
   cJSON *root = cJSON_ParseWithOpts(json, NULL, 1);
   if (root == NULL) {
@@ -1443,52 +1054,13 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
     }
     snprintf(err, errlen, "%s: line %d: not valid JSON (or text after the top-level object)",
              origin, line);
-    utf8_clean(err);
+    scn_utf8_clean(err);
     return -1;
   }
-  static const char *const keys[] = {
-      "name",    "description", "duration",   "machine", "inverter", "dc_link", "mechanics",
-      "sensors", "controller",  "references", "inject",  "log",      "board",   NULL};
-  int r = check_keys(&c, root, "", keys);
-  r = r ? r : check_duplicates(&c, root, "");
-  const cJSON *name = cJSON_GetObjectItemCaseSensitive(root, "name");
-  if (r == 0 && name != NULL) {
-    if (!cJSON_IsString(name)) {
-      r = fail(&c, "name", "must be a string");
-    } else {
-      snprintf(sc->name, sizeof sc->name, "%s", name->valuestring);
-      utf8_clean(sc->name);
-    }
-  }
-  const cJSON *desc = cJSON_GetObjectItemCaseSensitive(root, "description");
-  if (r == 0 && desc != NULL && !cJSON_IsString(desc)) {
-    r = fail(&c, "description", "must be a string");
-  }
-  if (r == 0 && !cJSON_GetObjectItemCaseSensitive(root, "duration")) {
-    r = fail(&c, "duration", "required (simulated time in seconds)");
-  }
-  r = r ? r : get_num(&c, root, "", "duration", 1e-4, 3600.0, &sc->duration);
-  /* Sections in dependency order: the machine preset sets defaults that the
-   * others may override. */
-  struct {
-    const char *key;
-    int (*fn)(ctx_t *, const cJSON *, scenario_t *);
-  } sections[] = {{"machine", parse_machine},
-                  {"inverter", parse_inverter},
-                  {"dc_link", parse_dclink},
-                  {"mechanics", parse_mechanics},
-                  {"sensors", parse_sensors},
-                  {"controller", parse_controller},
-                  {"references", parse_references},
-                  {"inject", parse_inject},
-                  {"log", parse_log},
-                  {"board", parse_board}};
-  for (size_t i = 0; r == 0 && i < sizeof sections / sizeof sections[0]; ++i) {
-    const cJSON *o = cJSON_GetObjectItemCaseSensitive(root, sections[i].key);
-    if (o != NULL) {
-      r = sections[i].fn(&c, o, sc);
-    }
-  }
+  /* the table's walk from its root: the top-level keys, then the sections
+   * in dependency order (the machine preset sets defaults that the others
+   * may override) */
+  int r = walk(&c, sc, root, "", K_ROOT, 0, 0);
   r = r ? r : check_star(&c, root, sc);
   r = r ? r : check_map_range(&c, sc, sc->map_file);
   if (r == 0 && cJSON_GetObjectItemCaseSensitive(root, "board") == NULL) {
@@ -1506,17 +1078,19 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
   sc->plant.dclink.v_source = profile_eval(&sc->v_source, 0.0);
   /* the drive's protection range (v_dc_max at most 1e4 V) bounds the link */
   if (!(sc->plant.dclink.v_source > 0.0 && sc->plant.dclink.v_source <= 1e4)) {
-    return fail(&c, "dc_link.voltage", "must be in (0, 10000] V at t = 0 (got %g)",
-                sc->plant.dclink.v_source);
+    return scn_fail(&c, "dc_link.voltage", "must be in (0, 10000] V at t = 0 (got %g)",
+                    sc->plant.dclink.v_source);
   }
   const pos_source_row_t *ps = pos_source(sc->drive.pos_source);
   if (ps != NULL && (ps->caps & POS_CAP_GATED) != 0u &&
       sc->plant.inverter.model != PLANT_INV_SWITCHING) {
-    return fail(&c, "inverter.model",
-                "a star-point position source needs the switching model (the DFC window's edges)");
+    return scn_fail(
+        &c, "inverter.model",
+        "a star-point position source needs the switching model (the DFC window's edges)");
   }
   if (ps != NULL && (ps->caps & POS_CAP_GATED) != 0u && !sc->board.asym_edges) {
-    return fail(&c, "board", "a star-point position source needs a board with asymmetric edges");
+    return scn_fail(&c, "board",
+                    "a star-point position source needs a board with asymmetric edges");
   }
   /* the star-point circuit settles within the sample's delay after the
    * edge (issue 23: the fabbri2022 presets trip `position` from a settling
@@ -1526,35 +1100,37 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
    * (controller.dfc_t_meas: drive_config_check), named there */
   if (ps != NULL && (ps->caps & POS_CAP_GATED) != 0u && settle > 0.0 &&
       sc->plant.sensors.star_tau > STAR_TAU_SHARE * settle * (1.0 + 1e-6)) {
-    return fail(&c, "sensors.star_tau",
-                "%g s: the star-point sample at controller.dfc_t_meas (%g s) after the edge, less "
-                "the dead time (%g s), leaves the circuit %.2g time constants to settle: at "
-                "least %g (star_tau <= %g s; the position trips from 4 on)",
-                sc->plant.sensors.star_tau, (double)sc->drive.dfc_t_meas,
-                sc->plant.inverter.dead_time, settle / sc->plant.sensors.star_tau,
-                1.0 / STAR_TAU_SHARE, STAR_TAU_SHARE * settle);
+    return scn_fail(
+        &c, "sensors.star_tau",
+        "%g s: the star-point sample at controller.dfc_t_meas (%g s) after the edge, less "
+        "the dead time (%g s), leaves the circuit %.2g time constants to settle: at "
+        "least %g (star_tau <= %g s; the position trips from 4 on)",
+        sc->plant.sensors.star_tau, (double)sc->drive.dfc_t_meas, sc->plant.inverter.dead_time,
+        settle / sc->plant.sensors.star_tau, 1.0 / STAR_TAU_SHARE, STAR_TAU_SHARE * settle);
   }
   if (resolve_substeps(&c, sc) != 0) {
     return -1;
   }
   const char *field = "";
   if (plant_check(&sc->plant, &field) != 0) {
-    return fail(&c, scenario_key_of(field), "invalid plant parameter (see docs/scenarios.md)");
+    return scn_fail(&c, scenario_key_of(field), "invalid plant parameter (see docs/scenarios.md)");
   }
   /* the ADC ranges the drive's HAL reports (hal_caps_t): the sensors' */
   sc->board.i_full_scale = (float)sc->plant.sensors.i_full_scale;
   sc->board.v_full_scale = (float)sc->plant.sensors.v_full_scale;
   if (!(sc->drive.i_trip < sc->board.i_full_scale)) {
-    return fail(&c, "controller.i_trip",
-                "must be below the current ADC's full scale sensors.i_full_scale (%g A): a current "
-                "beyond it reads as the full scale and would never trip (got %g A)",
-                sc->plant.sensors.i_full_scale, (double)sc->drive.i_trip);
+    return scn_fail(
+        &c, "controller.i_trip",
+        "must be below the current ADC's full scale sensors.i_full_scale (%g A): a current "
+        "beyond it reads as the full scale and would never trip (got %g A)",
+        sc->plant.sensors.i_full_scale, (double)sc->drive.i_trip);
   }
   if (!(sc->drive.v_dc_max < sc->board.v_full_scale)) {
-    return fail(&c, "controller.v_dc_max",
-                "must be below the DC-link ADC's full scale sensors.v_full_scale (%g V): a voltage "
-                "beyond it reads as the full scale and would never trip (got %g V)",
-                sc->plant.sensors.v_full_scale, (double)sc->drive.v_dc_max);
+    return scn_fail(
+        &c, "controller.v_dc_max",
+        "must be below the DC-link ADC's full scale sensors.v_full_scale (%g V): a voltage "
+        "beyond it reads as the full scale and would never trip (got %g V)",
+        sc->plant.sensors.v_full_scale, (double)sc->drive.v_dc_max);
   }
   /* the set as a whole, reported under the scenario key that sets the
    * field (drive_param_table.h) */
@@ -1566,14 +1142,14 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
     const char *key = p != NULL ? p->scenario : e.field;
     if (strcmp(e.field, "dfc_b") == 0 && c.p_key[0] != '\0') {
       /* the drive's b follows the machine's star point: name what set it */
-      return fail(&c, c.p_key, "the star point's p = b/a = %.3g (3.7), the drive's dfc_b: %s",
-                  (double)(sc->drive.dfc_b / sc->drive.dfc_a), e.reason);
+      return scn_fail(&c, c.p_key, "the star point's p = b/a = %.3g (3.7), the drive's dfc_b: %s",
+                      (double)(sc->drive.dfc_b / sc->drive.dfc_a), e.reason);
     }
     if (p != NULL && strcmp(e.reason, "outside its range") == 0) {
-      return fail(&c, key, "must be in [%g, %g] (got %g)", (double)p->min, (double)p->max,
-                  (double)drive_param_get(&sc->drive, p));
+      return scn_fail(&c, key, "must be in [%g, %g] (got %g)", (double)p->min, (double)p->max,
+                      (double)drive_param_get(&sc->drive, p));
     }
-    return fail(&c, key, "%s", e.reason);
+    return scn_fail(&c, key, "%s", e.reason);
   }
   return 0;
 }
@@ -1601,4 +1177,17 @@ int scenario_load_file(const char *path, scenario_t *sc, char *err, size_t errle
   int r = scenario_parse(buf, path, sc, err, errlen);
   free(buf);
   return r;
+}
+
+int scenario_dump(const scenario_t *sc, const char *path) {
+  static scenario_t d;
+  memcpy(&d, sc, sizeof d);
+  d.plant.machine.map = NULL;
+  d.drive.machine_map = NULL;
+  FILE *f = fopen(path, "wb");
+  if (f == NULL) {
+    return -1;
+  }
+  const int ok = fwrite(&d, sizeof d, 1, f) == 1;
+  return (fclose(f) == 0 && ok) ? 0 : -1;
 }

@@ -73,4 +73,9 @@ typedef struct {
 int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *err, size_t errlen);
 int scenario_load_file(const char *path, scenario_t *sc, char *err, size_t errlen);
 
+/* Writes the parsed scenario's bytes to `path` with its pointers (the flux
+ * map's) zeroed, so two builds' parses of one file compare byte for byte
+ * (fluxdrive-sil --dump-scenario). Returns 0, or -1 on an I/O error. */
+int scenario_dump(const scenario_t *sc, const char *path);
+
 #endif

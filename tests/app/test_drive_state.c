@@ -640,6 +640,32 @@ static void syr_machine_runs_foc_only(void **state) {
   assert_non_null(strstr(err.reason, "PM machine"));
 }
 
+/* The short's flux bound of a reluctance machine (no magnet) at start-up:
+ * the same as from a second configuration of the same set, and not 0 (it
+ * was 0 at start-up: the bisection took the previous set's flux scale, and
+ * every short was refused until a second set was taken). */
+static void syr_short_bound_from_its_own_set(void **state) {
+  (void)state;
+  drive_config_t cfg;
+  drive_config_default(&cfg);
+  cfg.pole_pairs = 2.0f;
+  cfg.rs = 6.8f;
+  cfg.ld = 0.05f;
+  cfg.lq = 0.25f;
+  cfg.lambda_m = 0.0f;
+  cfg.flux_min = 0.0f;
+  cfg.law = DRIVE_LAW_FOC;
+  setup_with(&cfg);
+  const float first = drv.safe.psi_max;
+  assert_true(first > 0.1f * drv.flux_scale);
+  drive_config_err_t err;
+  cfg.speed_max *= 0.99f; /* a new set of the same machine, taken with the gates off */
+  assert_int_equal(drive_request_config(&drv, &cfg, &err), 0);
+  run_isrs(2);
+  assert_float_equal(drv.cfg.speed_max, cfg.speed_max, 0.0f);
+  assert_float_equal(drv.safe.psi_max, first, 1e-6f * first);
+}
+
 /* Parameter requests: applied by the ISR; an IDLE parameter is refused
  * while running, a LIVE one applied at the next ISR. */
 static void parameter_requests_are_applied_by_the_isr(void **state) {
@@ -695,7 +721,7 @@ static void watchdog_needs_both_contexts(void **state) {
 
 /* Alignment: gates on with d current along theta = 0 for align_time and
  * until the encoder's speed has stayed calm: a rotor that never moved for
- * align_still_need periods (1 / w_n: 13 ms with the default machine, w_n =
+ * still_need periods (1 / w_n: 13 ms with the default machine, w_n =
  * 77 rad/s at 1 A), then the encoder's offset is what it reads there. */
 static void alignment_sets_the_encoder_offset(void **state) {
   (void)state;
@@ -710,7 +736,9 @@ static void alignment_sets_the_encoder_offset(void **state) {
   run_isrs(drv.cfg.offset_samples + 1);
   assert_int_equal(drv.state, DRIVE_STATE_ALIGN);
   assert_true(hal.gates_on);
-  const int need = (int)drv.align_still_need;
+  proc_align_timing_t tmg; /* the alignment procedure's (proc_align.c) */
+  proc_align_timing(&drv.cfg, &tmg);
+  const int need = (int)tmg.still_need;
   assert_true(need > (int)(0.01f / drv.cfg.ts) + 1); /* the calm outlasts align_time here */
   run_isrs(need - 2);
   assert_int_equal(drv.state, DRIVE_STATE_ALIGN); /* not yet settled */
@@ -723,7 +751,7 @@ static void alignment_sets_the_encoder_offset(void **state) {
 
 /* A rotor that keeps swinging through the encoder's alignment (issue 23,
  * point 18): no offset is taken; the position fault after
- * DRIVE_ALIGN_SWINGS swings more (align_n_timeout), gates off. */
+ * PROC_ALIGN_SWINGS swings more (n_timeout), gates off. */
 static void swinging_rotor_never_aligns(void **state) {
   (void)state;
   drive_config_t cfg;
@@ -734,7 +762,9 @@ static void swinging_rotor_never_aligns(void **state) {
   sample(0.0f, 0.0f, 0.0f, 310.0f);
   drive_cmd_enable(&drv, true);
   const float off0 = drv.pos_st.enc.offset;
-  for (int k = 0; k < (int)drv.cfg.offset_samples + (int)drv.align_n_timeout + 2; ++k) {
+  proc_align_timing_t tmg; /* the alignment procedure's (proc_align.c) */
+  proc_align_timing(&drv.cfg, &tmg);
+  for (int k = 0; k < (int)drv.cfg.offset_samples + (int)tmg.n_timeout + 2; ++k) {
     /* 0.1 rad mechanical at 5 Hz: 2 x 10 x 2 pi rad/s electrical peak */
     hal.sample.enc_angle = 1.0f + 0.1f * sinf(31.4159f * (float)k * drv.cfg.ts);
     drive_isr(&drv);
@@ -856,6 +886,7 @@ int main(void) {
                                      cmocka_unit_test(refused_law_switch_leaves_the_law_as_it_was),
                                      cmocka_unit_test(law_switch_waits_for_the_pending_set),
                                      cmocka_unit_test(syr_machine_runs_foc_only),
+                                     cmocka_unit_test(syr_short_bound_from_its_own_set),
                                      cmocka_unit_test(parameter_requests_are_applied_by_the_isr),
                                      cmocka_unit_test(watchdog_needs_both_contexts),
                                      cmocka_unit_test(alignment_sets_the_encoder_offset),

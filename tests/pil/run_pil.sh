@@ -62,7 +62,7 @@ export PYTHONPATH="$src/tools/src${PYTHONPATH:+:$PYTHONPATH}"
 # standstill to 500 rpm: agreement, the issue's goals per call (KF: predict
 # + update <= 360, RLS <= 220; measured 158 and 146) and for the whole ISR
 # with the core's trigonometry on the STM32G474's CORDIC co-processor
-# (< 3000; measured 2970: docs/benchmarks.md, "Sensorless: Kalman filter,
+# (< 3000; measured 2789: docs/benchmarks.md, "Sensorless: Kalman filter,
 # EKF, RLS"); then the EKF (<= 790; measured 251)
 "$python" -m fluxdrive pil "$src/sil/scenarios/pil_ivd_kf_rls.json" --law foc --isrs all \
   --functions --check-call kf_mech_predict=100 --check-call kf_mech_update=260 \

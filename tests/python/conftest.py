@@ -9,7 +9,9 @@ from __future__ import annotations
 import json
 import os
 import stat
+import subprocess
 import sys
+import tempfile
 import textwrap
 from pathlib import Path
 
@@ -27,6 +29,22 @@ SIGNALS = [
     "i_a", "i_b", "i_c", "i_d", "i_q", "v_dc", "duty_a", "duty_b", "duty_c",
     "flux", "flux_ref", "delta", "i_qs", "i_qs_ref", "state", "faults", "theta_e",
 ]
+
+
+def run_sil(sc: dict, timeout: float = 300.0) -> np.ndarray | str:
+    """Runs the real fluxdrive-sil on the scenario `sc` (a dict, written to a
+    temporary file) with its log: the log as a structured array, or the
+    runner's stderr (stripped) when it refused or failed. Shared by the
+    start tests (test_held_start.py, test_start_polarity.py)."""
+    with tempfile.TemporaryDirectory() as d:
+        p = os.path.join(d, "sc.json")
+        with open(p, "w") as f:
+            json.dump(sc, f)
+        r = subprocess.run([str(REAL_SIL), p, "--log", p + ".npy"], capture_output=True,
+                           text=True, timeout=timeout)
+        if r.returncode != 0:
+            return r.stderr.strip()
+        return np.load(p + ".npy")
 
 
 def make_log(n: int = 2000, dt: float = 1.0 / 16000.0, names: list[str] | None = None) -> np.ndarray:

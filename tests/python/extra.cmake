@@ -39,6 +39,12 @@ if(FD_PYTHON)
            COMMAND ${FD_PYTHON} -m fluxdrive params --check --sil $<TARGET_FILE:fluxdrive-sil>
            WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   set_tests_properties(params/agreement PROPERTIES LABELS python TIMEOUT 120)
+  # the signal tables against docs/log-format.md, the DBC's signal comments,
+  # the tools' signal table and the PIL field list (fluxdrive signals --check)
+  add_test(NAME signals/agreement
+           COMMAND ${FD_PYTHON} -m fluxdrive signals --check --sil $<TARGET_FILE:fluxdrive-sil>
+           WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  set_tests_properties(signals/agreement PROPERTIES LABELS python TIMEOUT 120)
 else()
   message(STATUS "FD_PYTHON not set: pytest not registered (scripts/test.sh sets it)")
 endif()

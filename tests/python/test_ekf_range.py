@@ -57,7 +57,7 @@ SEEDS = (1, 2, 3)
 POS_ERR_MAX = 0.5  # rad: controller.pos_err_max's default, the scenario's
 PRIOR_W = 30.0 / POLES * 30.0 / math.pi  # rpm mechanical: kf_p0's 1 sigma (30 rad/s electrical)
 RUN_STATE = 2
-P_MAX = 0.35  # the source's limit (pos_dfc.c POS_DFC_EKF_P_MAX)
+P_MAX = 0.35  # the source's limit (pos_track.c POS_DFC_EKF_P_MAX)
 
 
 def scenario(p: float, angle: float = 0.5, seed: int = 1, duration: float = 0.4,

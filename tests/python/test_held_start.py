@@ -8,7 +8,7 @@ by the d-axis saturation (the plant's machine.ld_sat, machine.i_sat), then
 the speed loop closes from standstill. The rotor is never pulled: it is
 free, with no torque, for the start's t_s (39 periods, 2.44 ms at 16 kHz,
 on fabbri2022_t51; up to 52, 3.25 ms, where the pulses are longer:
-drive_hold.c) and for nothing else. An active load T_L applied when the
+proc_hold.c) and for nothing else. An active load T_L applied when the
 gates come on (a brake released at the start) turns it by
 p T_L t^2 / (2 J) over that time (t from the load's onset to the run): on
 fabbri2022_t51 / _fig33 at 100 % rated load 2.0 deg electrical, on the
@@ -37,14 +37,11 @@ from __future__ import annotations
 from concurrent.futures import ProcessPoolExecutor
 import json
 import math
-import os
-import subprocess
-import tempfile
 
 import numpy as np
 import pytest
 
-from conftest import REAL_SIL, REPO_ROOT
+from conftest import REAL_SIL, REPO_ROOT, run_sil
 from fluxdrive import machines as mach
 
 pytestmark = pytest.mark.skipif(not REAL_SIL.exists(), reason="fluxdrive-sil not built")
@@ -120,15 +117,9 @@ def scenario(preset, source, angle, load, seed, duration, rpm=0.0, start_mode=1,
 
 
 def run(sc) -> np.ndarray | str:
-    with tempfile.TemporaryDirectory() as d:
-        p = os.path.join(d, "sc.json")
-        with open(p, "w") as f:
-            json.dump(sc, f)
-        r = subprocess.run([str(REAL_SIL), p, "--log", p + ".npy"], capture_output=True,
-                           text=True, timeout=300)
-        if r.returncode != 0:
-            return r.stderr.strip()[-300:]
-        return np.load(p + ".npy")
+    """The log, or the end of the runner's error (conftest.run_sil)."""
+    lg = run_sil(sc, timeout=300)
+    return lg[-300:] if isinstance(lg, str) else lg
 
 
 def predicted_move(preset, load, t_free) -> float:

@@ -183,6 +183,24 @@ def test_checks_on_db_dfvc(capsys) -> None:
     assert pil.check_runs([bad], None, None) == 1
 
 
+def test_budget_from_the_scenario_period(tmp_path, capsys) -> None:
+    """The cycle budget is 170 MHz over the scenario's inverter.pwm_frequency
+    (issue 24: the 32 kHz build of DB-DFVC), 16 kHz when not given."""
+    assert pil.budget_cycles(16000) == pil.BUDGET_CYCLES == 10625
+    assert pil.budget_cycles(32000) == 5312
+    sc = tmp_path / "s.json"
+    sc.write_text('{"inverter": {"pwm_frequency": 32000}}')
+    assert pil.scenario_pwm_hz(sc) == 32000.0
+    sc.write_text("{}")
+    assert pil.scenario_pwm_hz(sc) == 16000.0
+    r = run_with("db_dfvc", 2500, 4249)
+    r.budget = 5312
+    assert pil.check_runs([r], None, 80) == 0
+    assert "= 80.0 % of 5312, limit 80 % (4250)" in capsys.readouterr().out  # 4249.6
+    r.counts.cycles_worst = 4250
+    assert pil.check_runs([r], None, 80) == 1
+
+
 def test_pil_help_documents_all(capsys) -> None:
     with pytest.raises(SystemExit):
         build_parser().parse_args(["pil", "--help"])

@@ -31,13 +31,11 @@ import json
 import math
 import os
 import random
-import subprocess
-import tempfile
 
 import numpy as np
 import pytest
 
-from conftest import REAL_SIL, REPO_ROOT
+from conftest import REAL_SIL, REPO_ROOT, run_sil
 from fluxdrive import machines as mach
 
 pytestmark = pytest.mark.skipif(not REAL_SIL.exists(), reason="fluxdrive-sil not built")
@@ -122,17 +120,11 @@ def one(case) -> tuple:
     sc["mechanics"]["theta0"] = angle / pp
     sc["sensors"].update({"star_noise": noise, "seed": seed})
     sc["controller"].update({"pos_source": source, "dfc_sigma": sigma_of(noise)})
-    with tempfile.TemporaryDirectory() as d:
-        p = os.path.join(d, "sc.json")
-        with open(p, "w") as f:
-            json.dump(sc, f)
-        r = subprocess.run([str(REAL_SIL), p, "--log", p + ".npy"], capture_output=True,
-                           text=True, timeout=120)
-        if r.returncode != 0:
-            if source == "ekf" and EKF_REFUSAL in r.stderr:
-                return case, REFUSED
-            return case, r.stderr.strip()[-300:]
-        lg = np.load(p + ".npy")
+    lg = run_sil(sc, timeout=120)
+    if isinstance(lg, str):
+        if source == "ekf" and EKF_REFUSAL in lg:
+            return case, REFUSED
+        return case, lg[-300:]
     run = lg["state"] == RUN_STATE
     if not run.any():
         return case, "the alignment did not end"

@@ -287,6 +287,13 @@ def build_parser() -> argparse.ArgumentParser:
     mx.add_argument("--write", action="store_true", help="regenerate the files that differ")
     mx.add_argument("--check", action="store_true", help="exit 1 when a file differs")
     p.set_defaults(func=lambda a: __import__("fluxdrive.params").params.main(a))
+    p = sub.add_parser("signals", help="the signal tables into docs/log-format.md, the DBC's "
+                       "signal comments and the tools' signal table")
+    p.add_argument("--sil", metavar="PATH", help=sil_help)
+    mx = p.add_mutually_exclusive_group()
+    mx.add_argument("--write", action="store_true", help="regenerate the files that differ")
+    mx.add_argument("--check", action="store_true", help="exit 1 when a file differs")
+    p.set_defaults(func=lambda a: __import__("fluxdrive.signals").signals.main(a))
 
     p = sub.add_parser("cycles-board", help="cycle bound of the board's ISR path outside "
                        "drive_isr (wrapper, exception, register HAL)")

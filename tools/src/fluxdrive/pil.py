@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from fluxdrive import cm4_cycles, params, sil
+from fluxdrive.signals import pil_out
 from fluxdrive.errors import FluxdriveError
 
 ENV_ELF = "FLUXDRIVE_PIL_ELF"
@@ -59,6 +60,13 @@ QEMU = "qemu-system-arm"
 DUTY_TOL = 2e-5
 
 BUDGET_CYCLES = 10625  # 170 MHz / 16 kHz
+SYSCLK_HZ = 170_000_000
+
+
+def budget_cycles(pwm_hz: float) -> int:
+    """Cycles per ISR at the scenario's PWM frequency (``inverter.pwm_frequency``,
+    16 kHz by default): 10625 at 16 kHz, 5312 at 32 kHz."""
+    return int(SYSCLK_HZ / pwm_hz)
 RUN = 2  # DRIVE_STATE_RUN
 
 HEADER = np.dtype(
@@ -75,9 +83,10 @@ HEADER = np.dtype(
     ]
 )
 MAGIC, VERSION, FORCE_APPLIED = 0x52534946, 5, 1
-OUT = np.dtype(
-    [("duty", "<f4", 3), ("flags", "<u4"), ("faults", "<u4"), ("state", "<u4")]
-)
+# the output record's fields, named after the signals they carry
+# (sil/runner/isr_stream.h ISR_STREAM_OUT_FIELDS, `fluxdrive signals`)
+OUT = np.dtype(pil_out())
+DUTIES = ("duty_a", "duty_b", "duty_c")
 IN_SIZE = 240
 
 #: Blocks of the per-function share: the first pattern that a function name
@@ -88,7 +97,8 @@ BLOCKS = [
                                                           "hal_pwm_centred")),
     ("speed loop (speed_ctrl, every slow_div ISRs)", ("speed_ctrl_",)),
     ("position source (encoder, star point, PLL)", ("enc_", "pdfc_", "nearest_branch",
-                                                    "pos_source", "angle_pll_", "trk_",
+                                                    "pos_source", "pos_encoder_", "pos_star_",
+                                                    "pos_method_", "angle_pll_", "trk_",
                                                     "meas_r", "rls_step")),
     ("Kalman filter (kf_mech_predict, kf_mech_update: (4.46)-(4.49))",
      ("kf_mech_predict", "kf_mech_update", "kf_mech_reset", "kf_mech_r_speed")),
@@ -380,7 +390,10 @@ def compare(host: np.ndarray, pil: np.ndarray) -> Agreement:
     if len(pil) != len(host):
         raise FluxdriveError(f"PIL wrote {len(pil)} ISR outputs, expected {len(host)}",
                              exit_code=1)
-    dev = np.abs(host["duty"].astype(np.float64) - pil["duty"].astype(np.float64)).max(axis=1)
+    def duty(x: np.ndarray) -> np.ndarray:
+        return np.stack([x[d].astype(np.float64) for d in DUTIES], axis=-1).reshape(-1, 3)
+
+    dev = np.abs(duty(host) - duty(pil)).max(axis=1)
     dev = np.where(np.isnan(dev), np.inf, dev) if len(dev) else dev
     k = int(np.argmax(dev)) if len(dev) else 0
     return Agreement(
@@ -388,7 +401,7 @@ def compare(host: np.ndarray, pil: np.ndarray) -> Agreement:
         max_duty_dev=float(dev[k]) if len(dev) else 0.0,
         max_dev_isr=k,
         duty_bad=int((dev > DUTY_TOL).sum()),
-        gates_bad=int(((host["flags"] ^ pil["flags"]) & 1).sum()),
+        gates_bad=int(((host["gates"] ^ pil["gates"]) & 1).sum()),
         faults_bad=int((host["faults"] != pil["faults"]).sum()),
         state_bad=int((host["state"] != pil["state"]).sum()),
     )
@@ -473,6 +486,7 @@ class PilRun:
     agreement: Agreement
     counts: Counts
     trace_exact: bool  # traced replay's outputs == untraced replay's
+    budget: int = BUDGET_CYCLES  # cycles per ISR at the scenario's PWM frequency
 
 
 def build_default(root: Path, steps: tuple[list[str], ...], what: str) -> None:
@@ -524,6 +538,15 @@ def locate_runner(explicit: str | None, build: bool = True) -> Path:
     return sil.locate_sil(explicit)
 
 
+def scenario_pwm_hz(src: Path) -> float:
+    """The scenario's ``inverter.pwm_frequency`` (16 kHz when not given)."""
+    try:
+        sc = json.loads(src.read_text(encoding="utf-8"))
+    except (OSError, json.JSONDecodeError) as exc:
+        raise FluxdriveError(f"{src}: {exc}") from None
+    return float((sc.get("inverter") or {}).get("pwm_frequency", 16000.0))
+
+
 def scenario_with_law(src: Path, law: str | None, dst: Path) -> str:
     try:
         sc = json.loads(src.read_text(encoding="utf-8"))
@@ -562,12 +585,13 @@ def run_one(runner: Path, elf: Path, scenario: Path, law: str | None, isrs: int,
     if len(tr.counts) != n:
         raise FluxdriveError(f"trace shows {len(tr.counts)} ISRs, replayed {n}", exit_code=1)
     exact = traced_out.tobytes() == pil_out[:n].tobytes()
-    return PilRun(scenario.stem, law_name, agreement, law_counts(tr, host, stand_ins), exact)
+    return PilRun(scenario.stem, law_name, agreement, law_counts(tr, host, stand_ins), exact,
+                  budget_cycles(scenario_pwm_hz(scen)))
 
 
 # ---------------------------------------------------------------- report
-def _pct(cycles: float) -> str:
-    return f"{100 * cycles / BUDGET_CYCLES:.0f} %"
+def _pct(cycles: float, budget: int = BUDGET_CYCLES) -> str:
+    return f"{100 * cycles / budget:.0f} %"
 
 
 def board_estimate(c: Counts, board: cm4_cycles.BoardBound) -> tuple[float, float]:
@@ -605,6 +629,7 @@ def format_report(runs: list[PilRun], isrs: int, cpi: float | None = None,
     lines = []
     for r in runs:
         a, c = r.agreement, r.counts
+        bud = r.budget  # this run's: the scenario's PWM frequency
         lines.append(f"== {r.scenario} / {r.law}")
         lines.append(
             f"agreement over {a.isrs} ISRs: max |duty dev| {a.max_duty_dev:.3g} at ISR "
@@ -620,8 +645,8 @@ def format_report(runs: list[PilRun], isrs: int, cpi: float | None = None,
         lines.append(
             f"estimated cycles (Cortex-M4 model, docs/pil.md): mean {c.cycles_mean:.0f}, worst "
             f"{c.cycles_worst} (ISR {c.cycles_worst_isr}); {c.cpi:.2f} cycles/instruction; "
-            f"{_pct(c.cycles_mean)} mean / {_pct(c.cycles_worst)} worst of {BUDGET_CYCLES}"
-            + (f" (legacy {cpi:g} cycles/instruction: {_pct(c.worst * cpi)} worst)"
+            f"{_pct(c.cycles_mean, bud)} mean / {_pct(c.cycles_worst, bud)} worst of {bud}"
+            + (f" (legacy {cpi:g} cycles/instruction: {_pct(c.worst * cpi, bud)} worst)"
                if cpi else "")
         )
         if board is not None:
@@ -629,7 +654,7 @@ def format_report(runs: list[PilRun], isrs: int, cpi: float | None = None,
             lines.append(
                 f"board estimate (PIL - replay HAL {c.stand_in_cycles():.0f} + board HAL + ISR "
                 f"wrapper and exception, `fluxdrive cycles-board`): typical {bt:.0f} "
-                f"({_pct(bt)}), worst {bw:.0f} ({_pct(bw)})"
+                f"({_pct(bt, bud)}), worst {bw:.0f} ({_pct(bw, bud)})"
             )
             tc = trig_on_cordic(c, board)
             if tc is not None:
@@ -670,8 +695,8 @@ def format_markdown(runs: list[PilRun], isrs: int, cpi: float | None, build: str
         f"entry to its return, callees included, over the ISRs that ran the control law "
         f"({window}). The cycles are an **estimate**: every traced instruction priced with the Cortex-M4 cycle model of docs/pil.md "
         f"(TRM instruction timings, zero wait states, taken branches from the traced PC "
-        f"sequence, P = {cm4_cycles.P}), against {BUDGET_CYCLES} cycles per ISR "
-        f"(170 MHz / 16 kHz). Not included: the board's ISR wrapper, exception entry/exit "
+        f"sequence, P = {cm4_cycles.P}), against the cycles per ISR at 170 MHz and the "
+        f"scenario's PWM frequency ({BUDGET_CYCLES} at 16 kHz). Not included: the board's ISR wrapper, exception entry/exit "
         f"and register HAL (`fluxdrive cycles-board`{', below' if board else ''})."
     )
     out.append("")
@@ -685,8 +710,9 @@ def format_markdown(runs: list[PilRun], isrs: int, cpi: float | None, build: str
         c, a = r.counts, r.agreement
         out.append(
             f"| {r.scenario} | {r.law} | {c.isrs} | {c.mean:.0f} | {c.worst} | "
-            f"{c.cycles_mean:.0f} | {c.cycles_worst} | {c.cpi:.2f} | {_pct(c.cycles_mean)} | "
-            f"{_pct(c.cycles_worst)} |" + (f" {_pct(c.worst * cpi)} |" if cpi else "")
+            f"{c.cycles_mean:.0f} | {c.cycles_worst} | {c.cpi:.2f} | "
+            f"{_pct(c.cycles_mean, r.budget)} | {_pct(c.cycles_worst, r.budget)} |"
+            + (f" {_pct(c.worst * cpi, r.budget)} |" if cpi else "")
             + f" {a.max_duty_dev:.2g}{'' if a.ok else ' (FAIL)'} | {a.isrs} |"
         )
     out.append("")
@@ -706,8 +732,8 @@ def format_markdown(runs: list[PilRun], isrs: int, cpi: float | None, build: str
         out.append("|---|---|---:|---:|")
         for r in runs:
             bt, bw = board_estimate(r.counts, board)
-            out.append(f"| {r.scenario} | {r.law} | {bt:.0f} ({_pct(bt)}) | "
-                       f"{bw:.0f} ({_pct(bw)}) |")
+            out.append(f"| {r.scenario} | {r.law} | {bt:.0f} ({_pct(bt, r.budget)}) | "
+                       f"{bw:.0f} ({_pct(bw, r.budget)}) |")
         out.append("")
     out.append("Share of the mean per block (instructions per ISR, % of the mean; estimated "
                "cycles per ISR):")
@@ -874,11 +900,11 @@ def check_runs(runs: list[PilRun], worst_instr: int | None, worst_pct: float | N
                   f"(ISR {c.worst_isr}), limit {worst_instr}")
             rc |= 0 if ok else 1
         if worst_pct:
-            lim = worst_pct / 100.0 * BUDGET_CYCLES
+            lim = worst_pct / 100.0 * r.budget
             ok = c.cycles_worst <= lim
-            pct = 100 * c.cycles_worst / BUDGET_CYCLES
+            pct = 100 * c.cycles_worst / r.budget
             print(f"{'check' if ok else 'FAIL'}: {name}: worst case {c.cycles_worst} estimated "
-                  f"cycles (ISR {c.cycles_worst_isr}) = {pct:.1f} % of {BUDGET_CYCLES}, "
+                  f"cycles (ISR {c.cycles_worst_isr}) = {pct:.1f} % of {r.budget}, "
                   f"limit {worst_pct:g} % ({lim:.0f})")
             rc |= 0 if ok else 1
     return rc

@@ -24,7 +24,7 @@ import numpy as np
 
 from .model import FluxMap
 
-# star-point position sources: gated (POS_CAP_GATED, firmware/app/pos_dfc.c)
+# star-point position sources: gated (POS_CAP_GATED, firmware/app/pos_sources.c)
 GATED_SOURCES = ("dfc", "dfc_inv", "ivd", "dfc+kf", "ivd+kf", "ekf", "ivd+kf+rls")
 
 

@@ -1,0 +1,134 @@
+/*
+ * pos_rls.c - the identification column of the star-point sources
+ * (pos_star.h): a, b of the star-point model identified online by the RLS
+ * of (4.51)-(4.57) (estimation/rls_ab.h), the loop of Fig. 4.4 (Fabbri
+ * 2022): the IVD uses the identified a, b (held in the IVD's convergence
+ * region |b/a| <= 0.45 and within a factor 4 of dfc_a) and, once aligned,
+ * starts its iterations from the tracker's prediction (from the raw
+ * estimate their residual error biased b: issue 23 point 5); the RLS
+ * regressor is the filter's predicted angle (a priori: free of this
+ * period's signal noise, which the IVD angle carries - no errors-in-variables
+ * bias); it identifies only above rls_w_min, where the 2theta and 4theta
+ * columns are separable, and never with the EKF: the EKF's angle is itself
+ * a function of a and b, the thesis's non-observable combination (5.1.3),
+ * so no row combines them (pos_sources.c).
+ */
+#include <stddef.h>
+
+#include "math/fd_math.h"
+#include "pos_star.h"
+
+static rls_ab_cfg_t rls_cfg_of(const drive_config_t *cfg) {
+  const rls_ab_cfg_t r = {cfg->rls_lambda, cfg->dfc_sigma * cfg->dfc_sigma, cfg->rls_p_min,
+                          cfg->rls_p_max};
+  return r;
+}
+
+#define POS_DFC_P_MAX 0.45f /* |b/a| the IVD is given at most (Theorem 1: < 1/2) */
+/* The IVD's a, b: the RLS's within the guards (header). */
+static void rls_guarded(const rls_ab_t *r, const drive_config_t *cfg, dfc_cfg_t *dc) {
+  const float a0 = fabsf(cfg->dfc_a);
+  const float am = fd_clampf(fabsf(r->x[0]), 0.25f * a0, 4.0f * a0);
+  dc->a = cfg->dfc_a < 0.0f ? -am : am;
+  dc->b = fd_clampf(r->x[1], -POS_DFC_P_MAX * am, POS_DFC_P_MAX * am);
+}
+
+FD_COLD static void rls_init(pos_state_t *s, const drive_config_t *cfg) {
+  const rls_ab_cfg_t rc = rls_cfg_of(cfg);
+  (void)rls_ab_init(&s->star.id.rls, &rc);
+  rls_ab_reset(&s->star.id.rls, cfg->dfc_a, cfg->dfc_b, cfg->rls_p_max);
+  s->star.id.avg[0] = 0.0f; /* not settled before its updates (rls_health) */
+  s->star.id.avg[1] = 0.0f;
+  s->star.id.warm2 = 1.0f;
+  rls_guarded(&s->star.id.rls, cfg, &s->star.meas.dc); /* the RLS's start, guarded */
+}
+
+/* (2|p|)^2n: the warm-started IVD's n iterations contract the
+ * prediction's error of 2theta by (2|p|)^n (Theorem 1, (3.81)); its
+ * square scales the prediction's variance into the measurement's
+ * (pos_track.c, meas_r). Taken when the RLS moves a, b (every third period
+ * at most) and at the end of the alignment. */
+static void warm_gain(pos_state_t *s) {
+  const dfc_cfg_t *dc = &s->star.meas.dc;
+  const float p = fd_minf(fabsf(dc->b) / fd_maxf(fabsf(dc->a), 1e-12f), 0.5f);
+  float c = 1.0f;
+  for (unsigned k = 0u; k < dc->iterations && k < DFC_ITER_MAX; ++k) {
+    c *= 2.0f * p;
+  }
+  s->star.id.warm2 = c * c;
+}
+
+/* The RLS of a, b (4.51)-(4.57) on this vector at the filter's predicted
+ * angle u, and the IVD's a, b from it, within the guards (header). One
+ * update per refresh of the whole vector (when component a is the newest:
+ * every third period, 5.3 kHz, the thesis's DFC rate): successive updates
+ * then share no sample, as the RLS's independent noise assumes. */
+static bool rls_update(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v,
+                       const sincos_t *u) {
+  rls_ab_t *r = &s->star.id.rls;
+  bool upd = false;
+  if (s->star.meas.miss == 0u && s->star.meas.sig.last == 0u && s->star.pol.aligned &&
+      fabsf(pos_track_omega(s)) > cfg->rls_w_min) {
+    r->cfg = rls_cfg_of(cfg); /* the live tuning, for this update and rls_health */
+    upd = rls_ab_update(r, v->al, v->be, u->c, u->s, v->k);
+  }
+  if (upd) { /* the IVD's a, b move only here (pos_star_update keeps them) */
+    rls_guarded(r, cfg, &s->star.meas.dc);
+    warm_gain(s);
+  }
+  return upd;
+}
+
+/* The RLS's health (rls_ok), after each update: its a and b have settled
+ * within the band, each of them
+ *   steady: the distance it still has to go within POS_DFC_RLS_BAND:
+ *     its distance from its own low-pass over the updates (1 /
+ *     POS_DFC_RLS_AVG updates; from 0 at the start: no update, no
+ *     information, not settled) is the rate it moves at times that lag,
+ *     and an RLS at its covariance P converges with a time constant of
+ *     about 1 + R / P updates (gain P / (P + R)): the distance left is the
+ *     rate times that time constant when it is the longer,
+ *   known: twice the standard deviation its covariance states, sqrt(2 P)
+ *     (the floor-limited RLS's estimate has a variance of about P / 2),
+ *     within the band (a small b against the floor: p too small),
+ * and neither held at the IVD's guards (rls_guarded). A bias the model
+ * itself carries is not seen (docs/dfc.md). */
+#define POS_DFC_RLS_BAND 0.05f       /* issue 23 point 5: the 5 % band */
+#define POS_DFC_RLS_AVG  0.00390625f /* 1/256 per update: 48 ms at 5.3 kHz */
+static bool rls_health(pos_state_t *s, const drive_config_t *cfg) {
+  const rls_ab_t *r = &s->star.id.rls;
+  bool ok = true;
+  for (unsigned j = 0u; j < 2u; ++j) {
+    s->star.id.avg[j] += POS_DFC_RLS_AVG * (r->x[j] - s->star.id.avg[j]);
+    const float tol = POS_DFC_RLS_BAND * fabsf(r->x[j]);
+    const float pjj = r->p[(size_t)2u * j];
+    const float t_rls = 1.0f + r->cfg.r / pjj; /* updates; P >= p_min > 0 */
+    const float go = fabsf(r->x[j] - s->star.id.avg[j]) * fd_maxf(1.0f, POS_DFC_RLS_AVG * t_rls);
+    ok = ok && go <= tol && 2.0f * pjj <= tol * tol;
+  }
+  const float a0 = fabsf(cfg->dfc_a), am = fabsf(r->x[0]);
+  return ok && am > 0.25f * a0 && am < 4.0f * a0 && fabsf(r->x[1]) < POS_DFC_P_MAX * am;
+}
+
+/* One period: the update, and after one the health (rls_ok) */
+static void rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v,
+                     const sincos_t *u, pos_estimate_t *out) {
+  if (rls_update(s, cfg, v, u)) {
+    out->rls_ok = rls_health(s, cfg);
+  }
+}
+
+/* the warm start's gain at the a, b in force (pos_star_align: once per start) */
+FD_COLD static void rls_aligned(pos_state_t *s) {
+  warm_gain(s);
+}
+
+FD_COLD static const char *rls_check(const drive_config_t *cfg, const char **field) {
+  if (!(cfg->rls_p_min <= cfg->rls_p_max)) {
+    *field = "rls_p_min";
+    return "the RLS covariance limits need rls_p_min <= rls_p_max";
+  }
+  return NULL;
+}
+
+const pos_ident_t pos_ident_rls = {rls_init, rls_step, rls_aligned, rls_check};

@@ -1,0 +1,204 @@
+/*
+ * proc.h - procedures as laws: the drive's start-up procedures (offset
+ * calibration, the encoder's alignment, the held start) behind one table,
+ * beside the law table (ctrl.h), as ODrive makes its calibrations control
+ * laws (PhaseControlLaw, ResistanceMeasurementControlLaw).
+ *
+ * A procedure is a row {name, id, state shown, capabilities, check, wanted,
+ * init, step, abort, publish} (proc_row_t): check says whether a parameter
+ * set and position source can run it (the main loop's validation), wanted
+ * whether the start wants it with that set, init starts
+ * it, step runs one PWM period in the ISR and returns running, done or
+ * failed (with the fault bits), abort stops it (disable, trip), publish
+ * writes its progress and results into the procedure telemetry. Its state
+ * lives in a union (proc_state_t; one procedure runs at a time, as one law
+ * does). A step sees the period through a narrow view (proc_in_t: the
+ * sample, the offset-corrected currents, the voltage available, the
+ * position source's estimate) and asks for a voltage (proc_out_t); the
+ * drive modulates it and writes the pattern through the HAL, as for a
+ * law. Its voltage is bounded by the voltage available (v_max) and its
+ * current by the parameter set's (align_current, i_max), so a procedure
+ * cannot ask for more than the run may; the drive's protections stay in
+ * force while it runs. A procedure hands its result over where it is
+ * used, through its setup's sinks (the current offsets in force, the
+ * position source's reference), when its step returns PROC_DONE.
+ *
+ * The start sequence (proc_start_sequence) is a list of ids: the drive
+ * runs each row that applies (wanted, and its check passes: proc_applies)
+ * in turn, the gates coming on before the first that modulates, then the
+ * law; the sequence lists the gates-off procedures first.
+ *
+ * Adding a procedure: its module (proc_<name>.c with its row), its state
+ * in proc_state_t, one line in PROC_LIST, and its id in the sequence if
+ * the start runs it (proc.c; docs/architecture.md, "Adding a procedure").
+ * Every function of a procedure is FD_COLD (flash on the board): the ISR
+ * runs it only while it is in force, never in the run.
+ */
+#ifndef FLUXDRIVE_PROC_H
+#define FLUXDRIVE_PROC_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "control/current_ctrl.h"
+#include "drive_config.h"
+#include "hal.h"
+#include "math/frames.h"
+#include "model/machine.h"
+#include "pos_source.h"
+
+/* X(ENUM, name, description): one line per procedure, its row is
+ * proc_<name> (proc_<name>.c). */
+#define PROC_LIST(X)                                                                               \
+  X(OFFSET, offset, "current sensor offsets with the gates off (offset_samples averaged)")         \
+  X(ALIGN, align, "d current along theta = 0 for align_time; an encoder's: damped, until settled") \
+  X(HOLD, hold, "the held start (start_mode 1): angle at standstill, polarity from two d pulses")
+
+#define PROC_ENUM(E, n, d) PROC_##E,
+typedef enum { PROC_LIST(PROC_ENUM) PROC_COUNT } proc_id_t;
+#undef PROC_ENUM
+#define PROC_NONE PROC_COUNT /* no procedure in force */
+
+/* What a step returns. */
+enum { PROC_RUNNING = 0, PROC_DONE = 1, PROC_FAILED = 2 };
+
+/* The procedure telemetry's status (proc_telemetry_t.status). */
+enum {
+  PROC_ST_IDLE = 0, /* none has run since start-up */
+  PROC_ST_RUNNING = 1,
+  PROC_ST_DONE = 2,
+  PROC_ST_FAILED = 3,
+  PROC_ST_ABORTED = 4 /* disabled or tripped by another cause while it ran */
+};
+
+enum {
+  PROC_CAP_GATES = 1u << 0 /* modulates: the gates are on while it runs */
+};
+
+/* Results published like telemetry (drive_telemetry_t.proc): the last
+ * procedure that ran, where it is, what it found. */
+#define PROC_RESULTS 3
+typedef struct {
+  uint8_t id;     /* proc_id_t (PROC_NONE: none yet) */
+  uint8_t status; /* PROC_ST_* */
+  uint8_t phase;  /* the procedure's own phase (the held start's: acquisition, pulses ...) */
+  uint32_t n;     /* periods since it began */
+  uint32_t fault; /* PROC_ST_FAILED: the fault bits it raised */
+  /* its results (0 until found): offset: the three offsets [A]; align:
+   * the angle of the current (the source's reference once done) [rad
+   * electrical], the periods the rotor has been calm; hold: the angle along the
+   * pulses, the north pole's angle [rad electrical], the evidence
+   * (d0 - d1) / mean */
+  float result[PROC_RESULTS];
+} proc_telemetry_t;
+
+/* What every procedure reads, and where it hands its result over (the
+ * drive's, ISR-owned; built by the drive for each call). */
+typedef struct {
+  const drive_config_t *cfg;
+  const machine_t *machine;
+  const pos_source_row_t *pos_src;
+  pos_state_t *pos_st; /* the source: align / hold give it its reference */
+  float *offset;       /* [3] the current offsets in force [A] (offset calibration) */
+  bool gated;          /* the source measures through the DFC window */
+} proc_setup_t;
+
+/* One period as a procedure sees it. */
+typedef struct {
+  const hal_sample_t *s;     /* the sample set as read (raw currents) */
+  ab_t i_ab;                 /* offset-corrected (and window-corrected) currents [A] */
+  float v_max;               /* voltage amplitude it may ask: v_margin x linear range [V] */
+  const pos_estimate_t *pos; /* the position source's estimate this period */
+} proc_in_t;
+
+typedef struct {
+  ab_t v_ab;      /* voltage for the next period [V], |v_ab| <= v_max */
+  bool apply;     /* write the pattern of v_ab (false: nothing written this period) */
+  bool plain;     /* the pattern without the DFC window (a clean sample) */
+  uint32_t fault; /* PROC_FAILED: the fault bits (DRIVE_FAULT_*) */
+} proc_out_t;
+
+/* The encoder's alignment's timing (proc_align.c), from the parameter set:
+ * the damping and when the rotor counts as settled. */
+typedef struct {
+  float kd;            /* the damping: angle of the current per electrical rad/s [s] */
+  float w_calm;        /* settled: |speed| below this [rad/s electrical] ... */
+  uint32_t calm_need;  /* ... for this many periods */
+  uint32_t still_need; /* ... or from the start for this many */
+  uint32_t n_timeout;  /* not settled after this many periods: position fault */
+} proc_align_timing_t;
+
+/* The alignment's state: its timing (proc_align_timing) is derived from
+ * the parameter set at each step, not kept (a start's few ms in flash; the
+ * union stays at the size the drive's layout keeps, drive.h). */
+typedef struct {
+  current_ctrl_t cc; /* the d current's loop (alpha-beta frame at theta = 0) */
+  uint32_t n;        /* periods since it began */
+  uint32_t calm_n;   /* periods the encoder's speed has stayed below w_calm */
+  float phi;         /* the current's angle last period [rad] */
+} proc_align_t;
+
+typedef struct {
+  float acc[3];
+  uint32_t n;
+} proc_offset_t;
+
+typedef struct {
+  uint8_t phase;           /* proc_hold.c: PH_* */
+  uint16_t n;              /* periods into the phase */
+  uint32_t n_all;          /* periods since it began */
+  float theta;             /* the estimate's angle the pulses are applied along [rad] */
+  float theta_out;         /* the north pole's angle found [rad] */
+  float i0;                /* the d current when a pulse began [A] */
+  float di[2];             /* the d current each pulse built, along theta and theta + pi [A] */
+  uint8_t n_pulse, n_zero; /* periods of each pulse and of the way back (proc_hold.c) */
+  dq_t v_prev;             /* the voltage asked last period, in the estimate's frame [V] */
+  bool plain;              /* the pattern without the DFC window (a pulse's clean sample) */
+} proc_hold_t;
+
+typedef union {
+  proc_offset_t offset;
+  proc_align_t align;
+  proc_hold_t hold;
+} proc_state_t;
+
+typedef struct {
+  const char *name;
+  proc_id_t id;
+  uint8_t state; /* the drive state shown while it runs (drive_state_t) */
+  uint32_t caps; /* PROC_CAP_* */
+  /* NULL when the parameter set and source can run it, else why not
+   * (*field: the parameter); NULL check: always */
+  const char *(*check)(const proc_setup_t *su, const char **field);
+  /* whether the start wants it with this set (it may still be unable:
+   * check); NULL: always */
+  bool (*wanted)(const proc_setup_t *su);
+  void (*init)(proc_state_t *st, const proc_setup_t *su);
+  /* one period: PROC_RUNNING, PROC_DONE (result handed over) or
+   * PROC_FAILED (out->fault); writes every field of *out */
+  int (*step)(proc_state_t *st, const proc_setup_t *su, const proc_in_t *in, proc_out_t *out);
+  void (*abort)(proc_state_t *st); /* NULL: nothing to undo */
+  /* progress and results (tm->id and tm->status are the drive's) */
+  void (*publish)(const proc_state_t *st, proc_telemetry_t *tm);
+} proc_row_t;
+
+#define PROC_ROW_DECLARE(E, n, d) extern const proc_row_t proc_##n;
+PROC_LIST(PROC_ROW_DECLARE)
+#undef PROC_ROW_DECLARE
+
+/* The row of a procedure (NULL out of range). */
+const proc_row_t *proc_row(proc_id_t id);
+/* The start: the procedures the drive runs from an enable to the run, in
+ * order (*n of them). */
+const proc_id_t *proc_start_sequence(unsigned *n);
+/* Whether the start runs `id` with this setup: wanted and able (check). */
+bool proc_applies(proc_id_t id, const proc_setup_t *su);
+/* Every procedure of the start that is wanted must be able: NULL, or the
+ * first refusal (*field: the parameter). The main loop's validation
+ * (drive_config_usable). */
+const char *proc_start_refusal(const proc_setup_t *su, const char **field);
+
+/* proc_align.c: the alignment's timing for cfg (also the tests'). */
+void proc_align_timing(const drive_config_t *cfg, proc_align_timing_t *t);
+
+#endif /* FLUXDRIVE_PROC_H */

@@ -6,9 +6,9 @@
 # every ISR of both (--isrs all: the whole flux-weakening ramp, current
 # limit, voltage limit and MTPV included). Outputs must agree with this host
 # build's within the stated tolerance. FOC meets issue 24 point 8's limits
-# (mean <= 2000, worst <= 2300 instructions; measured 1480 / 1813 on the
-# ramp): checked as such. PI-DFVC and DB-DFVC do not yet (measured 2107 /
-# 2429 and 2132 / 2448 on the ramp, 2074 / 2358 and 2086 / 2374 on the
+# (mean <= 2000, worst <= 2300 instructions; measured 1466 / 1798 on the
+# ramp): checked as such. PI-DFVC and DB-DFVC do not yet (measured 2091 /
+# 2413 and 2116 / 2432 on the ramp, 2058 / 2342 and 2071 / 2358 on the
 # torque step): held where they are, every mean below 2200 and every worst
 # case below 2600 instructions, and the DB-DFVC worst case at or below 50 %
 # of the 10625-cycle budget in estimated Cortex-M4 cycles (measured 40 %;

@@ -36,7 +36,8 @@ set(FD_FLASH_SOURCES_g474
 # B-G431B-ESC1 (10 KiB CCM SRAM): the drive's ISR body and the law step
 # (add core hot functions by name as long as the link fits).
 set(FD_PLACEMENT_b_g431b_esc1 listed)
-set(FD_CCM_FUNCTIONS_b_g431b_esc1 drive_isr ctrl_step)
+# (ctrl_step is inline in drive_isr since issue 24 point 8's second round)
+set(FD_CCM_FUNCTIONS_b_g431b_esc1 drive_isr)
 
 # Write <dir>/fd_placement.ld for `board`: the input-section rules of the
 # .ccmram output section for libfd_app.a and libfd_core.a.

@@ -89,13 +89,6 @@ void ctrl_reset(ctrl_t *c) {
   c->impl->reset(&c->st);
 }
 
-void ctrl_step(ctrl_t *c, const ctrl_in_t *in, ctrl_out_t *out) {
-  c->impl->step(&c->st, &c->su, in, out);
-  if (!(fd_isfinite(out->v_ref.alpha) && fd_isfinite(out->v_ref.beta))) {
-    out->fault = 1u;
-  }
-}
-
 void ctrl_deadtime_delta(const ctrl_t *c, const ctrl_out_t *out, float delta[3]) {
   const abc_t i = frames_clarke_inv(out->i_pred);
   delta[0] = c->dtc.dt_ratio * deadtime_comp_sign(&c->dtc, i.a);

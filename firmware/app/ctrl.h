@@ -24,6 +24,7 @@
 #include "control/dfvc_sat.h"
 #include "drive_config.h"
 #include "math/fast_trig.h"
+#include "math/fd_math.h"
 #include "math/frames.h"
 #include "model/machine.h"
 #include "signal_row.h"
@@ -67,7 +68,9 @@ typedef struct {
   uint32_t fault;               /* non-zero: the law asks for the gates to be disabled */
   dq_t i_dq;                    /* rotor frame currents [A] */
   ab_t i_pred;                  /* currents expected over the next period [A] */
-  ctrl_telemetry_t tm;
+  /* set by the caller: where the law writes its telemetry, in place (the
+   * drive's published copy: no struct copy per period) */
+  ctrl_telemetry_t *tm;
 } ctrl_out_t;
 
 /* What every law reads: the parameter set and the machine in force (owned
@@ -91,9 +94,16 @@ typedef struct {
   dq_t mtpa_i;  /* its currents [A] */
 } ctrl_foc_t;
 
+/* PI-DFVC and DB-DFVC: one state and one step; the row's init says which
+ * voltage law the step runs (no per-law wrapper call in the ISR). */
+typedef struct {
+  dfvc_t core;
+  dfvc_law_t law; /* DFVC_LAW_PI or DFVC_LAW_DEADBEAT */
+} ctrl_dfvc_t;
+
 typedef union {
   ctrl_foc_t foc;
-  dfvc_t dfvc;
+  ctrl_dfvc_t dfvc;
   dfvc_sat_t dfvc_sat;
 } ctrl_state_t;
 
@@ -111,7 +121,7 @@ typedef struct {
   /* 0, or -1 when the law refuses the parameters (state unusable) */
   int (*init)(ctrl_state_t *s, const ctrl_setup_t *su);
   void (*reset)(ctrl_state_t *s); /* on enable: observers and integrators restart */
-  /* one period; writes every field of *out */
+  /* one period; writes every field of *out, and *out->tm */
   void (*step)(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *in, ctrl_out_t *out);
   /* the law's own signals beyond ctrl_telemetry_t (logs, docs/log-format.md):
    * getters on its ctrl_state_t, read after the ISR; NULL, 0: none */
@@ -147,7 +157,15 @@ const char *ctrl_law_refusal(drive_law_t law, const ctrl_setup_t *su);
 int ctrl_select(ctrl_t *c, drive_law_t law);
 /* Resets the law in force (on enable). */
 void ctrl_reset(ctrl_t *c);
-void ctrl_step(ctrl_t *c, const ctrl_in_t *in, ctrl_out_t *out);
+/* One period of the law in force: its row's step, called directly (an
+ * inline wrapper, no call of its own in the ISR); a non-finite voltage is a
+ * fault whatever the law said. out->tm must point at the telemetry. */
+static inline void ctrl_step(ctrl_t *c, const ctrl_in_t *in, ctrl_out_t *out) {
+  c->impl->step(&c->st, &c->su, in, out);
+  if (!(fd_isfinite(out->v_ref.alpha) && fd_isfinite(out->v_ref.beta))) {
+    out->fault = 1u;
+  }
+}
 /* Predictive dead-time compensation (Rubino 2020, Fig. 8) with the
  * currents the law expects over the period the duties act: the duty
  * change it adds per phase. */

@@ -504,9 +504,10 @@ FD_COLD static FD_NOINLINE uint32_t drive_protect_values(const drive_t *drv, con
  * time before the trip. */
 static void drive_monitor(drive_t *drv, const ctrl_in_t *in, const ctrl_out_t *out) {
   const uint32_t checks = drv->lc_checks; /* in.mode is drv->mode (drive_mode_refresh) */
-  const protect_lc_view_t v = {out->i_dq.d,      out->i_dq.q,     out->tm.torque, in->torque_ref,
-                               out->torque_min,  out->torque_max, out->tm.delta,  out->tm.flux,
-                               out->tm.flux_ref, out->tm.obs_err, checks};
+  const ctrl_telemetry_t *t = out->tm;
+  const protect_lc_view_t v = {out->i_dq.d,     out->i_dq.q,     t->torque, in->torque_ref,
+                               out->torque_min, out->torque_max, t->delta,  t->flux,
+                               t->flux_ref,     t->obs_err,      checks};
   const uint32_t trip = protect_lc_step(&drv->lc, &v);
   if (trip != 0u) {
     drv->tm.lc_cause = trip;
@@ -761,27 +762,34 @@ static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
   in.flux_ref = drv->cmd.flux;
 
   ctrl_out_t out;
+  /* the law writes its telemetry where it is published (also on the
+   * period it faults: what it saw then; the safe state keeps reading the
+   * last good period's flux, law_flux) */
+  out.tm = &drv->tm.law_tm;
   ctrl_step(&drv->ctrl, &in, &out);
   if (out.fault != 0u) {
     drive_trip(drv, DRIVE_FAULT_CONTROL);
     return;
   }
-  const modulation_out_t m = modulation_minmax(out.v_ref, s->v_dc, drv->duty_lo, drv->duty_hi);
+  /* the duties alone: drive_write rebuilds the applied voltage from what
+   * the board will apply */
+  float duty[3];
+  (void)modulation_minmax_duty(out.v_ref, s->v_dc, drv->duty_lo, drv->duty_hi, duty);
   float dtc[3];
   ctrl_deadtime_delta(&drv->ctrl, &out, dtc);
-  drv->v_applied = drive_write(drv, m.duty, dtc, s->v_dc);
+  drv->v_applied = drive_write(drv, duty, dtc, s->v_dc);
   drv->torque_min_avail = out.torque_min;
   drv->torque_max_avail = out.torque_max;
+  drv->law_flux = out.tm->flux;
 
   drive_telemetry_t *tm = &drv->tm;
   tm->i_dq[0] = out.i_dq.d;
   tm->i_dq[1] = out.i_dq.q;
   tm->theta_e = in.theta_e;
   tm->torque_ref = in.torque_ref;
-  tm->torque_est = out.tm.torque;
+  tm->torque_est = out.tm->torque;
   drv->pos.in.i_q = out.i_dq.q;
-  drv->pos.in.torque = out.tm.torque;
-  tm->law_tm = out.tm;
+  drv->pos.in.torque = out.tm->torque;
   drive_monitor(drv, &in, &out);
 }
 
@@ -870,9 +878,10 @@ FD_COLD FD_NOINLINE static void drive_proc_step(drive_t *drv, const float i[3],
   const int res = r->step(&drv->proc_st, &su, &in, &out);
   drv->plain = out.plain;
   if (out.apply) {
-    const modulation_out_t m = modulation_minmax(out.v_ab, s->v_dc, drv->duty_lo, drv->duty_hi);
+    float duty[3];
+    (void)modulation_minmax_duty(out.v_ab, s->v_dc, drv->duty_lo, drv->duty_hi, duty);
     const float none[3] = {0.0f, 0.0f, 0.0f};
-    drv->v_applied = drive_write(drv, m.duty, none, s->v_dc);
+    drv->v_applied = drive_write(drv, duty, none, s->v_dc);
   }
   proc_telemetry_t *t = &drv->tm.proc;
   r->publish(&drv->proc_st, t);
@@ -903,7 +912,7 @@ FD_COLD FD_NOINLINE static void drive_safe(drive_t *drv, const float i[3], const
                                  drv->pos.out.omega,
                                  drv->tm.state == DRIVE_STATE_RUN,
                                  (dq_t){drv->tm.i_dq[0], drv->tm.i_dq[1]},
-                                 drv->tm.law_tm.flux,
+                                 drv->law_flux,
                                  (drv->ctrl.impl->caps & CTRL_CAP_FLUX) != 0u,
                                  &drv->machine,
                                  c->asc_speed,

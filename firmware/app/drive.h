@@ -152,7 +152,10 @@ typedef struct drive_s {
   bool speed_active;
   float speed_torque;                       /* torque reference from the speed loop [N m] */
   float torque_min_avail, torque_max_avail; /* what the law can deliver now */
-  protect_lc_t lc;                          /* the loss-of-control monitor (every run period) */
+  /* the law's flux of the last period it ran without a fault (the safe
+   * state's trapped-flux input; tm.law_tm also holds a faulted period's) */
+  float law_flux;
+  protect_lc_t lc; /* the loss-of-control monitor (every run period) */
   float inv_pole_pairs;
   float v_lin;            /* linear voltage range now [V] */
   float duty_lo, duty_hi; /* duty range: the board's, narrowed by a DFC window */

@@ -52,17 +52,28 @@ FD_COLD static int dfvc_law_init(ctrl_state_t *s, const ctrl_setup_t *su) {
   /* the output rotation: from theta_s(tau+1) to the centre of the interval
    * the voltage acts, t_out after the sample (dfvc.h, rot_advance) */
   d.rot_advance = fd_clampf(su->t_out / cfg->ts - 1.0f, 0.0f, 1.0f);
-  return dfvc_init(&s->dfvc, &d);
+  return dfvc_init(&s->dfvc.core, &d);
+}
+
+FD_COLD static int pi_init(ctrl_state_t *s, const ctrl_setup_t *su) {
+  s->dfvc.law = DFVC_LAW_PI;
+  return dfvc_law_init(s, su);
+}
+
+FD_COLD static int db_init(ctrl_state_t *s, const ctrl_setup_t *su) {
+  s->dfvc.law = DFVC_LAW_DEADBEAT;
+  return dfvc_law_init(s, su);
 }
 
 static void dfvc_law_reset(ctrl_state_t *s) {
-  dfvc_reset(&s->dfvc);
+  dfvc_reset(&s->dfvc.core);
 }
 
-static void dfvc_law_step(dfvc_law_t law, ctrl_state_t *s, const ctrl_setup_t *su,
-                          const ctrl_in_t *in, ctrl_out_t *out) {
+/* Both rows' step: the voltage law their init chose (ctrl_dfvc_t.law). */
+static void dfvc_law_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *in,
+                          ctrl_out_t *out) {
   const dfvc_in_t din = {
-      .law = law,
+      .law = s->dfvc.law,
       .i_ab = in->i_ab,
       .v_ab_applied = in->v_applied,
       .theta_r = in->theta_e,
@@ -72,7 +83,7 @@ static void dfvc_law_step(dfvc_law_t law, ctrl_state_t *s, const ctrl_setup_t *s
       .lambda_ref = in->flux_ref,
   };
   dfvc_out_t d;
-  dfvc_step(&s->dfvc, &din, &d);
+  dfvc_step(&s->dfvc.core, &din, &d);
   out->v_ref = d.v_ab_ref;
   out->i_pred = d.i_ab_mid;
   /* rotor-frame currents: from the law's sin/cos of theta_e unless it
@@ -84,7 +95,7 @@ static void dfvc_law_step(dfvc_law_t law, ctrl_state_t *s, const ctrl_setup_t *s
   out->torque_max = fd_minf(d.torque_max, su->cfg->torque_max);
   out->fault = d.fault;
   /* every field written (no zero-fill call in the ISR) */
-  ctrl_telemetry_t *tm = &out->tm;
+  ctrl_telemetry_t *tm = out->tm; /* where the drive publishes it */
   tm->flux = d.lambda_s;
   tm->flux_ref = d.lambda_ref;
   tm->delta = d.delta; /* the load-angle limit's: taken every ISR */
@@ -98,19 +109,11 @@ static void dfvc_law_step(dfvc_law_t law, ctrl_state_t *s, const ctrl_setup_t *s
   tm->obs_err = d.obs_err;
 }
 
-static void db_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *in, ctrl_out_t *out) {
-  dfvc_law_step(DFVC_LAW_DEADBEAT, s, su, in, out);
-}
-
-static void pi_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *in, ctrl_out_t *out) {
-  dfvc_law_step(DFVC_LAW_PI, s, su, in, out);
-}
-
 const ctrl_law_t ctrl_law_pi_dfvc = {"pi_dfvc",      CTRL_CAP_FLUX | CTRL_CAP_DELTA,
-                                     dfvc_check,     dfvc_law_init,
-                                     dfvc_law_reset, pi_step,
+                                     dfvc_check,     pi_init,
+                                     dfvc_law_reset, dfvc_law_step,
                                      NULL,           0u};
 const ctrl_law_t ctrl_law_db_dfvc = {"db_dfvc",      CTRL_CAP_FLUX | CTRL_CAP_DELTA,
-                                     dfvc_check,     dfvc_law_init,
-                                     dfvc_law_reset, db_step,
+                                     dfvc_check,     db_init,
+                                     dfvc_law_reset, dfvc_law_step,
                                      NULL,           0u};

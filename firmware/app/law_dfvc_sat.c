@@ -72,7 +72,7 @@ static void dfvc_sat_law_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctr
   out->torque_min = -out->torque_max;
   out->fault = d.fault;
   /* every field written (no zero-fill call in the ISR) */
-  ctrl_telemetry_t *tm = &out->tm;
+  ctrl_telemetry_t *tm = out->tm; /* where the drive publishes it */
   tm->flux = d.lambda_s;
   tm->flux_ref = d.r.lambda_ref;
   tm->delta = 0.0f; /* telemetry only: its readers take it from lam_d, lam_q */

@@ -93,7 +93,7 @@ static void foc_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *i
   }
   /* every field written (no zero-fill call in the ISR): FOC has no flux
    * loop, load angle or observer */
-  ctrl_telemetry_t *tm = &out->tm;
+  ctrl_telemetry_t *tm = out->tm; /* where the drive publishes it */
   tm->flux = sqrtf(flux.d * flux.d + flux.q * flux.q);
   tm->flux_ref = 0.0f;
   tm->delta = 0.0f;

@@ -168,15 +168,42 @@ static void test_board_range(void **state) {
   }
 }
 
+/* The duty-only variant the drive calls gives modulation_minmax()'s duties
+ * bit for bit, and says which case it took: linear, scaled onto the circle,
+ * or the safe middle of the range. */
+static void test_duty_only_same(void **state) {
+  (void)state;
+  const double vmax = 0.95 * VDC / sqrt(3.0);
+  for (int k = 0; k < 360; k += 11) {
+    const double th = k * T_PI / 180.0;
+    for (double amp = 0.1 * vmax; amp < 1.6 * vmax; amp += 0.3 * vmax) {
+      const ab_t v = {(float)(amp * cos(th)), (float)(amp * sin(th))};
+      const modulation_out_t o = modulation_minmax(v, VDC, 0.02f, 0.95f);
+      float d[3];
+      const int r = modulation_minmax_duty(v, VDC, 0.02f, 0.95f, d);
+      for (int x = 0; x < 3; x++) {
+        assert_true(d[x] == o.duty[x]);
+      }
+      assert_int_equal(r, o.saturated ? MODULATION_SCALED : MODULATION_LINEAR);
+    }
+  }
+  float d[3];
+  assert_int_equal(modulation_minmax_duty((ab_t){NAN, 1.0f}, VDC, 0.0f, 1.0f, d), MODULATION_SAFE);
+  assert_int_equal(modulation_minmax_duty((ab_t){3e38f, 3e38f}, VDC, 0.0f, 1.0f, d),
+                   MODULATION_SAFE);
+  assert_int_equal(modulation_minmax_duty((ab_t){1.0f, 1.0f}, 0.0f, 0.0f, 1.0f, d),
+                   MODULATION_SAFE);
+  for (int x = 0; x < 3; x++) {
+    ASSERT_NEAR(d[x], 0.5, 0.0);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_v_max),
-      cmocka_unit_test(test_known_vectors),
-      cmocka_unit_test(test_linear_range_applied),
-      cmocka_unit_test(test_linear_limit),
-      cmocka_unit_test(test_overmodulation),
-      cmocka_unit_test(test_bad_inputs),
-      cmocka_unit_test(test_board_range),
+      cmocka_unit_test(test_v_max),         cmocka_unit_test(test_duty_only_same),
+      cmocka_unit_test(test_known_vectors), cmocka_unit_test(test_linear_range_applied),
+      cmocka_unit_test(test_linear_limit),  cmocka_unit_test(test_overmodulation),
+      cmocka_unit_test(test_bad_inputs),    cmocka_unit_test(test_board_range),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -170,6 +170,14 @@ def test_checks_on_db_dfvc(capsys) -> None:
     assert "FAIL: scen/db_dfvc: worst case 5313 estimated cycles" in capsys.readouterr().out
     # other laws are reported for agreement only
     assert pil.check_runs([run_with("foc", 9000, 9000)], 3000, 50) == 0
+    # every law's mean and worst case (issue 24, point 8)
+    assert pil.check_runs([run_with("foc", 2299, 9000)], None, None, 2200, worst_all=2300) == 0
+    assert pil.check_runs([run_with("foc", 2300, 9000)], None, None, 2201, worst_all=2300) == 1
+    assert "FAIL: scen/foc: worst case 2300 instructions (ISR 7), limit 2300" in \
+        capsys.readouterr().out
+    assert pil.check_runs([run_with("pi_dfvc", 2100, 9000)], None, None, 2000) == 1
+    a = build_parser().parse_args(["pil", "s.json", "--check-worst-all", "2300"])
+    assert a.check_worst_all == 2300
     bad = run_with("foc", 1, 1)
     bad.agreement.duty_bad = 1
     assert pil.check_runs([bad], None, None) == 1

@@ -27,4 +27,13 @@ float modulation_v_max(float v_dc, float d_min, float d_max);
  * and v_applied = 0. */
 modulation_out_t modulation_minmax(ab_t v_ref, float v_dc, float d_min, float d_max);
 
+/* What modulation_minmax_duty() did (its saturated flag: not LINEAR). */
+enum { MODULATION_LINEAR = 0, MODULATION_SCALED = 1, MODULATION_SAFE = 2 };
+/* The duties of modulation_minmax() alone (the same values), for a caller
+ * that rebuilds the applied voltage itself from what the board really
+ * applies (the drive: drive_write): no applied vector computed and thrown
+ * away every period. SAFE: the middle of the range (no usable v_dc or
+ * reference). */
+int modulation_minmax_duty(ab_t v_ref, float v_dc, float d_min, float d_max, float duty[3]);
+
 #endif

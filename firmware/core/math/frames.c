@@ -13,11 +13,10 @@
 
 /* Any input (frames_wrap_pi() calls it beyond one turn either side). */
 float frames_wrap_pi_slow(float theta) {
-  if (!fd_isfinite(theta)) {
-    return 0.0f;
-  }
   /* r = theta - 2 pi floor(t): the floor by a conversion to an integer
-   * (exact, same value as floorf) while |t| < 2^30, floorf beyond */
+   * (exact, same value as floorf) while |t| < 2^30, floorf beyond. A
+   * non-finite theta gives a non-finite t, which fails the first test: its
+   * check is off the usual path (a finite theta always gives a finite t) */
   const float t = (theta + FRAMES_PI) * FRAMES_INV_2PI;
   float fl;
   if (fabsf(t) < 1073741824.0f) {
@@ -27,6 +26,9 @@ float frames_wrap_pi_slow(float theta) {
       fl -= 1.0f;
     }
   } else {
+    if (!fd_isfinite(theta)) {
+      return 0.0f;
+    }
     fl = floorf(t);
   }
   float r = theta - FRAMES_2PI * fl;

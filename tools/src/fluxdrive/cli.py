@@ -256,6 +256,8 @@ def build_parser() -> argparse.ArgumentParser:
                    "(e.g. docs/benchmarks.md)")
     p.add_argument("--check-worst", type=_positive_int, metavar="N",
                    help="fail when the DB-DFVC worst case reaches N instructions")
+    p.add_argument("--check-worst-all", type=_positive_int, metavar="N",
+                   help="fail when any run's worst case (every law) reaches N instructions")
     p.add_argument("--check-mean", type=_positive_int, metavar="N",
                    help="fail when a run's mean reaches N instructions per law ISR")
     p.add_argument("--check-mean-cordic", type=_positive_int, metavar="N",

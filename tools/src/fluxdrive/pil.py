@@ -826,7 +826,8 @@ def main(args) -> int:
         update_markdown(Path(args.markdown), md)
         print(f"markdown: {args.markdown} (section '{SECTION[3:]}')")
     rc = check_runs(runs, args.check_worst, getattr(args, "check_cycles", None),
-                    getattr(args, "check_mean", None), getattr(args, "check_call", None))
+                    getattr(args, "check_mean", None), getattr(args, "check_call", None),
+                    getattr(args, "check_worst_all", None))
     lim = getattr(args, "check_mean_cordic", None)
     if lim:
         for r in runs:
@@ -856,12 +857,14 @@ def parse_call_limits(items: list[str] | None) -> dict[str, float]:
 
 
 def check_runs(runs: list[PilRun], worst_instr: int | None, worst_pct: float | None,
-               mean_instr: int | None = None, call_limits: list[str] | None = None) -> int:
+               mean_instr: int | None = None, call_limits: list[str] | None = None,
+               worst_all: int | None = None) -> int:
     """Agreement and exact trace for every run; with limits, the DB-DFVC
     worst case: fewer than ``worst_instr`` instructions and at most
     ``worst_pct`` % of the cycle budget (estimated); every run's mean below
-    ``mean_instr``; each FUNC of ``call_limits`` (FUNC=N) at most N
-    instructions per call, callees included. Prints; 1 on failure."""
+    ``mean_instr`` and worst case below ``worst_all`` (every law); each
+    FUNC of ``call_limits`` (FUNC=N) at most N instructions per call,
+    callees included. Prints; 1 on failure."""
     rc = 0
     limits = parse_call_limits(call_limits)
     for r in runs:
@@ -882,6 +885,11 @@ def check_runs(runs: list[PilRun], worst_instr: int | None, worst_pct: float | N
             ok = r.counts.mean < mean_instr
             print(f"{'check' if ok else 'FAIL'}: {name}: mean {r.counts.mean:.0f} instructions, "
                   f"limit {mean_instr}")
+            rc |= 0 if ok else 1
+        if worst_all:
+            ok = r.counts.worst < worst_all
+            print(f"{'check' if ok else 'FAIL'}: {name}: worst case {r.counts.worst} instructions "
+                  f"(ISR {r.counts.worst_isr}), limit {worst_all}")
             rc |= 0 if ok else 1
         if r.law != "db_dfvc":
             continue

@@ -178,9 +178,11 @@ static inline void dfc_clarke(const float x[3], float *al, float *be) {
 /* The standard DFC's / IVD's / Full IVD's estimate (3.8) / (3.98) (from_raw:
  * from zeta, trace[0..1] the raw one) or, from the start *ur, *ui, the
  * iterations (3.76) / (3.100) alone (c->iterations of them, IVD methods):
- * dfc_vector2 and dfc_ivd_from share it. */
-static bool ivd_run(const dfc_cfg_t *c, const dfc_vec_t *v, float i_q, bool from_raw, float *ur,
-                    float *ui, float *trace) {
+ * dfc_vector2 and dfc_ivd_from share it, inlined: each call of the ISR
+ * (the warm start's dfc_ivd_from every period) without the other's branch. */
+static inline __attribute__((always_inline)) bool ivd_run(const dfc_cfg_t *c, const dfc_vec_t *v,
+                                                          float i_q, bool from_raw, float *ur,
+                                                          float *ui, float *trace) {
   const float inv_a = 1.0f / c->a;
   const float zr = -v->al * inv_a, zi = v->be * inv_a; /* zeta = e^{j2th} - p e^{-j4th} */
   const bool full = c->method == DFC_FULL_IVD;

@@ -133,7 +133,8 @@ typedef union {
  * how the angle is measured, what tracks it, what identifies the model
  * online. Rows: pos_sources.c; adding one: docs/architecture.md. */
 typedef struct pos_source_row_s {
-  uint32_t caps; /* POS_CAP_* */
+  uint32_t caps;      /* POS_CAP_* */
+  unsigned n_signals; /* the number of signals (below); beside caps: no padding */
   void (*init)(pos_state_t *s, const drive_config_t *cfg);
   void (*reset)(pos_state_t *s);
   void (*update)(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp, pos_io_t *io);
@@ -151,7 +152,6 @@ typedef struct pos_source_row_s {
   /* the source's own signals (logs, docs/log-format.md): getters on its
    * pos_state_t, read after the ISR; NULL, 0: none */
   const signal_row_t *signals;
-  unsigned n_signals;
   /* the star point's columns (pos_star.h) */
   const pos_method_t *method;   /* DFC, inverse DFC, IVD (Full IVD with phase shifts) */
   const pos_tracker_t *tracker; /* PLL, Kalman filter, EKF */

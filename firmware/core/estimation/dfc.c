@@ -87,7 +87,7 @@ void dfc_vec_plain(const float g[3], dfc_vec_t *v) {
 
 /* cos, sin of a small angle (|x| < 0.5 rad: within 3e-5) by their series
  * to the fourth / fifth order: no libm in the ISR */
-static inline void dfc_turn(float x, float *c, float *s) {
+static inline __attribute__((always_inline)) void dfc_turn(float x, float *c, float *s) {
   const float x2 = x * x;
   *c = 1.0f - 0.5f * x2 * (1.0f - x2 * (1.0f / 12.0f));
   *s = x * (1.0f - x2 * (1.0f / 6.0f) * (1.0f - x2 * (1.0f / 20.0f)));
@@ -96,19 +96,25 @@ static inline void dfc_turn(float x, float *c, float *s) {
 void dfc_signals_vector(const dfc_signals_t *s, float w2, dfc_vec_t *v) {
   /* phase axes c_x of the amplitude-invariant Clarke transform */
   static const float cx[3][2] = {{1.0f, 0.0f}, {-0.5f, 0.86602540f}, {-0.5f, -0.86602540f}};
-  const float t_new = s->t[s->last];
-  float a11 = 0.0f, a12 = 0.0f, a22 = 0.0f, r1 = 0.0f, r2 = 0.0f;
-  float b11 = 0.0f, b12 = 0.0f, b21 = 0.0f, b22 = 0.0f;
-  for (int x = 0; x < 3; ++x) {
+  /* the newest component is not turned (phi = 0: d = e = c_x): its terms
+   * c_x c_x^T of A and B are constants (c_x0^2, c_x0 c_x1, c_x1^2), the
+   * sums start from them and the loop runs over the two held ones only */
+  static const float cc[3][3] = {
+      {1.0f, 0.0f, 0.0f}, {0.25f, -0.43301270f, 0.75000000f}, {0.25f, 0.43301270f, 0.75000000f}};
+  const unsigned l = s->last;
+  const float t_new = s->t[l];
+  float a11 = cc[l][0], a12 = cc[l][1], a22 = cc[l][2];
+  float r1 = cx[l][0] * s->g[l], r2 = cx[l][1] * s->g[l];
+  float b11 = a11, b12 = a12, b21 = a12, b22 = a22;
+  for (unsigned j = 1u; j < 3u; ++j) {
+    const unsigned x = l + j < 3u ? l + j : l + j - 3u;
     /* phi = 2 omega_e (t_new - t_x): the 2theta term was e^{+j phi} ahead,
      * so Gamma_x projects it on c_x e^{-j phi} (d); the 4theta term was
      * e^{-j2phi} behind: on c_x e^{+j2phi} (e) */
     const float phi = w2 * (t_new - s->t[x]);
-    float co = 1.0f, si = 0.0f, co2 = 1.0f, si2 = 0.0f; /* the newest: not turned */
-    if (x != (int)s->last) {
-      dfc_turn(-phi, &co, &si);
-      dfc_turn(2.0f * phi, &co2, &si2);
-    }
+    float co, si, co2, si2;
+    dfc_turn(-phi, &co, &si);
+    dfc_turn(2.0f * phi, &co2, &si2);
     const float d1 = cx[x][0] * co - cx[x][1] * si, d2 = cx[x][0] * si + cx[x][1] * co;
     const float e1 = cx[x][0] * co2 - cx[x][1] * si2, e2 = cx[x][0] * si2 + cx[x][1] * co2;
     a11 += d1 * d1;
@@ -172,9 +178,11 @@ static inline void dfc_clarke(const float x[3], float *al, float *be) {
 /* The standard DFC's / IVD's / Full IVD's estimate (3.8) / (3.98) (from_raw:
  * from zeta, trace[0..1] the raw one) or, from the start *ur, *ui, the
  * iterations (3.76) / (3.100) alone (c->iterations of them, IVD methods):
- * dfc_vector2 and dfc_ivd_from share it. */
-static bool ivd_run(const dfc_cfg_t *c, const dfc_vec_t *v, float i_q, bool from_raw, float *ur,
-                    float *ui, float *trace) {
+ * dfc_vector2 and dfc_ivd_from share it, inlined: each call of the ISR
+ * (the warm start's dfc_ivd_from every period) without the other's branch. */
+static inline __attribute__((always_inline)) bool ivd_run(const dfc_cfg_t *c, const dfc_vec_t *v,
+                                                          float i_q, bool from_raw, float *ur,
+                                                          float *ui, float *trace) {
   const float inv_a = 1.0f / c->a;
   const float zr = -v->al * inv_a, zi = v->be * inv_a; /* zeta = e^{j2th} - p e^{-j4th} */
   const bool full = c->method == DFC_FULL_IVD;

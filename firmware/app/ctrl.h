@@ -21,7 +21,7 @@
 #include "control/current_ctrl.h"
 #include "control/deadtime_comp.h"
 #include "control/dfvc.h"
-#include "control/dfvc_sat.h"
+#include "control/dfvc_decoupled.h"
 #include "drive_config.h"
 #include "math/fast_trig.h"
 #include "math/fd_math.h"
@@ -104,7 +104,7 @@ typedef struct {
 typedef union {
   ctrl_foc_t foc;
   ctrl_dfvc_t dfvc;
-  dfvc_sat_t dfvc_sat;
+  dfvc_decoupled_t dfvc_decoupled;
 } ctrl_state_t;
 
 enum {

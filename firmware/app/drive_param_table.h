@@ -112,11 +112,11 @@
     "PI-DFVC flux-loop bandwidth")                                                                          \
   X(36, dfvc_iqs_bw,    F32,  "rad/s",  6283.1853f,  1.0f,    1e5f,     IDLE, "controller.dfvc_iqs_bw",    \
     "PI-DFVC i_qs-loop bandwidth")                                                                          \
-  X(52, dfvc_sat_bw,    F32,  "rad/s",  628.31853f,  1.0f,    1e5f,     IDLE, "controller.dfvc_sat_bw",    \
+  X(52, dfvc_decoupled_bw,    F32,  "rad/s",  628.31853f,  1.0f,    1e5f,     IDLE, "controller.dfvc_decoupled_bw",    \
     "decoupled DFVC: bandwidth Omega of both loops, k_p = 2 Omega, k_i = Omega^2 (Varatharajan 2022 (28))") \
-  X(53, dfvc_sat_gains, U16,  "",       0.0f,        0.0f,    2.0f,     IDLE, "controller.dfvc_sat_gains", \
+  X(53, dfvc_decoupled_gains, U16,  "",       0.0f,        0.0f,    2.0f,     IDLE, "controller.dfvc_decoupled_gains", \
     "decoupled DFVC gain set: 0 proposed (a, b) (22), 1 state of the art (a', b') (17), 2 constant-gain PI (26)") \
-  X(54, dfvc_sat_refs,  U16,  "",       1.0f,        0.0f,    1.0f,     IDLE, "controller.dfvc_sat_refs",  \
+  X(54, dfvc_decoupled_refs,  U16,  "",       1.0f,        0.0f,    1.0f,     IDLE, "controller.dfvc_decoupled_refs",  \
     "decoupled DFVC references: 0 the flux map's MTPA/MTPV tables (29)-(31), 1 online (32), (34)")       \
   X(55, sat_obs_g,      F32,  "rad/s",  31.415927f,  0.0f,    1e5f,     IDLE, "controller.sat_obs_g",      \
     "decoupled DFVC: hybrid flux observer gain g (Varatharajan 2022 (24))")                                \

@@ -37,7 +37,7 @@ def _bw_check(res, fs):
         # decoupled: through the flux step i_tau follows its own reference
         # (-5 % with 1/lambda*) as the i_tau loop would; without the a term
         # of (23) the residual of that fit is several times larger at rated
-        # and limit loads (mutant dfvc_sat_no_decoupling_a, docs/mutation.md)
+        # and limit loads (mutant dfvc_decoupled_no_decoupling_a, docs/mutation.md)
         if p.load != "light":
             assert p.cross.rms < 0.08, tag
         # static: where the response settles against the reference

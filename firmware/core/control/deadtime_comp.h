@@ -10,7 +10,7 @@
  * gives the hard sign). Positive current flows from the inverter into the
  * machine; with it, the dead time loses volts, so the duty is raised.
  * With dfvc.h, i_pred is frames_clarke_inv(out.i_ab_mid), the mean of the
- * currents predicted at tau+1 and tau+2; with dfvc_sat.h, the references'
+ * currents predicted at tau+1 and tau+2; with dfvc_decoupled.h, the references'
  * current (a compensation on the measured current feeds back through its
  * sign near zero current: docs/faults.md, issue 23 point 17).
  */

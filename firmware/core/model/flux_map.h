@@ -69,7 +69,7 @@ flux_map_ldq_t flux_map_inductance(const flux_map_t *m, dq_t i);
  * to it: the centred difference over one step on a bilinear map is the
  * slopes of the two cells the window covers, weighted by its share in
  * each. 16 table words instead of the 40 of five lookups (the ISR of the
- * decoupled DFVC, control/dfvc_sat.h). */
+ * decoupled DFVC, control/dfvc_decoupled.h). */
 dq_t flux_map_flux_inductance(const flux_map_t *m, dq_t i, flux_map_ldq_t *l);
 /* i_dq(lambda_dq) [A]: Newton on the bilinear map (FLUX_MAP_NEWTON steps
  * from the zero-current linearisation, each with the interpolant's own

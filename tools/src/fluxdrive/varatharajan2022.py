@@ -310,8 +310,8 @@ def bandwidth_point(sil, root, out, tab, fs, omega, gains, speed, load) -> BwPoi
     sign = -1.0 if load == "limit" else 1.0
     dt = min(STEP * PAPER.torque_rated, 0.2 * t_op)  # small against the operating point too
     c = sc["controller"]
-    c["dfvc_sat_bw"] = omega
-    c["dfvc_sat_gains"] = gains
+    c["dfvc_decoupled_bw"] = omega
+    c["dfvc_decoupled_gains"] = gains
     sc["inverter"]["pwm_frequency"] = fs
     sc["mechanics"]["speed"]["terms"][0]["value"] = speed
     # ramps to the operating point (a step of the flux from zero at speed
@@ -365,7 +365,7 @@ class RobustSeg:
 
 def robustness(sil, root, out, tab, fs: float, gains: int) -> tuple[Run, list]:
     sc = copy.deepcopy(base(root, "robustness"))
-    sc["controller"]["dfvc_sat_gains"] = gains
+    sc["controller"]["dfvc_decoupled_gains"] = gains
     sc["inverter"]["pwm_frequency"] = fs
     r = run(sil, sc, out, f"robust_{int(fs)}_{gains}")
     lg = r.log
@@ -822,7 +822,7 @@ def linear_machine(sil, root, out) -> Run:
           "mechanics": {"mode": "imposed", "speed": {"unit": "rpm", "terms": [
               {"type": "const", "value": 100}]}},
           "sensors": {"encoder_cpr": 0},
-          "controller": {"law": "dfvc_decoupled", "mode": "torque", "dfvc_sat_refs": 1,
+          "controller": {"law": "dfvc_decoupled", "mode": "torque", "dfvc_decoupled_refs": 1,
                          "flux_min": 0.1},
           "references": {"torque": [{"type": "step", "t": 0.1, "value": 10.0}]},
           "board": {"preset": "ideal"}}

@@ -1,6 +1,6 @@
 /*
- * ref_dfvc_sat_pi.cpp - Eigen (double) reference of the regulators of the
- * decoupled DFVC (control/dfvc_sat_pi.h, Varatharajan 2022 (26)-(28)):
+ * ref_dfvc_decoupled_pi.cpp - Eigen (double) reference of the regulators of the
+ * decoupled DFVC (control/dfvc_decoupled_pi.h, Varatharajan 2022 (26)-(28)):
  *  - the gains: the closed loop of each axis, y(k+1) = y(k) + Ts u(k) with
  *    u = kp e + I, I += ki Ts e, written as a 2x2 state matrix in double
  *    with the float core's kp, ki, has its two eigenvalues at
@@ -29,7 +29,7 @@ extern "C" {
 
 #include <cmocka.h>
 
-#include "control/dfvc_sat_pi.h"
+#include "control/dfvc_decoupled_pi.h"
 }
 
 namespace {
@@ -40,9 +40,9 @@ void test_double_pole(void **state) {
   for (int n = 0; n < 200; ++n) {
     const double ts = (n % 2) ? 2e-4 : 6.25e-5;
     const double omega = 10.0 + 50.0 * n; /* Omega Ts up to 2 */
-    dfvc_sat_pi_t c;
-    const dfvc_sat_pi_cfg_t cfg = {static_cast<float>(ts), static_cast<float>(omega), 1e4f};
-    assert_int_equal(dfvc_sat_pi_init(&c, &cfg), 0);
+    dfvc_decoupled_pi_t c;
+    const dfvc_decoupled_pi_cfg_t cfg = {static_cast<float>(ts), static_cast<float>(omega), 1e4f};
+    assert_int_equal(dfvc_decoupled_pi_init(&c, &cfg), 0);
     /* state (y, I): e = -y (r = 0); I' = I - ki Ts y; y' = y + Ts (-kp y + I') */
     const double kp = c.kp, ki = c.ki;
     Eigen::Matrix2d a;
@@ -62,7 +62,7 @@ struct Ref {
   double kp, ki, ts, vfmax;
   double integ_f = 0.0, integ_t = 0.0, u_t_prev = 0.0;
 
-  Eigen::Vector2d step(const dfvc_sat_pi_in_t &in) {
+  Eigen::Vector2d step(const dfvc_decoupled_pi_in_t &in) {
     const double itau_pred = in.i_ft.q + ts * u_t_prev;
     const double e_f = in.lambda_ref - in.lambda_next;
     const double e_t = in.itau_ref - itau_pred;
@@ -102,14 +102,14 @@ void test_step_against_eigen(void **state) {
   for (int run = 0; run < 200; ++run) {
     const float ts = (run % 2) ? 2e-4f : 6.25e-5f;
     const float omega = static_cast<float>(2 * 3.14159265 * (50.0 + 250.0 * u01(rng)));
-    dfvc_sat_pi_t c;
-    const dfvc_sat_pi_cfg_t cfg = {ts, omega, (run % 3) ? 1e4f : 60.0f};
-    assert_int_equal(dfvc_sat_pi_init(&c, &cfg), 0);
+    dfvc_decoupled_pi_t c;
+    const dfvc_decoupled_pi_cfg_t cfg = {ts, omega, (run % 3) ? 1e4f : 60.0f};
+    assert_int_equal(dfvc_decoupled_pi_init(&c, &cfg), 0);
     Ref r{c.kp, c.ki, ts, cfg.v_f_max};
     const float a = static_cast<float>(10.0 * u01(rng));
     const float b = static_cast<float>(2.0 + 40.0 * u01(rng));
     for (int k = 0; k < 500; ++k) {
-      dfvc_sat_pi_in_t in;
+      dfvc_decoupled_pi_in_t in;
       in.lambda_ref = static_cast<float>(0.2 + u01(rng));
       in.itau_ref = static_cast<float>(4.0 * (2.0 * u01(rng) - 1.0));
       in.lambda_next = in.lambda_ref + static_cast<float>(0.02 * (2.0 * u01(rng) - 1.0));
@@ -119,8 +119,8 @@ void test_step_against_eigen(void **state) {
       in.rs = 6.8f;
       in.g = {a, b};
       in.v_max = static_cast<float>(50.0 + 300.0 * u01(rng));
-      dfvc_sat_pi_out_t out;
-      dfvc_sat_pi_step(&c, &in, &out);
+      dfvc_decoupled_pi_out_t out;
+      dfvc_decoupled_pi_step(&c, &in, &out);
       const Eigen::Vector2d v = r.step(in);
       saturated += out.sat != 0u;
       const double scale = 1.0 + std::abs(v(0)) + std::abs(v(1));

@@ -1,5 +1,5 @@
 /*
- * test_dfvc_sat.c - the blocks of the decoupled DFVC of Varatharajan 2022:
+ * test_dfvc_decoupled.c - the blocks of the decoupled DFVC of Varatharajan 2022:
  * the stator-flux-frame model (6)-(10), (17), (22), (23) against hand
  * values and identities; the regulators (26)-(28) against the discrete
  * closed loop they are designed for; the references (29)-(34).
@@ -12,7 +12,7 @@
 #include <cmocka.h>
 #include <math.h>
 
-#include "control/dfvc_sat.h"
+#include "control/dfvc_decoupled.h"
 #include "../core/flux_map_fixture.h"
 
 /* An interior-PM machine in the fluxdrive frame (PM on d, Lq > Ld). */
@@ -88,7 +88,7 @@ static void test_transform_roundtrip(void **st) {
 }
 
 /* (7) vanishes on the MTPA trajectory of the linear IPM (closed form in
- * machine_mtpa_current) and, with the sign used by (32) (dfvc_sat_refs.h),
+ * machine_mtpa_current) and, with the sign used by (32) (dfvc_decoupled_refs.h),
  * is positive where the flux is above the MTPA flux for the torque, for
  * both torque signs. */
 static void test_mtpa_condition(void **st) {
@@ -155,9 +155,9 @@ static void test_mtpv_condition(void **st) {
  * step response rises faster and then creeps. */
 static double pi_step_run(float b_ratio, int axis, double *y_at) {
   const float ts = 2e-4f, omega = 628.3185f;
-  dfvc_sat_pi_t c;
-  const dfvc_sat_pi_cfg_t cfg = {ts, omega, 1e4f};
-  assert_int_equal(dfvc_sat_pi_init(&c, &cfg), 0);
+  dfvc_decoupled_pi_t c;
+  const dfvc_decoupled_pi_cfg_t cfg = {ts, omega, 1e4f};
+  assert_int_equal(dfvc_decoupled_pi_init(&c, &cfg), 0);
   const sfo_gains_t g = {6.0f, 25.0f};
   const sfo_gains_t gh = {6.0f, 25.0f / b_ratio};
   double lam = 0.8, itau = 2.0, lam_next = 0.8;
@@ -167,10 +167,10 @@ static double pi_step_run(float b_ratio, int axis, double *y_at) {
   for (int k = 0; k < 200; ++k) {
     const float lr = (float)(0.8 + (axis == 0 ? 0.01 : 0.0));
     const float ir = (float)(2.0 + (axis == 1 ? 0.05 : 0.0));
-    const dfvc_sat_pi_in_t in = {lr, ir,  (float)lam_next, (dq_t){0.0f, (float)itau}, 0.0f, 0.0f,
-                                 gh, 1e4f};
-    dfvc_sat_pi_out_t out;
-    dfvc_sat_pi_step(&c, &in, &out);
+    const dfvc_decoupled_pi_in_t in = {
+        lr, ir, (float)lam_next, (dq_t){0.0f, (float)itau}, 0.0f, 0.0f, gh, 1e4f};
+    dfvc_decoupled_pi_out_t out;
+    dfvc_decoupled_pi_step(&c, &in, &out);
     /* plant over [k, k+1) with the voltage computed last period */
     const double uf = v_pend.d, ut = v_pend.q;
     lam += ts * uf;
@@ -220,16 +220,16 @@ static void test_refs_lut(void **st) {
   assert_int_equal(flux_map_parse(&map, blob, (uint32_t)sizeof blob, &fs), 0);
   machine_t m;
   assert_int_equal(machine_init_map(&m, 1.0f, &map), 0);
-  dfvc_sat_refs_t r;
-  const dfvc_sat_refs_cfg_t cfg = {
-      &m, DFVC_SAT_REFS_LUT, 2e-4f, 5.0f, 0.1f, 0.9f, 0.9f, 60.0f, 0.0f, 2.0f};
-  assert_int_equal(dfvc_sat_refs_init(&r, &cfg), 0);
-  dfvc_sat_refs_in_t in = {0};
+  dfvc_decoupled_refs_t r;
+  const dfvc_decoupled_refs_cfg_t cfg = {
+      &m, DFVC_DECOUPLED_REFS_LUT, 2e-4f, 5.0f, 0.1f, 0.9f, 0.9f, 60.0f, 0.0f, 2.0f};
+  assert_int_equal(dfvc_decoupled_refs_init(&r, &cfg), 0);
+  dfvc_decoupled_refs_in_t in = {0};
   in.torque_ref = 3.0f;
   in.omega_r = 10.0f;
   in.v_lin = 200.0f;
-  dfvc_sat_refs_out_t o;
-  dfvc_sat_refs_update(&r, &in, &o);
+  dfvc_decoupled_refs_out_t o;
+  dfvc_decoupled_refs_update(&r, &in, &o);
   assert_float_equal(o.lambda_ref, flux_map_mtpa_flux(&map, 3.0f), 1e-6f);
   assert_float_equal(o.itau_ref, 3.0f / (1.5f * map.pole_pairs * o.lambda_ref), 1e-5f);
   /* flux weakening: (30) with the resistive drop, its current low-passed
@@ -237,32 +237,32 @@ static void test_refs_lut(void **st) {
    * 0.2 s (twenty time constants) it is there */
   in.omega_r = 1000.0f;
   in.i_amp = 2.0f;
-  dfvc_sat_refs_update(&r, &in, &o);
+  dfvc_decoupled_refs_update(&r, &in, &o);
   assert_float_equal(o.lambda_ref, (0.9f * 200.0f - 1.0f * 2.0f * 2e-4f / 0.0102f) / 1000.0f,
                      1e-6f);
   for (int k = 0; k < 1000; ++k) {
-    dfvc_sat_refs_update(&r, &in, &o);
+    dfvc_decoupled_refs_update(&r, &in, &o);
   }
   assert_float_equal(o.lambda_ref, (0.9f * 200.0f - 1.0f * 2.0f) / 1000.0f, 1e-6f);
-  assert_true(o.limits & DFVC_SAT_REFS_FLUX_VLIM);
+  assert_true(o.limits & DFVC_DECOUPLED_REFS_FLUX_VLIM);
   assert_float_equal(o.torque_mtpv, 0.9f * flux_map_mtpv_torque(&map, o.lambda_ref), 1e-5f);
   /* current limit: i_f = 4 of 5 A leaves 3 A for i_tau */
   in.omega_r = 10.0f;
   in.torque_ref = 50.0f;
   in.i_f = 4.0f;
-  dfvc_sat_refs_update(&r, &in, &o);
+  dfvc_decoupled_refs_update(&r, &in, &o);
   assert_true(fabsf(o.itau_ref) <= 3.0f + 1e-5f);
   in.torque_ref = 6.0f;
   in.i_f = 4.9f;
-  dfvc_sat_refs_update(&r, &in, &o);
+  dfvc_decoupled_refs_update(&r, &in, &o);
   assert_float_equal(fabsf(o.itau_ref), sqrtf(25.0f - 4.9f * 4.9f), 1e-5f);
-  assert_true(o.limits & DFVC_SAT_REFS_IMAX);
+  assert_true(o.limits & DFVC_DECOUPLED_REFS_IMAX);
   /* bad: LUT without a map */
   machine_t lin;
   assert_int_equal(machine_init_linear(&lin, 2.0f, 1.0f, 0.1f, 0.3f, 0.0f), 0);
-  dfvc_sat_refs_cfg_t bad = cfg;
+  dfvc_decoupled_refs_cfg_t bad = cfg;
   bad.machine = &lin;
-  assert_int_equal(dfvc_sat_refs_init(&r, &bad), -1);
+  assert_int_equal(dfvc_decoupled_refs_init(&r, &bad), -1);
 }
 
 /* Online MTPA (32): the flux falls while (7) is positive (flux above MTPA),
@@ -270,38 +270,38 @@ static void test_refs_lut(void **st) {
 static void test_refs_online(void **st) {
   (void)st;
   setup_ipm();
-  dfvc_sat_refs_t r;
-  const dfvc_sat_refs_cfg_t cfg = {
-      &ipm, DFVC_SAT_REFS_ONLINE, 2e-4f, 5.0f, 0.1f, 0.9f, 0.9f, 60.0f, 0.0f, 2.0f};
-  assert_int_equal(dfvc_sat_refs_init(&r, &cfg), 0);
-  dfvc_sat_refs_in_t in = {0};
+  dfvc_decoupled_refs_t r;
+  const dfvc_decoupled_refs_cfg_t cfg = {
+      &ipm, DFVC_DECOUPLED_REFS_ONLINE, 2e-4f, 5.0f, 0.1f, 0.9f, 0.9f, 60.0f, 0.0f, 2.0f};
+  assert_int_equal(dfvc_decoupled_refs_init(&r, &cfg), 0);
+  dfvc_decoupled_refs_in_t in = {0};
   in.omega_r = 10.0f;
   in.v_lin = 200.0f;
   in.adapt = 1;
   in.lambda_hat = 0.1f;
   in.mtpa_cross = -1.0f;
   in.i_tau = 0.0f; /* no torque: (7) degenerate, the flux holds */
-  dfvc_sat_refs_out_t o0;
-  dfvc_sat_refs_update(&r, &in, &o0);
+  dfvc_decoupled_refs_out_t o0;
+  dfvc_decoupled_refs_update(&r, &in, &o0);
   assert_float_equal(o0.lambda_mtpa, 0.1f, 1e-7f);
-  dfvc_sat_refs_reset(&r);
+  dfvc_decoupled_refs_reset(&r);
   in.i_tau = 1.0f;
-  dfvc_sat_refs_out_t o;
+  dfvc_decoupled_refs_out_t o;
   for (int k = 0; k < 10; ++k) {
-    dfvc_sat_refs_update(&r, &in, &o);
+    dfvc_decoupled_refs_update(&r, &in, &o);
     in.lambda_hat = o.lambda_ref;
   }
   assert_float_equal(o.lambda_mtpa, 0.1f + 10.0f * 2e-4f * 60.0f, 1e-4f);
   const float up = o.lambda_mtpa;
   in.mtpa_cross = 1.0f;
-  dfvc_sat_refs_update(&r, &in, &o);
+  dfvc_decoupled_refs_update(&r, &in, &o);
   assert_true(o.lambda_mtpa < up);
   /* in flux weakening (lambda_max below) it holds */
   in.omega_r = 2000.0f;
   in.mtpa_cross = -1.0f;
-  dfvc_sat_refs_update(&r, &in, &o);
+  dfvc_decoupled_refs_update(&r, &in, &o);
   const float held = r.lambda_mtpa;
-  dfvc_sat_refs_update(&r, &in, &o);
+  dfvc_decoupled_refs_update(&r, &in, &o);
   assert_float_equal(r.lambda_mtpa, held, 1e-7f);
 }
 
@@ -317,30 +317,30 @@ static void test_refs_online(void **st) {
 static void test_deadtime_current_is_the_references(void **st) {
   (void)st;
   setup_ipm();
-  dfvc_sat_cfg_t cfg;
-  dfvc_sat_cfg_defaults(&cfg, &ipm);
+  dfvc_decoupled_cfg_t cfg;
+  dfvc_decoupled_cfg_defaults(&cfg, &ipm);
   cfg.i_max = 5.0f;
-  dfvc_sat_t c;
-  assert_int_equal(dfvc_sat_init(&c, &cfg), 0);
-  dfvc_sat_in_t in = {.i_ab = {0.3f, -0.2f},
-                      .v_ab_applied = {5.0f, 3.0f},
-                      .theta_r = 0.7f,
-                      .omega_r = 100.0f,
-                      .v_lin = 100.0f,
-                      .torque_ref = 0.1f,
-                      .lambda_ref = 0.22f,
-                      .cm_scale = {1.0f, 1.0f}};
-  dfvc_sat_out_t o;
+  dfvc_decoupled_t c;
+  assert_int_equal(dfvc_decoupled_init(&c, &cfg), 0);
+  dfvc_decoupled_in_t in = {.i_ab = {0.3f, -0.2f},
+                            .v_ab_applied = {5.0f, 3.0f},
+                            .theta_r = 0.7f,
+                            .omega_r = 100.0f,
+                            .v_lin = 100.0f,
+                            .torque_ref = 0.1f,
+                            .lambda_ref = 0.22f,
+                            .cm_scale = {1.0f, 1.0f}};
+  dfvc_decoupled_out_t o;
   for (int k = 0; k < 20; ++k) { /* the observer away from the current model */
-    dfvc_sat_step(&c, &in, &o);
+    dfvc_decoupled_step(&c, &in, &o);
     in.theta_r += in.omega_r * cfg.ts;
   }
   const ab_t meas[2] = {{0.3f, -0.2f}, {-0.5f, 0.4f}};
   double off = 0.0; /* what the measured flux-axis current would have given */
   for (int k = 0; k < 2; ++k) {
-    dfvc_sat_t c2 = c;
+    dfvc_decoupled_t c2 = c;
     in.i_ab = meas[k];
-    dfvc_sat_step(&c2, &in, &o);
+    dfvc_decoupled_step(&c2, &in, &o);
     assert_int_equal(o.fault, 0);
     /* along the current model's flux at the measured current (linear IPM) */
     const double ld = LD * (double)o.i_dq.d + LM, lq = LQ * (double)o.i_dq.q;

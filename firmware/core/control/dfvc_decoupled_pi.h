@@ -1,5 +1,5 @@
 /*
- * dfvc_sat_pi.h - the regulators of the stator-flux-oriented control of a
+ * dfvc_decoupled_pi.h - the regulators of the stator-flux-oriented control of a
  * saturated machine (Varatharajan 2022, section IV): flux amplitude lambda
  * and torque current i_tau, one PI each, behind the transformation T of (23)
  * (decoupled DFVC (27)) or behind a constant gain (constant-gain PI DFVC
@@ -29,8 +29,8 @@
  *    limit), and the predictor uses the virtual input actually applied, so
  *    the loops leave the limit without overshoot from a stale prediction.
  */
-#ifndef FD_CONTROL_DFVC_SAT_PI_H
-#define FD_CONTROL_DFVC_SAT_PI_H
+#ifndef FD_CONTROL_DFVC_DECOUPLED_PI_H
+#define FD_CONTROL_DFVC_DECOUPLED_PI_H
 
 #include "math/frames.h"
 #include "model/sfo_model.h"
@@ -39,15 +39,15 @@ typedef struct {
   float ts;      /* [s] */
   float omega;   /* design bandwidth Omega [rad/s], (28) */
   float v_f_max; /* flux-axis voltage limit [V] */
-} dfvc_sat_pi_cfg_t;
+} dfvc_decoupled_pi_cfg_t;
 
 typedef struct {
-  dfvc_sat_pi_cfg_t cfg;
+  dfvc_decoupled_pi_cfg_t cfg;
   float kp, ki;   /* discrete (28) [1/s], [1/s^2] */
   float integ_f;  /* integral part of u_f [V] */
   float integ_t;  /* integral part of u_tau [A/s] */
   float u_t_prev; /* u_tau applied over [tau, tau+1) [A/s] */
-} dfvc_sat_pi_t;
+} dfvc_decoupled_pi_t;
 
 typedef struct {
   float lambda_ref;  /* [Vs] */
@@ -58,19 +58,20 @@ typedef struct {
   float rs;          /* [Ohm] */
   sfo_gains_t g;     /* gains of the transformation (b > 0) */
   float v_max;       /* voltage amplitude available [V] */
-} dfvc_sat_pi_in_t;
+} dfvc_decoupled_pi_in_t;
 
-enum { DFVC_SAT_PI_SAT_F = 1u << 0, DFVC_SAT_PI_SAT_T = 1u << 1 };
+enum { DFVC_DECOUPLED_PI_SAT_F = 1u << 0, DFVC_DECOUPLED_PI_SAT_T = 1u << 1 };
 
 typedef struct {
   dq_t v_ft;    /* (f, tau) voltage [V] */
   dq_t u;       /* virtual inputs applied (u_f [V], u_tau [A/s]) */
-  unsigned sat; /* DFVC_SAT_PI_SAT_* */
-} dfvc_sat_pi_out_t;
+  unsigned sat; /* DFVC_DECOUPLED_PI_SAT_* */
+} dfvc_decoupled_pi_out_t;
 
 /* Returns 0, or -1 for invalid parameters (ts, omega, v_f_max > 0 finite). */
-int dfvc_sat_pi_init(dfvc_sat_pi_t *c, const dfvc_sat_pi_cfg_t *cfg);
-void dfvc_sat_pi_reset(dfvc_sat_pi_t *c);
-void dfvc_sat_pi_step(dfvc_sat_pi_t *c, const dfvc_sat_pi_in_t *in, dfvc_sat_pi_out_t *out);
+int dfvc_decoupled_pi_init(dfvc_decoupled_pi_t *c, const dfvc_decoupled_pi_cfg_t *cfg);
+void dfvc_decoupled_pi_reset(dfvc_decoupled_pi_t *c);
+void dfvc_decoupled_pi_step(dfvc_decoupled_pi_t *c, const dfvc_decoupled_pi_in_t *in,
+                            dfvc_decoupled_pi_out_t *out);
 
 #endif

@@ -1,8 +1,8 @@
 /*
- * law_dfvc_sat.c - the decoupled DFVC of Varatharajan 2022 behind the law
- * table (control/dfvc_sat.h): any machine model (flux map or linear); gain
- * set (dfvc_sat_gains: 0 proposed (a, b) (22), 1 state of the art (a', b')
- * (17), 2 constant-gain PI (26)) and references (dfvc_sat_refs: 0 the map's
+ * law_dfvc_decoupled.c - the decoupled DFVC of Varatharajan 2022 behind the law
+ * table (control/dfvc_decoupled.h): any machine model (flux map or linear); gain
+ * set (dfvc_decoupled_gains: 0 proposed (a, b) (22), 1 state of the art (a', b')
+ * (17), 2 constant-gain PI (26)) and references (dfvc_decoupled_refs: 0 the map's
  * tables (29)-(31), 1 online (32), (34)) from the parameter table. The
  * current-model error factors cm_scale_d, cm_scale_q are LIVE (read every
  * period); the other parameters re-initialise the law.
@@ -12,48 +12,49 @@
 #include "ctrl_laws.h"
 #include "math/fd_math.h"
 
-FD_COLD static const char *dfvc_sat_check(const ctrl_setup_t *su) {
+FD_COLD static const char *dfvc_decoupled_check(const ctrl_setup_t *su) {
   const drive_config_t *cfg = su->cfg;
   if (!(cfg->flux_min > 0.0f)) {
     return "decoupled DFVC needs flux_min > 0";
   }
-  if (cfg->dfvc_sat_refs == (uint16_t)DFVC_SAT_REFS_LUT && su->machine->kind != MACHINE_FLUX_MAP) {
-    return "decoupled DFVC with LUT references (dfvc_sat_refs 0) needs a flux map";
+  if (cfg->dfvc_decoupled_refs == (uint16_t)DFVC_DECOUPLED_REFS_LUT &&
+      su->machine->kind != MACHINE_FLUX_MAP) {
+    return "decoupled DFVC with LUT references (dfvc_decoupled_refs 0) needs a flux map";
   }
-  if (!(cfg->flux_min <= dfvc_sat_flux_cap(su->machine, cfg->i_max))) {
+  if (!(cfg->flux_min <= dfvc_decoupled_flux_cap(su->machine, cfg->i_max))) {
     return "decoupled DFVC needs flux_min at most the largest stator flux the machine reaches "
            "at i_max";
   }
   return NULL;
 }
 
-FD_COLD static int dfvc_sat_law_init(ctrl_state_t *s, const ctrl_setup_t *su) {
+FD_COLD static int dfvc_decoupled_law_init(ctrl_state_t *s, const ctrl_setup_t *su) {
   const drive_config_t *cfg = su->cfg;
-  dfvc_sat_cfg_t d;
-  dfvc_sat_cfg_defaults(&d, su->machine);
+  dfvc_decoupled_cfg_t d;
+  dfvc_decoupled_cfg_defaults(&d, su->machine);
   d.ts = cfg->ts;
   d.g = cfg->sat_obs_g;
-  d.omega = cfg->dfvc_sat_bw;
+  d.omega = cfg->dfvc_decoupled_bw;
   /* v_f_max stays at its default: the voltage circle alone (vsd_max is the
    * SPM laws' d_s limit) */
   d.rot_advance = fd_clampf(su->t_out / cfg->ts - 1.0f, 0.0f, 1.0f);
-  d.gains = (dfvc_sat_gains_t)cfg->dfvc_sat_gains;
-  d.refs_mode = (dfvc_sat_refs_mode_t)cfg->dfvc_sat_refs;
+  d.gains = (dfvc_decoupled_gains_t)cfg->dfvc_decoupled_gains;
+  d.refs_mode = (dfvc_decoupled_refs_mode_t)cfg->dfvc_decoupled_refs;
   d.i_max = cfg->i_max;
   d.lambda_min = cfg->flux_min;
   d.k_v = cfg->k_v;
   d.k_t = cfg->k_t;
   d.k_a = cfg->k_a;
-  return dfvc_sat_init(&s->dfvc_sat, &d);
+  return dfvc_decoupled_init(&s->dfvc_decoupled, &d);
 }
 
-static void dfvc_sat_law_reset(ctrl_state_t *s) {
-  dfvc_sat_reset(&s->dfvc_sat);
+static void dfvc_decoupled_law_reset(ctrl_state_t *s) {
+  dfvc_decoupled_reset(&s->dfvc_decoupled);
 }
 
-static void dfvc_sat_law_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *in,
-                              ctrl_out_t *out) {
-  const dfvc_sat_in_t din = {
+static void dfvc_decoupled_law_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *in,
+                                    ctrl_out_t *out) {
+  const dfvc_decoupled_in_t din = {
       .i_ab = in->i_ab,
       .v_ab_applied = in->v_applied,
       .theta_r = in->theta_e,
@@ -63,8 +64,8 @@ static void dfvc_sat_law_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctr
       .lambda_ref = in->flux_ref,
       .cm_scale = {su->cfg->cm_scale_d, su->cfg->cm_scale_q},
   };
-  dfvc_sat_out_t d;
-  dfvc_sat_step(&s->dfvc_sat, &din, &d);
+  dfvc_decoupled_out_t d;
+  dfvc_decoupled_step(&s->dfvc_decoupled, &din, &d);
   out->v_ref = d.v_ab_ref;
   out->i_pred = d.i_ab_mid;
   out->i_dq = (d.fault != 0u) ? frames_park(in->i_ab, frames_sincos(in->theta_e)) : d.i_dq;
@@ -86,10 +87,10 @@ static void dfvc_sat_law_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctr
   tm->obs_err = d.obs_err;
 }
 
-/* Its signals (signal_row.h): what the last step found, dfvc_sat_tm_t. */
+/* Its signals (signal_row.h): what the last step found, dfvc_decoupled_tm_t. */
 #define SAT_SIG(field)                                                                             \
   FD_COLD static double sig_##field(const void *owner) {                                           \
-    return (double)((const ctrl_state_t *)owner)->dfvc_sat.tm.field;                               \
+    return (double)((const ctrl_state_t *)owner)->dfvc_decoupled.tm.field;                         \
   }
 SAT_SIG(flux_mtpa)
 SAT_SIG(torque_mtpv)
@@ -113,8 +114,11 @@ static const signal_row_t sat_signals[] = {
      sig_mtpv_angle},
 };
 
-const ctrl_law_t ctrl_law_dfvc_decoupled = {
-    "dfvc_decoupled",   CTRL_CAP_FLUX,
-    dfvc_sat_check,     dfvc_sat_law_init,
-    dfvc_sat_law_reset, dfvc_sat_law_step,
-    sat_signals,        sizeof sat_signals / sizeof sat_signals[0]};
+const ctrl_law_t ctrl_law_dfvc_decoupled = {"dfvc_decoupled",
+                                            CTRL_CAP_FLUX,
+                                            dfvc_decoupled_check,
+                                            dfvc_decoupled_law_init,
+                                            dfvc_decoupled_law_reset,
+                                            dfvc_decoupled_law_step,
+                                            sat_signals,
+                                            sizeof sat_signals / sizeof sat_signals[0]};

@@ -1,5 +1,5 @@
 /*
- * dfvc_sat_refs.h - flux and torque-current references of the DFVC of a
+ * dfvc_decoupled_refs.h - flux and torque-current references of the DFVC of a
  * saturated machine (Varatharajan 2022, section V), from the map's tables
  * (LUT) or adapted online.
  *
@@ -55,16 +55,19 @@
  * PM machine would be demagnetised at standstill: 25 A and a trip on the
  * interior-PM preset); (34) with a non-finite or negative margin gives |T_hat| k_T.
  */
-#ifndef FD_CONTROL_DFVC_SAT_REFS_H
-#define FD_CONTROL_DFVC_SAT_REFS_H
+#ifndef FD_CONTROL_DFVC_DECOUPLED_REFS_H
+#define FD_CONTROL_DFVC_DECOUPLED_REFS_H
 
 #include "model/machine.h"
 
-typedef enum { DFVC_SAT_REFS_LUT = 0, DFVC_SAT_REFS_ONLINE = 1 } dfvc_sat_refs_mode_t;
+typedef enum {
+  DFVC_DECOUPLED_REFS_LUT = 0,
+  DFVC_DECOUPLED_REFS_ONLINE = 1
+} dfvc_decoupled_refs_mode_t;
 
 typedef struct {
   const machine_t *machine; /* LUT mode: a flux-map machine */
-  dfvc_sat_refs_mode_t mode;
+  dfvc_decoupled_refs_mode_t mode;
   float ts;         /* [s] */
   float i_max;      /* current amplitude limit [A] */
   float lambda_min; /* [Vs] */
@@ -75,15 +78,15 @@ typedef struct {
                      * MTPA starts at max(lambda_min, lambda_0) */
   float lambda_cap; /* upper bound of the adapted flux: the flux the current
                      * limit builds on the magnetising axis [Vs] */
-} dfvc_sat_refs_cfg_t;
+} dfvc_decoupled_refs_cfg_t;
 
 typedef struct {
-  dfvc_sat_refs_cfg_t cfg;
+  dfvc_decoupled_refs_cfg_t cfg;
   float lambda_mtpa; /* online: the integrator of (32) [Vs] */
   float lambda_ref;  /* lambda* of the last update [Vs] */
   float i_amp_f;     /* current amplitude, low-passed (10 ms), for (30) [A] */
   float i_alpha;     /* its filter's gain per period */
-} dfvc_sat_refs_t;
+} dfvc_decoupled_refs_t;
 
 typedef struct {
   float torque_ref;      /* T* [N m] */
@@ -99,13 +102,13 @@ typedef struct {
   float mtpv_cross;      /* lambda^T J i^a, eq. (10) [Vs A] */
   float mtpv_angle;      /* |angle(i^a) - delta| on the line [rad] */
   int adapt;             /* 1: the drive runs (the online MTPA integrates) */
-} dfvc_sat_refs_in_t;
+} dfvc_decoupled_refs_in_t;
 
 enum {
-  DFVC_SAT_REFS_FLUX_VLIM = 1u << 0, /* lambda* from (30) */
-  DFVC_SAT_REFS_FLUX_MIN = 1u << 1,  /* lambda* = lambda_min */
-  DFVC_SAT_REFS_TMAX = 1u << 2,      /* T* clipped by the MTPV limit (31)/(34) */
-  DFVC_SAT_REFS_IMAX = 1u << 3       /* i_tau* clipped by the current limit */
+  DFVC_DECOUPLED_REFS_FLUX_VLIM = 1u << 0, /* lambda* from (30) */
+  DFVC_DECOUPLED_REFS_FLUX_MIN = 1u << 1,  /* lambda* = lambda_min */
+  DFVC_DECOUPLED_REFS_TMAX = 1u << 2,      /* T* clipped by the MTPV limit (31)/(34) */
+  DFVC_DECOUPLED_REFS_IMAX = 1u << 3       /* i_tau* clipped by the current limit */
 };
 
 typedef struct {
@@ -115,13 +118,13 @@ typedef struct {
   float torque_mtpv; /* T_max of (31) or (34) [N m] */
   float itau_ref;    /* [A] */
   float torque_max;  /* >= 0, what the drive can deliver now [N m] */
-  unsigned limits;   /* DFVC_SAT_REFS_* */
-} dfvc_sat_refs_out_t;
+  unsigned limits;   /* DFVC_DECOUPLED_REFS_* */
+} dfvc_decoupled_refs_out_t;
 
 /* Returns 0, or -1 for invalid parameters (LUT mode without a map). */
-int dfvc_sat_refs_init(dfvc_sat_refs_t *r, const dfvc_sat_refs_cfg_t *cfg);
-void dfvc_sat_refs_reset(dfvc_sat_refs_t *r);
-void dfvc_sat_refs_update(dfvc_sat_refs_t *r, const dfvc_sat_refs_in_t *in,
-                          dfvc_sat_refs_out_t *out);
+int dfvc_decoupled_refs_init(dfvc_decoupled_refs_t *r, const dfvc_decoupled_refs_cfg_t *cfg);
+void dfvc_decoupled_refs_reset(dfvc_decoupled_refs_t *r);
+void dfvc_decoupled_refs_update(dfvc_decoupled_refs_t *r, const dfvc_decoupled_refs_in_t *in,
+                                dfvc_decoupled_refs_out_t *out);
 
 #endif

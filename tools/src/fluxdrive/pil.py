@@ -680,7 +680,7 @@ def format_report(runs: list[PilRun], isrs: int, cpi: float | None = None,
     return "\n".join(lines)
 
 
-SECTION = "## ISR instruction counts (PIL, QEMU mps2-an386)"
+SECTION = "### The laws on the encoder (PIL, QEMU mps2-an386)"
 
 
 def format_markdown(runs: list[PilRun], isrs: int, cpi: float | None, build: str,
@@ -748,8 +748,8 @@ def format_markdown(runs: list[PilRun], isrs: int, cpi: float | None, build: str
 
 
 def update_markdown(path: Path, section: str) -> None:
-    """Replace our section (from its heading to the next '## ' heading) or
-    append it; other sections are left as they are."""
+    """Replace our section (from its heading to the next '## ' or '### '
+    heading) or append it; other sections are left as they are."""
     text = path.read_text(encoding="utf-8") if path.exists() else "# Benchmarks\n\n"
     lines = text.splitlines(keepends=True)
     start = next((i for i, ln in enumerate(lines) if ln.rstrip() == SECTION), None)
@@ -758,8 +758,8 @@ def update_markdown(path: Path, section: str) -> None:
             text += "\n"
         new = text + ("\n" if not text.endswith("\n\n") else "") + section
     else:
-        end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith("## ")),
-                   len(lines))
+        end = next((i for i in range(start + 1, len(lines))
+                    if lines[i].startswith("## ") or lines[i].startswith("### ")), len(lines))
         tail = "".join(lines[end:])
         new = "".join(lines[:start]) + section + ("\n" + tail if tail else "")
     path.write_text(new, encoding="utf-8")
@@ -824,7 +824,7 @@ def main(args) -> int:
     md = format_markdown(runs, args.isrs, cpi, build, board)
     if args.markdown:
         update_markdown(Path(args.markdown), md)
-        print(f"markdown: {args.markdown} (section '{SECTION[3:]}')")
+        print(f"markdown: {args.markdown} (section '{SECTION.lstrip('# ')}')")
     rc = check_runs(runs, args.check_worst, getattr(args, "check_cycles", None),
                     getattr(args, "check_mean", None), getattr(args, "check_call", None),
                     getattr(args, "check_worst_all", None))

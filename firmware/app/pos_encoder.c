@@ -13,7 +13,6 @@
  * gives the speed, and its prediction for this sample the plausibility
  * measure (health).
  */
-#include <math.h>
 #include <stddef.h>
 
 #include "math/fd_math.h"
@@ -31,14 +30,9 @@ void pos_encoder_reset(pos_state_t *s) {
   s->enc.started = false;
 }
 
-/* The electrical angle spans pole_pairs turns: most samples lie beyond
- * frames_wrap_pi's one-turn fast paths (89 % in the PIL's scenarios), so
- * only its first test is kept and the rest goes straight to the general
- * wrap (issue 24 point 8: 31 instructions per ISR before). */
 static float enc_electrical(const pos_state_t *s, const drive_config_t *cfg,
                             const hal_sample_t *smp) {
-  const float x = cfg->pole_pairs * (smp->enc_angle + s->enc.half) - s->enc.offset;
-  return fabsf(x) < FRAMES_PI ? x : frames_wrap_pi_slow(x);
+  return frames_wrap_pi(cfg->pole_pairs * (smp->enc_angle + s->enc.half) - s->enc.offset);
 }
 
 void pos_encoder_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample_t *smp,

@@ -91,7 +91,13 @@ void ctrl_reset(ctrl_t *c) {
 
 void ctrl_deadtime_delta(const ctrl_t *c, const ctrl_out_t *out, float delta[3]) {
   const abc_t i = frames_clarke_inv(out->i_pred);
-  delta[0] = c->dtc.dt_ratio * deadtime_comp_sign(&c->dtc, i.a);
-  delta[1] = c->dtc.dt_ratio * deadtime_comp_sign(&c->dtc, i.b);
-  delta[2] = c->dtc.dt_ratio * deadtime_comp_sign(&c->dtc, i.c);
+  /* all three before the first store: a store through delta could alias
+   * *c, and would make the compiler read i_band and dt_ratio again per phase */
+  const float r = c->dtc.dt_ratio;
+  const float sa = deadtime_comp_sign(&c->dtc, i.a);
+  const float sb = deadtime_comp_sign(&c->dtc, i.b);
+  const float sc = deadtime_comp_sign(&c->dtc, i.c);
+  delta[0] = r * sa;
+  delta[1] = r * sb;
+  delta[2] = r * sc;
 }

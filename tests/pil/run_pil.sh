@@ -7,8 +7,8 @@
 # limit, voltage limit and MTPV included). Outputs must agree with this host
 # build's within the stated tolerance. FOC meets issue 24 point 8's limits
 # (mean <= 2000, worst <= 2300 instructions; measured 1466 / 1798 on the
-# ramp): checked as such. PI-DFVC and DB-DFVC do not yet (measured 2091 /
-# 2413 and 2116 / 2432 on the ramp, 2058 / 2342 and 2071 / 2358 on the
+# ramp): checked as such. PI-DFVC and DB-DFVC do not yet (measured 2068 /
+# 2392 and 2091 / 2409 on the ramp, 2034 / 2324 and 2045 / 2335 on the
 # torque step): held where they are, every mean below 2200 and every worst
 # case below 2600 instructions, and the DB-DFVC worst case at or below 50 %
 # of the 10625-cycle budget in estimated Cortex-M4 cycles (measured 40 %;

@@ -196,15 +196,10 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
   }
 
   out->v_ab_ref = v_ab;
-  out->i_ab_pred = i1;
-  out->i_ab_pred2 = i2;
   out->i_ab_mid.alpha = 0.5f * (i1.alpha + i2.alpha);
   out->i_ab_mid.beta = 0.5f * (i1.beta + i2.beta);
   out->lambda_s = o.lambda_s;
-  out->lambda_s_pred = o.lambda_s_next;
   out->lambda_ref = r.lambda_ref;
-  out->theta_s = o.theta_s;
-  out->omega_s = o.omega_s;
   out->delta = o.delta;
   out->i_ds = o.i_dqs.d;
   out->i_qs = o.i_dqs.q;
@@ -216,8 +211,6 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
     const float ea = o.lambda.alpha - o.lambda_cm.alpha, eb = o.lambda.beta - o.lambda_cm.beta;
     out->obs_err = sqrtf(ea * ea + eb * eb);
   }
-  /* torque at tau+1, eq. (16) */
-  out->torque_pred = 1.5f * k->machine->pole_pairs * o.lambda_s_next * i1_dqs.q;
   out->torque_min = r.torque_min;
   out->torque_max = r.torque_max;
   out->v_dqs = v_dqs;

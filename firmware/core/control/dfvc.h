@@ -126,24 +126,22 @@ enum {
 };
 
 typedef struct {
-  ab_t v_ab_ref;   /* voltage to apply over [tau+1, tau+2) [V], |v| <= v_lin */
-  ab_t i_ab_pred;  /* predicted current at tau+1 (MPE) [A] */
-  ab_t i_ab_pred2; /* predicted current at tau+2 with v_ab_ref [A] */
-  ab_t i_ab_mid;   /* (pred + pred2)/2: mean over [tau+1, tau+2), for dead-time comp [A] */
+  ab_t v_ab_ref; /* voltage to apply over [tau+1, tau+2) [V], |v| <= v_lin */
+  /* mean of the MPE currents at tau+1 and at tau+2 with v_ab_ref: over
+   * [tau+1, tau+2), for dead-time comp [A]. The two predictions, the
+   * predicted flux and torque and the flux angle and speed are not outputs
+   * (nothing read them; their stores cost the ISR, issue 24 point 8) */
+  ab_t i_ab_mid;
   /* telemetry at tau unless stated */
-  float lambda_s;      /* observed flux amplitude [Vs] */
-  float lambda_s_pred; /* predicted at tau+1 [Vs] */
-  float lambda_ref;    /* lambda* [Vs] */
-  float theta_s;       /* flux angle [rad] */
-  float omega_s;       /* flux-frame speed (filtered) [rad/s] */
-  float delta;         /* load angle [rad] */
-  float i_ds, i_qs;    /* stator-flux frame currents [A] */
-  float i_qs_ref;      /* limited i_qs* [A] */
-  float i_qs_pred;     /* predicted at tau+1 [A] */
-  dq_t i_dq_r;         /* rotor-frame currents at tau (telemetry) [A] */
-  float torque;        /* 3/2 p lambda_s i_qs [N m] */
-  float obs_err;       /* |lambda_hat - lambda_cm| at tau: observer vs current model [Vs] */
-  float torque_pred;   /* predicted at tau+1 [N m] */
+  float lambda_s;   /* observed flux amplitude [Vs] */
+  float lambda_ref; /* lambda* [Vs] */
+  float delta;      /* load angle [rad] */
+  float i_ds, i_qs; /* stator-flux frame currents [A] */
+  float i_qs_ref;   /* limited i_qs* [A] */
+  float i_qs_pred;  /* predicted at tau+1 [A] */
+  dq_t i_dq_r;      /* rotor-frame currents at tau (telemetry) [A] */
+  float torque;     /* 3/2 p lambda_s i_qs [N m] */
+  float obs_err;    /* |lambda_hat - lambda_cm| at tau: observer vs current model [Vs] */
   float torque_min, torque_max; /* deliverable now [N m] (dfvc_refs.h) */
   dq_t v_dqs;                   /* (ds, qs) voltage reference [V] */
   uint32_t limits;              /* DFVC_REFS_* | DFVC_LIMIT_* */

@@ -112,7 +112,14 @@ static inline float frames_wrap_pi(float theta) {
   if (fabsf(theta) < FRAMES_PI) {
     return theta;
   }
-  if (theta >= FRAMES_PI && theta < 3.0f * FRAMES_PI) {
+  /* Then theta < 3 pi first: an angle of many turns (the encoder's
+   * pole_pairs times the mechanical angle, 89 % of the Rubino 2020 SPM's
+   * samples) fails it and goes to the general path after one compare
+   * (issue 24 point 8); the branches' results are as before */
+  if (!(theta < 3.0f * FRAMES_PI)) {
+    return frames_wrap_pi_slow(theta);
+  }
+  if (theta >= FRAMES_PI) {
     const float r = theta - FRAMES_2PI;
     return r < FRAMES_PI ? r : -FRAMES_PI;
   }

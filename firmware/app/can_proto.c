@@ -326,6 +326,7 @@ static bool handle_frame(can_proto_t *p, drive_t *drv, const hal_can_frame_t *f,
       reply_error(&r, CAN_RESULT_OUT_OF_RANGE, bad);
       r.value = value_in_force(drv, m);
       if (m == CAN_MSG_PARAM_REQ) {
+        /* mut: nan_reply_without_param */
         param_echo(p, drv, f->data, &r); /* a NaN or inf value: name the parameter */
       }
     } else if (m == CAN_MSG_PARAM_REQ) {

@@ -51,6 +51,7 @@ FD_COLD int ctrl_select(ctrl_t *c, drive_law_t law) {
   /* into a scratch state first: a refused init leaves the law in force,
    * its state and its row exactly as they were (issue 22, point 2) */
   ctrl_state_t st;
+  /* mut: law_init_over_running_state */
   if (row->init(&st, &c->su) != 0) {
     return -1;
   }
@@ -90,6 +91,7 @@ void ctrl_reset(ctrl_t *c) {
 }
 
 void ctrl_deadtime_delta(const ctrl_t *c, const ctrl_out_t *out, float delta[3]) {
+  /* mut: deadtime_comp_sign */
   const abc_t i = frames_clarke_inv(out->i_pred);
   /* all three before the first store: a store through delta could alias
    * *c, and would make the compiler read i_band and dt_ratio again per phase */

@@ -174,6 +174,7 @@ FD_COLD static void drive_protect_configure(drive_t *drv) {
 
 FD_COLD int drive_config_fits_board(const drive_config_t *cfg, const hal_caps_t *caps,
                                     drive_config_err_t *err) {
+  /* mut: adc_range_not_checked */
   if (caps->i_full_scale > 0.0f && !(cfg->i_trip < caps->i_full_scale)) {
     err->field = "i_trip";
     err->reason = "must be below the current ADC's full scale (hal_caps: i_full_scale); a "
@@ -188,6 +189,7 @@ FD_COLD int drive_config_fits_board(const drive_config_t *cfg, const hal_caps_t 
   }
   const pos_source_row_t *ps = pos_source(cfg->pos_source);
   const uint32_t need = HAL_CAP_STAR_POINT | HAL_CAP_ASYM_EDGES;
+  /* mut: star_point_board_unchecked */
   if (ps != NULL && (ps->caps & POS_CAP_GATED) != 0u && (caps->features & need) != need) {
     err->field = "pos_source";
     err->reason = "the board has no star-point samples with asymmetric PWM edges (DFC window)";
@@ -348,6 +350,7 @@ FD_COLD int drive_init(drive_t *drv, const drive_config_t *cfg, drive_config_err
  * the LIVE part while running (the rest when the gates are off again). */
 static void take_config(drive_t *drv) {
   const uint32_t seq = drv->creq.seq;
+  /* mut: race_config_odd_seq */
   if ((seq & 1u) != 0u || (seq == drv->cfg_seen && !drv->cfg_pending)) {
     return;
   }
@@ -360,6 +363,7 @@ static void take_config(drive_t *drv) {
   /* nothing written in a fault or under the short changes how the safe
    * state is held (asc_speed, i_max, the machine ...): the set waits until
    * the fault is cleared and the short has ended (issue 22, point 1) */
+  /* mut: write_in_fault_applied */
   if (drv->state == DRIVE_STATE_FAULT || drv->safe.asc) {
     drv->cfg_pending = true;
     return;
@@ -399,6 +403,7 @@ static FD_NOINLINE void take_fault_requests(drive_t *drv) {
  * starts again on an enable command posted after the clear. */
 static void take_commands(drive_t *drv) {
   const uint32_t seq = drv->req.seq;
+  /* mut: race_commands_odd_seq */
   if ((seq & 1u) != 0u || seq == drv->cmd.seq) {
     return;
   }
@@ -407,7 +412,9 @@ static void take_commands(drive_t *drv) {
   drv->cmd.seq = seq;
   drive_mode_refresh(drv);
   if (drv->cmd.clear_count != drv->clear_seen) {
+    /* mut: clear_voids_unseen_requests */
     drv->clear_seen = drv->cmd.clear_count;
+    /* mut: race_clear_in_main_loop.1 */
     if (drv->state == DRIVE_STATE_FAULT) {
       hal_fault_hw_clear();
       drv->faults = 0u;
@@ -431,6 +438,7 @@ static void take_commands(drive_t *drv) {
 static FD_NOINLINE uint32_t drive_break_causes(void) {
   const uint32_t src = hal_fault_hw_source();
   uint32_t f = (src & HAL_BREAK_GATE_DRIVER) != 0u ? DRIVE_FAULT_GATE_DRIVER : 0u;
+  /* mut: break_source_ignored */
   if ((src & HAL_BREAK_OVERCURRENT) != 0u || f == 0u) {
     f |= DRIVE_FAULT_HW_OVERCURRENT;
   }
@@ -565,6 +573,7 @@ static ab_t drive_write(drive_t *drv, const float duty[3], const float dtc[3], f
   req.n_star = 0u;
   req.t_star_req[0] = 0.0f;
   req.t_star_req[1] = 0.0f;
+  /* mut: held_start_pulses_windowed */
   const bool window = drv->gated && !drv->plain;
   if (window) {
     drive_window_pattern(drv, dc, &req);
@@ -576,6 +585,7 @@ static ab_t drive_write(drive_t *drv, const float duty[3], const float dtc[3], f
   for (int x = 0; x < 3; ++x) {
     const float d = got.off[x] - got.on[x];
     drv->tm.duty[x] = d;
+    /* mut: board_duty_range_ignored.2 */
     pole[x] = (d > 0.0f && d < 1.0f) ? d - dtc[x] : d;
   }
   if (window) {
@@ -593,6 +603,7 @@ static FD_NOINLINE void drive_window_sample(const drive_t *drv, float i[3], floa
   if (!gates_on_state(drv->state)) {
     return;
   }
+  /* mut: dfc_window_sample_uncorrected */
   const float k = drv->win_k * v_dc;
   for (int x = 0; x < 3; ++x) {
     i[x] += k * drv->win_m[x];
@@ -774,6 +785,8 @@ static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
   /* the duties alone: drive_write rebuilds the applied voltage from what
    * the board will apply */
   float duty[3];
+  /* mut: board_duty_range_ignored.1 */
+  /* mut: board_duty_range_only */
   (void)modulation_minmax_duty(out.v_ref, s->v_dc, drv->duty_lo, drv->duty_hi, duty);
   float dtc[3];
   ctrl_deadtime_delta(&drv->ctrl, &out, dtc);
@@ -960,6 +973,7 @@ static void drive_publish(drive_t *drv, const hal_sample_t *s, const float i[3])
 void drive_isr(drive_t *drv) {
   hal_sample_t s;
   hal_adc_read(&s);
+  /* mut: watchdog_kicked_in_isr */
   drv->isr_count++;
   take_commands(drv); /* first: a parameter set is validated with the law commanded */
   take_config(drv);
@@ -984,6 +998,7 @@ void drive_isr(drive_t *drv) {
   if (f != 0u) {
     drive_trip(drv, f);
   }
+  /* mut: rearm_on_enable_low */
   if (!drv->armed && drv->cmd.enable_count != drv->arm_mark) {
     drv->armed = true; /* an enable command since the last disarm */
     drv->tm.armed = 1u;
@@ -994,6 +1009,7 @@ void drive_isr(drive_t *drv) {
   case DRIVE_STATE_IDLE:
     /* a pending set first: it initialises the commanded law itself (the
      * switch was validated against that set, not the one in force) */
+    /* mut: law_switch_before_pending_set */
     if (drv->cmd.law != drv->ctrl.law && drv->cmd.law != drv->law_refused && !drv->cfg_pending) {
       drive_select_law(drv);
     }

@@ -24,6 +24,7 @@ bool drive_telemetry_read(drive_t *drv, drive_telemetry_t *out) {
     DRIVE_BARRIER();
     /* the ISR may have run between the two reads (volatile) */
     // cppcheck-suppress knownConditionTrueFalse
+    /* mut: race_tm_read_unchecked */
     if (drv->tm_seq == s1) {
       return true;
     }
@@ -103,9 +104,11 @@ void drive_cmd_enable(drive_t *drv, bool enable) {
   cmd_end(drv);
 }
 
+/* mut: race_clear_in_main_loop.2 */
 void drive_cmd_clear_fault(drive_t *drv) {
   drive_cmd_t *c = cmd_begin(drv);
   c->clear_count++;
+  /* mut: clear_drops_enable */
   c->clear_enable_mark = c->enable_count; /* enables before the clear do not restart */
   cmd_end(drv);
 }
@@ -213,6 +216,7 @@ int drive_request_config(drive_t *drv, const drive_config_t *cfg, drive_config_e
    * it before or with the set, never an old reference beyond the limits in
    * force; the ISR's command block stays the published one */
   drive_cmd_t *c = cmd_begin(drv);
+  /* mut: live_limit_not_reclamped */
   c->torque = command_clamp(c->torque, -cfg->torque_max, cfg->torque_max);
   c->speed = command_clamp(c->speed, -cfg->speed_max, cfg->speed_max);
   current_clamp(&c->id, &c->iq, cfg->i_max);

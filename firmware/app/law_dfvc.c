@@ -15,6 +15,7 @@
 /* Largest relative difference of L_q from L_d an SPM law accepts. */
 #define DFVC_ISOTROPY_TOL 0.1f
 
+/* mut: law_check_removed */
 FD_COLD static const char *dfvc_check(const ctrl_setup_t *su) {
   const machine_t *m = su->machine;
   if (m->kind != MACHINE_LINEAR) {
@@ -29,6 +30,7 @@ FD_COLD static const char *dfvc_check(const ctrl_setup_t *su) {
   if (!(su->cfg->flux_min > 0.0f)) {
     return "DFVC needs flux_min > 0";
   }
+  /* mut: dfvc_vsd_max_unchecked */
   if (!(su->cfg->vsd_max > 0.0f)) {
     return "DFVC needs vsd_max > 0 (the limit of its d_s voltage)";
   }
@@ -40,6 +42,7 @@ FD_COLD static int dfvc_law_init(ctrl_state_t *s, const ctrl_setup_t *su) {
   dfvc_cfg_t d;
   dfvc_cfg_defaults(&d, su->machine);
   d.ts = cfg->ts;
+  /* mut: observer_no_crossover */
   d.omega_c = cfg->flux_obs_wc;
   d.i_max = cfg->i_max;
   d.delta_max = cfg->delta_max;
@@ -47,6 +50,7 @@ FD_COLD static int dfvc_law_init(ctrl_state_t *s, const ctrl_setup_t *su) {
   d.lambda_min = cfg->flux_min;
   d.lambda_collapse = 0.5f * cfg->flux_min;
   d.v_margin = cfg->v_margin;
+  /* mut: pi_bw_div4 */
   d.pi_bw_flux = cfg->dfvc_flux_bw;
   d.pi_bw_iqs = cfg->dfvc_iqs_bw;
   /* the output rotation: from theta_s(tau+1) to the centre of the interval

@@ -84,8 +84,10 @@ static void foc_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *i
    * (drive_monitor). The speed loop's anti-windup takes the same bound. */
   out->torque_min = -t_lim;
   out->torque_max = t_lim;
+  /* mut: foc_voltage_limit_torque_ignored */
   if (s->foc.cc.limited != 0) {
     if (in->torque_ref > 0.0f) {
+      /* mut: foc_voltage_limit_no_zero_bound */
       out->torque_max = fd_clampf(t_now, 0.0f, t_lim);
     } else if (in->torque_ref < 0.0f) {
       out->torque_min = fd_clampf(t_now, -t_lim, 0.0f);

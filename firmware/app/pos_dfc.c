@@ -142,6 +142,7 @@ void pos_star_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample
   /* the live parameters (b, iterations, phase shifts) in force */
   const float id_a = m->dc.a, id_b = m->dc.b;
   m->dc = pos_method_cfg(s->star.method, cfg);
+  /* mut: ivd_kf_without_iterations */
   if (s->star.ident != NULL) { /* the identification's a, b, guarded at its steps */
     m->dc.a = id_a;
     m->dc.b = id_b;
@@ -193,6 +194,7 @@ void pos_star_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample
       s2 = w.s;
       m->trace[0] = c2; /* the start, for logs */
       m->trace[1] = s2;
+      /* mut: rls_ivd_raw_start */
       ok = dfc_ivd_from(&m->dc, &v, in->i_q, &c2, &s2, m->trace);
     } else {
       ok = dfc_vector2(&m->dc, m->sig.g, &v, in->i_q, &c2, &s2, m->trace);
@@ -234,6 +236,7 @@ void pos_star_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample
    * moves, near the alignment angle; docs/dfc.md) */
   if (!s->star.pol.aligned) {
     const sincos_t u = frames_sincos(pred);
+    /* mut: polarity_evidence_on_measured_angle */
     s->star.pol.acc -= (out->omega - s->star.pol.w_prev) * u.s;
     s->star.pol.w_prev = out->omega;
     pol_energy(s, u.c);
@@ -252,6 +255,7 @@ FD_COLD void pos_star_align(pos_state_t *s, const drive_config_t *cfg, const hal
   const pos_polarity_t *pol = &s->star.pol;
   const float acc = pol->acc;
   const float now = pos_track_theta(s);
+  /* mut: polarity_energy_evidence_off */
   const float e = pol->e_n > 0u ? pol->e_acc / (float)pol->e_n + (pol->e_lp - pol->e_c0) : 0.0f;
   /* the energy first (the rotor went down the potential: theta), then the
    * speed change (the estimate moved as the torque pulled: theta) */
@@ -260,6 +264,7 @@ FD_COLD void pos_star_align(pos_state_t *s, const drive_config_t *cfg, const hal
   float th;
   if (e_says || a_says) {
     const bool theta_right = e_says ? e > 0.0f : acc > 0.0f;
+    /* mut: dfc_polarity_ignored */
     th = theta_right ? now : frames_wrap_pi(now + FRAMES_PI); /* theta + pi */
   } else {
     th = nearest_branch(now, theta);

@@ -22,6 +22,7 @@
 FD_COLD void pos_encoder_init(pos_state_t *s, const drive_config_t *cfg) {
   angle_pll_init(&s->enc.pll, cfg->pll_bw, cfg->ts);
   s->enc.offset = cfg->enc_offset;
+  /* mut: encoder_half_count_removed */
   s->enc.half = cfg->enc_cpr > 0u ? FRAMES_PI / (float)cfg->enc_cpr : 0.0f;
   s->enc.started = false;
 }

@@ -68,6 +68,7 @@ static bool rls_update(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_
   rls_ab_t *r = &s->star.id.rls;
   bool upd = false;
   if (s->star.meas.miss == 0u && s->star.meas.sig.last == 0u && s->star.pol.aligned &&
+      /* mut: rls_never_updates */
       fabsf(pos_track_omega(s)) > cfg->rls_w_min) {
     r->cfg = rls_cfg_of(cfg); /* the live tuning, for this update and rls_health */
     upd = rls_ab_update(r, v->al, v->be, u->c, u->s, v->k);
@@ -104,6 +105,7 @@ static bool rls_health(pos_state_t *s, const drive_config_t *cfg) {
     const float pjj = r->p[(size_t)2u * j];
     const float t_rls = 1.0f + r->cfg.r / pjj; /* updates; P >= p_min > 0 */
     const float go = fabsf(r->x[j] - s->star.id.avg[j]) * fd_maxf(1.0f, POS_DFC_RLS_AVG * t_rls);
+    /* mut: rls_ok_no_covariance */
     ok = ok && go <= tol && 2.0f * pjj <= tol * tol;
   }
   const float a0 = fabsf(cfg->dfc_a), am = fabsf(r->x[0]);

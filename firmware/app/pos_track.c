@@ -107,6 +107,7 @@ static void trk_kf_predict(pos_state_t *s, const drive_config_t *cfg, float torq
   kf->cfg.q[0] = cfg->kf_q_omega;
   kf->cfg.q[1] = cfg->kf_q_theta;
   kf->cfg.q[2] = cfg->kf_q_load;
+  /* mut: kf_torque_input_dropped */
   kf_mech_predict(kf, torque);
 }
 
@@ -144,6 +145,7 @@ static float meas_r_sys(const pos_state_t *s) {
    * above 1): a variance, no CORDIC call */
   const float d =
       tn <= 1.0f ? tn / (1.0f + 0.28125f * tn * tn) : 0.5f * FRAMES_PI - tn / (tn * tn + 0.28125f);
+  /* mut: kf_r_method_error_tenth */
   return 0.125f * d * d;
 }
 
@@ -170,7 +172,9 @@ static float meas_r(const pos_state_t *s, const drive_config_t *cfg, const dfc_v
   /* (4.29): |Gamma|^2, the b term in it (4.31); the IVD has removed it (4.30) */
   const float g2 = s->star.method->decoupled ? s->star.meas.dc.a * s->star.meas.dc.a
                                              : v->al * v->al + v->be * v->be;
+  /* mut: kf_r_warm_ivd_exact */
   const float sys = cfg->kf_r_sys * (warm ? s->star.id.warm2 * kf_mech_var_theta(&s->star.trk.u.kf)
+                                          /* mut: kf_r_without_the_method_error */
                                           : meas_r_sys(s));
   return cfg->kf_r_scale * (0.25f * var / fd_maxf(g2, 1e-12f) + sys);
 }
@@ -237,6 +241,7 @@ static void trk_ekf_measure(pos_state_t *s, const drive_config_t *cfg, const dfc
 static float trk_ekf_start_angle(const pos_state_t *s, const dfc_vec_t *v, float theta0) {
   dfc_cfg_t d = s->star.meas.dc;
   d.method = DFC_IVD;
+  /* mut: ekf_start_on_standard_dfc_angle */
   d.iterations = DFC_ITER_MAX;
   float c2, s2;
   if (!dfc_vector2(&d, s->star.meas.sig.g, v, 0.0f, &c2, &s2, NULL)) {
@@ -251,6 +256,7 @@ static float trk_ekf_start_angle(const pos_state_t *s, const dfc_vec_t *v, float
  * linearisation valid over a tenth of that near the corners of h at high
  * |p|: the jump of issue 23 point 4) */
 FD_COLD static void trk_ekf_branch(pos_state_t *s, float th) {
+  /* mut: ekf_branch_flip_resets_covariance */
   s->star.trk.u.kf.x[1] = th;
 }
 
@@ -260,6 +266,7 @@ FD_COLD static void trk_ekf_branch(pos_state_t *s, float th) {
 #define POS_DFC_EKF_P_MAX 0.35f
 
 FD_COLD static const char *trk_ekf_check(const drive_config_t *cfg, const char **field) {
+  /* mut: ekf_p_limit_off */
   if (!(fabsf(cfg->dfc_b) <= POS_DFC_EKF_P_MAX * fabsf(cfg->dfc_a))) {
     *field = "dfc_b";
     return "the EKF needs |p| = |dfc_b / dfc_a| <= 0.35: its update (4.36) is linearised on "

@@ -71,6 +71,7 @@ FD_COLD static int align_step(proc_state_t *st, const proc_setup_t *su, const pr
   const drive_config_t *c = su->cfg;
   proc_align_timing_t tmg;
   proc_align_timing(c, &tmg);
+  /* mut: encoder_alignment_undamped */
   const bool enc = !su->gated && tmg.kd > 0.0f;
   const float w = in->pos->omega;
   const float phi = enc ? fd_clampf(-tmg.kd * w, -0.25f * FRAMES_PI, 0.25f * FRAMES_PI) : 0.0f;

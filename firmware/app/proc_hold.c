@@ -182,6 +182,7 @@ FD_COLD static int hold_step(proc_state_t *st, const proc_setup_t *su, const pro
         if (!(mean > 0.0f) || !(fabsf(d0 - d1) > PROC_HOLD_EVIDENCE_MIN * mean)) {
           r = PROC_FAILED; /* no saturation to show the pole */
         } else {
+          /* mut: held_start_polarity_reversed */
           h->theta_out = d0 > d1 ? h->theta : frames_wrap_pi(h->theta + FRAMES_PI);
           su->pos_src->hold(su->pos_st, h->theta_out);
           r = PROC_DONE;

@@ -21,6 +21,7 @@ static void spline_slopes(const double *f, double *m, ptrdiff_t n, ptrdiff_t s, 
   w[0] = 1.0 / b;
   m[0] = 3.0 * (f[s] - f[0]) / b;
   for (ptrdiff_t i = 1; i < n; ++i) {
+    /* mut: plant_spline_end_condition */
     const double diag = i == n - 1 ? 2.0 : 4.0;
     const double rhs =
         i == n - 1 ? 3.0 * (f[i * s] - f[(i - 1) * s]) : 3.0 * (f[(i + 1) * s] - f[(i - 1) * s]);

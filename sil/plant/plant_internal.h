@@ -146,6 +146,7 @@ static inline double plant_dclink_voltage(const plant_t *pl, const double *x) {
  * not negative through a rectifier's diode. */
 static inline double plant_dclink_source(double vs, double v, double inv_r, int one_way) {
   const double i = (vs - v) * inv_r;
+  /* mut: rectifier_two_way */
   return one_way && i < 0.0 ? 0.0 : i;
 }
 

@@ -184,6 +184,7 @@ static void sw_deriv(const plant_t *pl, const sw_cfg_t *cf, const double *x, dou
                        : (fl && cf->cond[j] == COND_LO) ? cf->rl[j]
                                                         : 0.0;
       v[j] = k * vdc;
+      /* mut: short_link_current_one_way */
       idc += k * i[j];
     }
     const double val = (2.0 * v[0] - v[1] - v[2]) * (1.0 / 3.0);
@@ -582,6 +583,7 @@ static void short_node(sw_legs_t *lg, int x, int y, int z) {
   type[x] = LEG_LO;
   type[y] = LEG_LO;
   if (type[z] != LEG_OPEN) {
+    /* mut: short_node_rails_unshifted */
     lg->rl[z] = type[z] == LEG_HI ? 0.0 : -1.0;
     lg->rh[z] = type[z] == LEG_LO ? 0.0 : 1.0;
     type[z] = LEG_FLOAT;

@@ -75,6 +75,7 @@ static void star_matrix(const plant_t *pl, double c, double s, double i_q, doubl
   const plant_aniso_t *an = &pl->p.machine.aniso;
   const double k = star_k(an, i_q);
   const double c2 = c * c - s * s, s2 = 2.0 * c * s;
+  /* mut: star_mutual_follows_self */
   const double rs = 2.0 * an->shift + an->phi_self * i_q, rm = 2.0 * an->shift + an->phi_mut * i_q;
   double cs = c2, ss = s2, cm = c2, sm = s2;
   if (rs != 0.0) {
@@ -183,6 +184,7 @@ double plant_star_vn(const plant_t *pl, const double v[3], const double i[3], do
   }
   double L[3][3], dL[3][3], g[3];
   star_matrix(pl, c_e, s_e, i_q, L, dL);
+  /* mut: star_point_isotropic */
   star_divider(L, g);
   double vn = 0.0;
   for (int k = 0; k < 3; k++) {

@@ -969,6 +969,7 @@ static int check_star(ctx_t *c, const cJSON *root, scenario_t *sc) {
     k_at = k_at < pm->aniso.k_min ? pm->aniso.k_min
                                   : (k_at > pm->aniso.k_max ? pm->aniso.k_max : k_at);
     /* the unloaded p at or above 1/2 is the drive's dfc_b (named by p_key) */
+    /* mut: star_load_theorem1_off */
     if (fabs(p0) < 0.5 && !(fabs(p_max) < 0.5)) {
       static const char *const kl[] = {"star_amp_iq", "star_phi_self", "star_phi_mutual",
                                        "star_phi_iq", NULL};

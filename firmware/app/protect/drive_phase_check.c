@@ -66,6 +66,7 @@ static int window_dc(const drive_ph_window_t *p, float d[2]) {
       p->r1[0] - (w1[0] * p->r2[0] - w1[1] * p->r2[1]) - (w2[0] * p->r3[0] - w2[1] * p->r3[1]);
   const float nb =
       p->r1[1] - (w1[0] * p->r2[1] + w1[1] * p->r2[0]) - (w2[0] * p->r3[1] + w2[1] * p->r3[0]);
+  /* mut: voltage_balance_alpha_sign */
   d[0] = na / den;
   d[1] = nb / den;
   return 0;
@@ -90,6 +91,7 @@ static int verdict(drive_phase_check_t *p, float i_max, float v_dc) {
     p->vdef_ab[1] = d[1] / v_dc;
     p->vdef = sqrtf(p->vdef_ab[0] * p->vdef_ab[0] + p->vdef_ab[1] * p->vdef_ab[1]);
     p->vdef_max = fd_maxf(p->vdef_max, p->vdef);
+    /* mut: voltage_balance_off */
     if (p->vdef > DRIVE_PH_VDEF) {
       v = 1;
     }
@@ -112,6 +114,7 @@ uint32_t drive_phase_check(drive_phase_check_t *p, const drive_phase_view_t *vie
     return 0u;
   }
   p->w.angle += fabsf(tm->omega_m) * c->pole_pairs * (float)isrs * c->ts;
+  /* mut: voltage_balance_no_resistance */
   window_add(&p->w, tm, c->rs, p->w.angle * (1.0f / FRAMES_2PI));
   if (p->w.angle < FRAMES_2PI) {
     if (p->w.n >= DRIVE_PH_MAX_N) { /* too slow: no verdict */
@@ -120,6 +123,7 @@ uint32_t drive_phase_check(drive_phase_check_t *p, const drive_phase_view_t *vie
     }
     return 0u;
   }
+  /* mut: phase_check_off */
   const int v = verdict(p, c->i_max, tm->v_dc);
   p->bad = v > 0 ? p->bad + 1 : 0;
   memset(&p->w, 0, sizeof p->w);

@@ -63,6 +63,7 @@ uint32_t protect_pos_step(protect_pos_t *p, const protect_pos_view_t *v) {
   p->psi = psi;
   p->psi_ok = true;
   const float rd = u.d - (v->rs * i.d + dpsi.d - w * psi.q);
+  /* mut: pos_check_emf_sign */
   const float rq = u.q - (v->rs * i.q + dpsi.q + w * psi.d);
   /* the flux's two parts, the magnet's and the currents', each on its own
    * scale (in flux weakening they cancel, their errors do not) */
@@ -73,6 +74,7 @@ uint32_t protect_pos_step(protect_pos_t *p, const protect_pos_view_t *v) {
   p->res = sqrtf(rd * rd + rq * rq) / fd_maxf(tol, 1e-6f);
   if (!(rd * rd + rq * rq <= tol * tol)) { /* NaN counts as over */
     if ((float)++p->n * (float)v->periods * v->ts >= POS_TRIP_S) {
+      /* mut: pos_check_never */
       return DRIVE_FAULT_POSITION;
     }
   } else if (p->n > 0) {

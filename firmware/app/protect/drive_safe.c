@@ -53,16 +53,18 @@
 #define SAFE_SQRT3 1.7320508f
 /* the link level that engages the short, ahead of the overvoltage trip */
 #define SAFE_V_RATIO 0.95f
-#define ENTRY_N      16u    /* periods above the entry speed before the short */
-#define EXIT_N       16u    /* periods below the exit speed before all off */
-#define EXIT_RATIO   0.7f   /* exit speed / entry speed (hysteresis) */
-#define W_I_BW       300.0f /* bandwidth of the current-vector speed [rad/s] */
-#define I_FLOOR      0.02f  /* current vector too small to turn, times i_max */
+/* mut: asc_exit_early */
+#define ENTRY_N    16u    /* periods above the entry speed before the short */
+#define EXIT_N     16u    /* periods below the exit speed before all off */
+#define EXIT_RATIO 0.7f   /* exit speed / entry speed (hysteresis) */
+#define W_I_BW     300.0f /* bandwidth of the current-vector speed [rad/s] */
+#define I_FLOOR    0.02f  /* current vector too small to turn, times i_max */
 
 /* Faults after which the bridge is not trusted with a short. */
 #define SAFE_NO_ASC (DRIVE_FAULT_HW_OVERCURRENT | DRIVE_FAULT_GATE_DRIVER)
 
 static bool asc_allowed(const protect_safe_t *z, const protect_safe_view_t *v) {
+  /* mut: asc_never */
   return v->asc_speed > 0.0f && z->i_sc < v->i_max && (v->faults & SAFE_NO_ASC) == 0u &&
          !v->hw_tripped;
 }

@@ -17,6 +17,7 @@ FD_COLD uint32_t protect_isum_step(protect_isum_t *p, const protect_isum_view_t 
   const float *i = v->i_abc;
   const float big = fd_maxf(fabsf(i[0]), fd_maxf(fabsf(i[1]), fabsf(i[2])));
   if (fabsf(i[0] + i[1] + i[2]) > fd_maxf(v->i_sum_abs, v->i_sum_rel * big)) {
+    /* mut: current_sum_never_trips */
     if (++p->n >= PROTECT_ISUM_TRIP) {
       return DRIVE_FAULT_CURRENT_SENSOR;
     }

@@ -77,6 +77,7 @@ void protect_lc_reset(protect_lc_t *p);
 static inline uint32_t protect_lc_conditions(const protect_lc_t *p, const protect_lc_view_t *v) {
   uint32_t cond = 0u;
   if (v->i_d * v->i_d + v->i_q * v->i_q > p->i_lim2) {
+    /* mut: lost_control_current_off */
     cond |= DRIVE_LC_CURRENT;
   }
   if ((v->checks & PROTECT_LC_CHECK_TORQUE) != 0u) {
@@ -84,6 +85,7 @@ static inline uint32_t protect_lc_conditions(const protect_lc_t *p, const protec
      * on the scale of the torque at i_max */
     const float t_ref = fd_clampf(v->torque_ref, v->torque_min, v->torque_max);
     if (fabsf(v->torque - t_ref) > p->torque_tol) {
+      /* mut: lost_control_torque_off */
       cond |= DRIVE_LC_TORQUE;
     }
   }
@@ -92,15 +94,18 @@ static inline uint32_t protect_lc_conditions(const protect_lc_t *p, const protec
      * its torque margin k_T: its load angle from d is near 90 deg on a
      * reluctance machine) */
     if ((v->checks & PROTECT_LC_CHECK_DELTA) != 0u && fabsf(v->delta) > p->delta_lim) {
+      /* mut: lost_control_delta_off */
       cond |= DRIVE_LC_DELTA;
     }
     if (fabsf(v->flux - v->flux_ref) > p->track * v->flux_ref) {
+      /* mut: lost_control_flux_off */
       cond |= DRIVE_LC_FLUX;
     }
     /* the observer against its current model, on the scale of the flux at
      * i_max: a detuned model (Rubino 2020, Figs. 19-20) differs by tens of
      * per cent of that at most, a diverging integration by more */
     if (v->obs_err > p->obs_tol) {
+      /* mut: lost_control_observer_off */
       cond |= DRIVE_LC_OBSERVER;
     }
   }

@@ -46,7 +46,9 @@ FD_COLD uint32_t protect_ra_step(protect_ra_t *p, const protect_ra_view_t *v) {
   if (p->n >= n_win) {
     p->n = 0u; /* a new window */
     const float d = (p->w1 - p->w0) / (float)q;
+    /* mut: runaway_no_growth_needed */
     const float away = e > 0.0f ? d : -d;
+    /* mut: runaway_check_off */
     if (away > p->floor) {
       return DRIVE_LC_RUNAWAY;
     }

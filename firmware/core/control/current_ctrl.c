@@ -52,9 +52,11 @@ dq_t current_ctrl_update(current_ctrl_t *cc, dq_t i_ref, dq_t i, float we, float
     we = 0.0f;
   }
   const machine_t *m = cc->cfg.machine;
+  /* mut: foc_map_constant_gains */
   if (m->kind == MACHINE_FLUX_MAP) {
     const machine_ldq_t l = machine_inductance(m, i_ref);
     cc->pi_d.kp = cc->cfg.bandwidth * l.dd;
+    /* mut: foc_map_q_gain */
     cc->pi_q.kp = cc->cfg.bandwidth * l.qq;
   }
   /* decoupling feed-forward: v = Rs i + L di/dt + we J lambda(i) */

@@ -66,9 +66,13 @@ void dfvc_deadbeat_step(const dfvc_deadbeat_t *db, const dfvc_deadbeat_in_t *in,
   unsigned sat = 0u;
 
   /* Rubino 2020, eq. (29) */
+  /* mut: deadbeat_no_rs_29 */
   const float vd = m->rs * in->i_dqs_next.d + (in->lambda_ref - in->lambda_s_next) * db->inv_ts;
   /* Rubino 2020, eq. (33) */
+  /* mut: deadbeat_no_rs_33 */
+  /* mut: deadbeat_no_omega_delta_33 */
   const float vq = m->rs * in->i_dqs_next.q + in->omega_delta * machine_ls(m) * in->i_dqs_next.d +
+                   /* mut: deadbeat_emf_sign */
                    in->omega_r * in->lambda_s_next + db->ls_ts * (in->iqs_ref - in->i_dqs_next.q);
   out->v_dqs_raw.d = vd;
   out->v_dqs_raw.q = vq;

@@ -79,6 +79,7 @@ static void dfvc_decoupled_model_at(const machine_t *m, dq_t s, dq_t lambda, dq_
 static void dfvc_decoupled_map(const machine_t *m, dq_t s, dq_t i, dq_t *li, machine_ldq_t *l) {
   machine_ldq_t k;
   const dq_t f = machine_flux_inductance(m, i, &k);
+  /* mut: cm_scale_ignored */
   *li = (dq_t){s.d * f.d, s.q * f.q};
   *l = (machine_ldq_t){s.d * k.dd, s.d * k.dq, s.q * k.qd, s.q * k.qq};
 }
@@ -181,6 +182,7 @@ static float dfvc_decoupled_ref_if(dq_t i, dq_t li, machine_ldq_t l, float lambd
   }
   const float amp = sqrtf(n2);
   const float quad = li.d * (l.qq * li.d - l.dq * li.q) + li.q * (l.dd * li.q - l.qd * li.d);
+  /* mut: dfvc_ref_if_no_current_model */
   return (li.d * i.d + li.q * i.q) / amp + (lambda_ref - amp) * quad / (n2 * det);
 }
 
@@ -239,6 +241,7 @@ void dfvc_decoupled_step(dfvc_decoupled_t *c, const dfvc_decoupled_in_t *in,
     g = (sfo_gains_t){0.0f, c->b0};
     break;
   default:
+    /* mut: dfvc_decoupled_no_decoupling_a */
     g = q.prop;
     break;
   }
@@ -290,6 +293,8 @@ void dfvc_decoupled_step(dfvc_decoupled_t *c, const dfvc_decoupled_in_t *in,
    * not the measured one, whose sign near zero current would feed back
    * through the compensation (docs/faults.md, issue 23 point 17) */
   out->i_ab_mid =
+      /* mut: dfvc_dt_current_measured */
+      /* mut: dfvc_dt_current_measured_flux_axis */
       frames_park_inv((dq_t){dfvc_decoupled_ref_if(i, li, l, r->lambda_ref), r->itau_ref}, scv);
   out->i_dq = i;
   out->lambda_s = o.lambda_s;

@@ -19,6 +19,7 @@ FD_COLD int dfvc_decoupled_pi_init(dfvc_decoupled_pi_t *c, const dfvc_decoupled_
   c->cfg = *cfg;
   /* eq. (28) in discrete form (dfvc_decoupled_pi.h): double pole at exp(-Omega Ts) */
   const float p = expf(-k->omega * k->ts);
+  /* mut: dfvc_decoupled_kp_half */
   c->kp = (1.0f - p * p) / k->ts;
   c->ki = (1.0f - p) * (1.0f - p) / (k->ts * k->ts);
   return 0;

@@ -75,6 +75,7 @@ void dfvc_decoupled_refs_update(dfvc_decoupled_refs_t *r, const dfvc_decoupled_r
         fabsf(in->lambda_hat - r->lambda_ref) <= DFVC_DECOUPLED_REFS_SETTLED * r->lambda_ref;
     const int loaded = fabsf(in->i_tau) > DFVC_DECOUPLED_REFS_LOADED * c->i_max;
     if (in->adapt && settled && loaded && r->lambda_mtpa < lmax) {
+      /* mut: mtpa_adaptation_printed_sign */
       r->lambda_mtpa -= c->ts * c->k_a * in->mtpa_cross;
     }
     r->lambda_mtpa = fd_clampf(r->lambda_mtpa, c->lambda_min,
@@ -95,6 +96,7 @@ void dfvc_decoupled_refs_update(dfvc_decoupled_refs_t *r, const dfvc_decoupled_r
   if (c->mode == DFVC_DECOUPLED_REFS_LUT) {
     tmax = c->k_t * flux_map_mtpv_torque(c->machine->map, lref);
   } else {
+    /* mut: mtpv_no_margin_term */
     const float margin = kt * in->mtpv_cross * in->mtpv_angle;
     tmax = c->k_t * (fabsf(in->torque_est) + (fd_isfinite(margin) ? fd_maxf(margin, 0.0f) : 0.0f));
   }

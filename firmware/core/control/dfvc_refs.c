@@ -25,6 +25,7 @@ FD_COLD int dfvc_refs_init(dfvc_refs_t *r, const dfvc_refs_cfg_t *cfg) {
         dfvc_refs_pos(c->lambda_min) && dfvc_refs_pos(c->v_margin) && c->v_margin <= 1.0f)) {
     return -1;
   }
+  /* mut: i_max_plus10pct */
   r->cfg = *cfg;
   dfvc_refs_reset(r);
   return 0;
@@ -34,6 +35,7 @@ void dfvc_refs_reset(dfvc_refs_t *r) {
   /* Rubino 2020, eq. (26) */
   float sd;
   float cd;
+  /* mut: delta_max_65deg */
   fd_sincosf(r->cfg.delta_max, &sd, &cd);
   r->iqs_max_delta = r->cfg.machine->lambda_m / machine_ls(r->cfg.machine) * sd;
   r->cos_delta_max = cd;
@@ -49,6 +51,7 @@ float dfvc_refs_lambda_mtpa(const dfvc_refs_t *r, float torque_ref) {
   /* Rubino 2020, eq. (22) */
   const machine_t *m = c->machine;
   const float x = machine_ls(m) * t / (m->pole_pairs * m->lambda_m * m->lambda_m);
+  /* mut: mtpa_flux_2_3 */
   return m->lambda_m * sqrtf(1.0f + (4.0f / 9.0f) * x * x);
 }
 
@@ -66,6 +69,7 @@ static float dfvc_refs_vlim_of(const dfvc_refs_t *r, float vq, float inv_w, floa
 
 /* sqrt(v_max^2 - (Rs i_ds)^2) of (23), or -1 when the radicand is not positive */
 static float dfvc_refs_vq_avail(const dfvc_refs_t *r, float v_lin, float i_ds) {
+  /* mut: v_margin_0_9 */
   const float vmax = fd_maxf(v_lin, 0.0f) * r->cfg.v_margin;
   const float rd = r->cfg.machine->rs * i_ds;
   const float rad = vmax * vmax - rd * rd;
@@ -133,6 +137,7 @@ void dfvc_refs_update(dfvc_refs_t *r, const dfvc_refs_in_t *in, dfvc_refs_out_t 
   const float den = 1.0f + k * k;
   const float rad = den * c->i_max * c->i_max - a * a;
   const float q_line = (rad > 0.0f) ? fd_maxf((sqrtf(rad) - k * a) / den, 0.0f) : 0.0f;
+  /* mut: refs_25_at_tau2_removed */
   if (in->i_dqs_next.d < 0.0f) {
     const float rad1 = c->i_max * c->i_max - in->i_dqs_next.d * in->i_dqs_next.d;
     out->iqs_max_i = fd_minf(q_line, (rad1 > 0.0f) ? sqrtf(rad1) : 0.0f);
@@ -150,6 +155,7 @@ void dfvc_refs_update(dfvc_refs_t *r, const dfvc_refs_in_t *in, dfvc_refs_out_t 
    * in place of i_qs(tau), when that gives less flux (see dfvc_refs.h);
    * then (24)-(26) again at the new flux */
   const float lv2 = dfvc_refs_vlim_of(r, vq, inv_w, in->omega_r, iq);
+  /* mut: refs_23_at_iqs_ref_removed */
   if (lv2 < lref) {
     out->lambda_vlim = lv2;
     lref = lv2;

@@ -27,6 +27,7 @@ FD_COLD int dfc_check(const dfc_cfg_t *c) {
     return DFC_ERR_PHI;
   }
   /* Theorem 1: |Delta_k| -> 0 iff |p| < 1/2 */
+  /* mut: dfc_theorem1_unchecked */
   if ((c->method == DFC_IVD || c->method == DFC_FULL_IVD) && !(fabsf(c->b) < 0.5f * fabsf(c->a))) {
     return DFC_ERR_P;
   }
@@ -113,6 +114,7 @@ void dfc_signals_vector(const dfc_signals_t *s, float w2, dfc_vec_t *v) {
      * e^{-j2phi} behind: on c_x e^{+j2phi} (e) */
     const float phi = w2 * (t_new - s->t[x]);
     float co, si, co2, si2;
+    /* mut: dfc_sequentiality_sign */
     dfc_turn(-phi, &co, &si);
     dfc_turn(2.0f * phi, &co2, &si2);
     const float d1 = cx[x][0] * co - cx[x][1] * si, d2 = cx[x][0] * si + cx[x][1] * co;
@@ -160,6 +162,7 @@ FD_NOINLINE bool dfc_ivd_step(float zr, float zi, float p, const float k[4], con
   const float tr = sr * rb[0] - si * rb[1], ti = sr * rb[1] + si * rb[0];
   const float qr = k[0] * tr + k[1] * ti, qi = k[2] * tr + k[3] * ti;
   float vr, vi;
+  /* mut: dfc_ivd_no_b_term */
   if (!dfc_normalise(zr + p * qr, zi + p * qi, &vr, &vi)) {
     return false;
   }
@@ -190,6 +193,7 @@ static inline __attribute__((always_inline)) bool ivd_run(const dfc_cfg_t *c, co
   if (full) {
     const sincos_t pa = frames_sincos(c->phi_a * i_q), pb = frames_sincos(c->phi_b * i_q);
     ra[0] = pa.c;
+    /* mut: dfc_full_ivd_phi_a_sign */
     ra[1] = -pa.s;
     rb[0] = pb.c;
     rb[1] = -pb.s;
@@ -242,6 +246,7 @@ bool dfc_vector2(const dfc_cfg_t *c, const float g[3], const dfc_vec_t *v, float
     const float gs[3] = {g0 + v->al, g0 - 0.5f * v->al + hb, g0 - 0.5f * v->al - hb};
     float k[3], ka, kb;
     for (int x = 0; x < 3; ++x) {
+      /* mut: inverse_dfc_on_raw_components */
       const float d = gs[x] + (1.0f / 3.0f);
       k[x] = fabsf(d) > 1e-6f ? 1.0f / d : 0.0f;
     }
@@ -268,6 +273,7 @@ bool dfc_ivd_from(const dfc_cfg_t *c, const dfc_vec_t *v, float i_q, float *c2, 
   if (!(c->method == DFC_IVD || c->method == DFC_FULL_IVD)) {
     return false;
   }
+  /* mut: ivd_from_ignores_start */
   float ur = *c2, ui = *s2;
   if (!ivd_run(c, v, i_q, false, &ur, &ui, trace)) {
     return false;

@@ -78,6 +78,7 @@ bool kf_mech_update(kf_mech_t *k, float theta_meas, float r) {
   const float innov = frames_wrap_pi(theta_meas - x[1]); /* (4.20), wrapped */
   x[0] += k1 * innov;
   x[1] = frames_wrap_pi(x[1] + k2 * innov);
+  /* mut: kf_load_gain_dropped */
   x[2] += k3 * innov;
   /* Joseph form: (I - K H) P (I - K H)^T + K R K^T. With H = [0 1 0],
    * A = I - K H has column 2 = -K (+1 on the diagonal); A P A^T expands to
@@ -87,6 +88,7 @@ bool kf_mech_update(kf_mech_t *k, float theta_meas, float r) {
   p[P11] += -2.0f * k1 * c1 + s * k1 * k1;
   p[P12] += -k1 * c2 - c1 * k2 + s * k1 * k2;
   p[P13] += -k1 * c3 - c1 * k3 + s * k1 * k3;
+  /* mut: kf_joseph_term_dropped */
   p[P22] += -2.0f * k2 * c2 + s * k2 * k2;
   p[P23] += -k2 * c3 - c2 * k3 + s * k2 * k3;
   p[P33] += -2.0f * k3 * c3 + s * k3 * k3;
@@ -106,10 +108,14 @@ bool kf_mech_update_ekf(kf_mech_t *k, float g_al, float g_be, float a, float b, 
   /* the 4theta term as the signal vector carries it: q = K (cos 4theta,
    * -sin 4theta) (dfc.h: the map the IVD applies; K = I at standstill,
    * where this is (4.35)); h = (-a cos 2theta + b q_r, a sin 2theta - b q_i) */
+  /* mut: ekf_sequentiality_map_ignored.1 */
   const float qr = km[0] * c4 - km[1] * s4, qi = km[2] * c4 - km[3] * s4;
   /* innovation (4.41) and the theta column of H (4.36) */
   const float e1 = g_al - (-a * c2 + b * qr), e2 = g_be - (a * s2 - b * qi);
+  /* mut: ekf_sequentiality_map_ignored.2 */
   const float h1 = 2.0f * a * s2 - 4.0f * b * (km[0] * s4 + km[1] * c4);
+  /* mut: ekf_jacobian_b_sign */
+  /* mut: ekf_sequentiality_map_ignored.3 */
   const float h2 = 2.0f * a * c2 + 4.0f * b * (km[2] * s4 + km[3] * c4);
   /* P H^T = c h^T with c = P's theta column; S = (h h^T) p22 + r I (4.37) */
   const float c1 = p[P12], cc2 = p[P22], c3 = p[P23];

@@ -36,6 +36,7 @@ bool rls_ab_update(rls_ab_t *k, float g_al, float g_be, float c2, float s2, cons
   /* H of (4.54): rows (alpha, beta), columns (a, b) */
   const float c4 = c2 * c2 - s2 * s2, s4 = 2.0f * s2 * c2;
   float h12 = c4, h22 = s4;
+  /* mut: rls_sequentiality_map_ignored */
   if (km != NULL) { /* the 4theta term as the sequentiality maps it (dfc_vec_t.k) */
     h12 = km[0] * c4 - km[1] * s4;
     h22 = km[3] * s4 - km[2] * c4;

@@ -64,6 +64,7 @@ dq_t flux_map_flux(const flux_map_t *m, dq_t i) {
 }
 
 flux_map_ldq_t flux_map_inductance(const flux_map_t *m, dq_t i) {
+  /* mut: flux_map_inductance_step */
   const float hd = 0.5f * m->did, hq = 0.5f * m->diq;
   const dq_t dp = flux_map_flux(m, (dq_t){i.d + hd, i.q});
   const dq_t dm = flux_map_flux(m, (dq_t){i.d - hd, i.q});
@@ -168,6 +169,7 @@ dq_t flux_map_current(const flux_map_t *m, dq_t lambda) {
 
 float flux_map_torque(const flux_map_t *m, float pole_pairs, dq_t i) {
   const dq_t l = flux_map_flux(m, i);
+  /* mut: flux_map_torque_sign */
   return 1.5f * pole_pairs * (l.d * i.q - l.q * i.d);
 }
 

@@ -60,6 +60,7 @@ sfo_gains_t sfo_gains_sota(float lambda, sincos_t sc_delta, float l_app_d, float
   /* Varatharajan 2022, eq. (17), PM on +d (sfo_model.h): the PM term
    * -sin(delta) lambda_m / (lambda L_q) becomes cos(delta) lambda_m / (lambda L_d) */
   g.a = 0.5f * s2 * k;
+  /* mut: sfo_sota_pm_sign */
   g.b = c2 * k + ((lambda > 1e-9f) ? sc_delta.c * lambda_m / (lambda * l_app_d) : 0.0f);
   return g;
 }

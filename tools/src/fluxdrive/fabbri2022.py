@@ -324,6 +324,7 @@ def identify_shifts(sil, root, out, plant: dict | None = None, seed: int | None 
     r = _shift_measure(_run(sil, _shift_sc(root, "ivd", plant=plant, seed=seed), out,
                             f"shift_ivd{tag}"), "IVD (1 iteration)")
     phi_a, phi_b, _, _ = star_shifts.fit_shifts(r.iq, r.phasors)
+    # mut: shifts_phi_b_doubled
     return r, phi_a, phi_b
 
 

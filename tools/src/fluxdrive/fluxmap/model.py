@@ -112,6 +112,7 @@ def syr_to_fluxdrive(i_d, i_q, psi_d, psi_q):
     i_d, i_q = np.asarray(i_d, float), np.asarray(i_q, float)
     new_id = -i_q[::-1] + 0.0  # no -0.0
     new_iq = i_d.copy()
+    # mut: syr_convention_psi_d_sign
     new_psi_d = -np.asarray(psi_q, float).T[:, ::-1]
     new_psi_q = np.asarray(psi_d, float).T[:, ::-1].copy()
     return new_id, new_iq, new_psi_d, new_psi_q

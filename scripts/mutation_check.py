@@ -83,10 +83,11 @@ REGION_LINES = 12  # the find text lies within the marker's line and this many a
 MARK_SUFFIXES = (".c", ".h", ".py", ".cmake", ".ld", ".sh")
 
 
-def markers(root: Path) -> dict[str, list[str]]:
-    """Marker name -> the files it appears in (source files of root)."""
+def markers(root: Path, files: list[str] | None = None) -> dict[str, list[str]]:
+    """Marker name -> the files it appears in (files, relative to root;
+    default: the source files of root's git work tree)."""
     out: dict[str, list[str]] = {}
-    for rel in source_files(root):
+    for rel in files if files is not None else source_files(root):
         if not rel.endswith(MARK_SUFFIXES):
             continue
         try:
@@ -100,10 +101,12 @@ def markers(root: Path) -> dict[str, list[str]]:
     return out
 
 
-def resolve_anchors(root: Path, mutants: list[Mutant]) -> dict[str, str]:
-    """Sets each anchored edit's file from its marker in root; returns the
-    mutants whose marker is missing or not unique, with the reason."""
-    index = markers(root) if any(e.anchor for m in mutants for e in m.edits) else {}
+def resolve_anchors(root: Path, mutants: list[Mutant],
+                    files: list[str] | None = None) -> dict[str, str]:
+    """Sets each anchored edit's file from its marker in root (among files,
+    default root's source files); returns the mutants whose marker is
+    missing or not unique, with the reason."""
+    index = markers(root, files) if any(e.anchor for m in mutants for e in m.edits) else {}
     bad: dict[str, str] = {}
     for m in mutants:
         for e in m.edits:
@@ -562,7 +565,9 @@ def _run(args, src_root: Path, work: Path, python: str, mutants: list[Mutant], t
 
     # stale mutants: reported, not run
     results: dict[str, Result] = {}
-    unresolved = resolve_anchors(src, mutants)
+    # the copy is no git work tree of its own (it may lie inside the
+    # caller's, under build/): its files are the caller's source files
+    unresolved = resolve_anchors(src, mutants, source_files(src_root))
     for m in mutants:
         why = ([unresolved[m.id]] if m.id in unresolved else
                [r for r in (stale_reason(src, e) for e in m.edits) if r])

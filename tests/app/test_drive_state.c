@@ -613,19 +613,24 @@ static void refused_law_switch_leaves_the_law_as_it_was(void **state) {
   assert_non_null(ctrl_law_refusal(DRIVE_LAW_DB_DFVC, &c.su));
 }
 
+/* A reluctance machine (no magnet, Lq > Ld) under FOC. */
+static void syr_config(drive_config_t *cfg) {
+  drive_config_default(cfg);
+  cfg->pole_pairs = 2.0f;
+  cfg->rs = 6.8f;
+  cfg->ld = 0.05f;
+  cfg->lq = 0.25f;
+  cfg->lambda_m = 0.0f;
+  cfg->flux_min = 0.0f;
+  cfg->law = DRIVE_LAW_FOC;
+}
+
 /* A reluctance machine (no magnet, Lq > Ld): FOC runs it, the SPM laws
  * are unavailable with their reason instead of failing the whole drive. */
 static void syr_machine_runs_foc_only(void **state) {
   (void)state;
   drive_config_t cfg;
-  drive_config_default(&cfg);
-  cfg.pole_pairs = 2.0f;
-  cfg.rs = 6.8f;
-  cfg.ld = 0.05f;
-  cfg.lq = 0.25f;
-  cfg.lambda_m = 0.0f;
-  cfg.flux_min = 0.0f;
-  cfg.law = DRIVE_LAW_FOC;
+  syr_config(&cfg);
   setup_with(&cfg);
   const char *why = drive_cmd_set_law(&drv, DRIVE_LAW_DB_DFVC);
   assert_non_null(why);
@@ -647,14 +652,7 @@ static void syr_machine_runs_foc_only(void **state) {
 static void syr_short_bound_from_its_own_set(void **state) {
   (void)state;
   drive_config_t cfg;
-  drive_config_default(&cfg);
-  cfg.pole_pairs = 2.0f;
-  cfg.rs = 6.8f;
-  cfg.ld = 0.05f;
-  cfg.lq = 0.25f;
-  cfg.lambda_m = 0.0f;
-  cfg.flux_min = 0.0f;
-  cfg.law = DRIVE_LAW_FOC;
+  syr_config(&cfg);
   setup_with(&cfg);
   const float first = drv.safe.psi_max;
   assert_true(first > 0.1f * drv.flux_scale);

@@ -195,24 +195,35 @@ def targets(root: Path, t: dict) -> dict[Path, str]:
     }
 
 
+def sync_generated(root: Path, files: dict[Path, str], write: bool) -> list[Path]:
+    """The generated files whose text differs from files' (written when
+    write): shared by `fluxdrive params` and `fluxdrive signals`."""
+    differ = []
+    for path, text in files.items():
+        old = path.read_text(encoding="utf-8") if path.exists() else None
+        if old == text:
+            continue
+        differ.append(path)
+        if write:
+            path.write_text(text, encoding="utf-8")
+            print(f"wrote {path.relative_to(root)}")
+    return differ
+
+
+def report_differ(root: Path, differ: list[Path], source: str, fix: str) -> None:
+    for p in differ:
+        print(f"differs from {source}: {p.relative_to(root)}")
+    print(f"regenerate with: {fix}")
+
+
 def main(args: argparse.Namespace) -> int:
     from fluxdrive.sil import find_repo_root, locate_sil
 
     root = find_repo_root() or Path.cwd()
     t = from_sil(locate_sil(args.sil))
-    differ = []
-    for path, text in targets(root, t).items():
-        old = path.read_text(encoding="utf-8") if path.exists() else None
-        if old == text:
-            continue
-        differ.append(path)
-        if args.write:
-            path.write_text(text, encoding="utf-8")
-            print(f"wrote {path.relative_to(root)}")
+    differ = sync_generated(root, targets(root, t), args.write)
     if args.check and differ:
-        for p in differ:
-            print(f"differs from the firmware's table: {p.relative_to(root)}")
-        print("regenerate with: fluxdrive params --write")
+        report_differ(root, differ, "the firmware's table", "fluxdrive params --write")
         return 1
     if not differ:
         print("DBC, tools table and docs/parameters.md agree with the firmware's table")

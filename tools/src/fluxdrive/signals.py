@@ -199,19 +199,10 @@ def main(args: argparse.Namespace) -> int:
     errs = problems(root, t)
     for e in errs:
         print(f"disagrees: {e}")
-    differ = []
-    for path, text in targets(root, t).items():
-        old = path.read_text(encoding="utf-8") if path.exists() else None
-        if old == text:
-            continue
-        differ.append(path)
-        if args.write:
-            path.write_text(text, encoding="utf-8")
-            print(f"wrote {path.relative_to(root)}")
+    from fluxdrive.params import report_differ, sync_generated
+    differ = sync_generated(root, targets(root, t), args.write)
     if args.check and differ:
-        for p in differ:
-            print(f"differs from the signal tables: {p.relative_to(root)}")
-        print("regenerate with: fluxdrive signals --write")
+        report_differ(root, differ, "the signal tables", "fluxdrive signals --write")
         return 1
     if errs:
         return 1

@@ -52,18 +52,14 @@ dq_t machine_current(const machine_t *m, dq_t lambda) {
 
 machine_ldq_t machine_inductance(const machine_t *m, dq_t i) {
   if (m->kind == MACHINE_FLUX_MAP) {
-    const flux_map_ldq_t l = flux_map_inductance(m->map, i);
-    return (machine_ldq_t){l.dd, l.dq, l.qd, l.qq};
+    return flux_map_inductance(m->map, i);
   }
   return (machine_ldq_t){m->ld, 0.0f, 0.0f, m->lq}; /* linear: independent of i */
 }
 
 dq_t machine_flux_inductance(const machine_t *m, dq_t i, machine_ldq_t *l) {
   if (m->kind == MACHINE_FLUX_MAP) {
-    flux_map_ldq_t k;
-    const dq_t f = flux_map_flux_inductance(m->map, i, &k);
-    *l = (machine_ldq_t){k.dd, k.dq, k.qd, k.qq};
-    return f;
+    return flux_map_flux_inductance(m->map, i, l); /* in place: one type */
   }
   *l = (machine_ldq_t){m->ld, 0.0f, 0.0f, m->lq};
   return (dq_t){m->ld * i.d + m->lambda_m, m->lq * i.q};

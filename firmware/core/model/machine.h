@@ -24,10 +24,9 @@
 
 typedef enum { MACHINE_LINEAR = 0, MACHINE_FLUX_MAP, MACHINE_KIND_COUNT } machine_kind_t;
 
-/* Incremental inductance matrix d lambda_dq / d i_dq [H]. */
-typedef struct {
-  float dd, dq, qd, qq;
-} machine_ldq_t;
+/* Incremental inductance matrix d lambda_dq / d i_dq [H]: the map's type
+ * (flux_map.h), so that a map's lookup fills the caller's matrix in place. */
+typedef flux_map_ldq_t machine_ldq_t;
 
 typedef struct {
   machine_kind_t kind;

@@ -24,10 +24,10 @@ FM_INLINE float word_f32(const uint32_t *w, uint32_t i) {
 }
 
 /* The grid cell used for i: its first point (offset k nd + j, clamped so
- * that the cell exists) and the position (u, v) inside it in steps, not
- * clamped (linear extrapolation outside the grid). */
+ * that the cell exists), its column j and row k, and the position (u, v)
+ * inside it in steps, not clamped (linear extrapolation outside the grid). */
 typedef struct {
-  uint32_t o;
+  uint32_t o, j, k;
   float u, v;
 } cell_t;
 
@@ -36,7 +36,7 @@ FM_INLINE cell_t cell_of(const flux_map_t *m, dq_t i) {
   const float y = (i.q - m->iq0) * m->inv_diq;
   const uint32_t j = (uint32_t)fd_clampf(x, 0.0f, (float)(m->nd - 2u)); /* >= 0: trunc = floor */
   const uint32_t k = (uint32_t)fd_clampf(y, 0.0f, (float)(m->nq - 2u));
-  return (cell_t){k * m->nd + j, x - (float)j, y - (float)k};
+  return (cell_t){k * m->nd + j, j, k, x - (float)j, y - (float)k};
 }
 
 /* The four corners of one table in a cell: f00 (j, k), f10 (j+1, k),
@@ -74,52 +74,72 @@ flux_map_ldq_t flux_map_inductance(const flux_map_t *m, dq_t i) {
                           (dp.q - dm.q) * m->inv_did, (qp.q - qm.q) * m->inv_diq};
 }
 
-/* Slope along d of table t in the cell column starting at offset o, at the
- * q fraction v (per step); along q at the d fraction u. */
-FM_INLINE float slope_d(const flux_map_t *m, const uint32_t *t, uint32_t o, float v) {
-  return (1.0f - v) * (word_f32(t, o + 1u) - word_f32(t, o)) +
-         v * (word_f32(t, o + m->nd + 1u) - word_f32(t, o + m->nd));
-}
-FM_INLINE float slope_q(const flux_map_t *m, const uint32_t *t, uint32_t o, float u) {
-  return (1.0f - u) * (word_f32(t, o + m->nd) - word_f32(t, o)) +
-         u * (word_f32(t, o + m->nd + 1u) - word_f32(t, o + 1u));
+/* The centred (25) over one step (flux_map.h) needs, per axis, the slope
+ * of the cell next to c that the window [x - 1/2, x + 1/2] (steps) reaches
+ * into: the one after (fraction >= 1/2) or before it; at the grid's edge
+ * the cell's plane continues (the neighbour is the cell itself). Which
+ * neighbour, and the window's share in it, are the same for both tables. */
+typedef struct {
+  int nd_dir, nq_dir; /* +1 the next cell, -1 the previous one, 0 none */
+  float w, z;         /* the window's share in it along d, along q */
+} window_t;
+
+FM_INLINE window_t window_of(const flux_map_t *m, const cell_t *c) {
+  window_t s;
+  s.w = c->u - 0.5f;
+  if (s.w >= 0.0f) {
+    s.nd_dir = (c->j + 1u <= m->nd - 2u) ? 1 : 0;
+  } else {
+    s.nd_dir = (c->j >= 1u) ? -1 : 0;
+    s.w = -s.w;
+  }
+  s.z = c->v - 0.5f;
+  if (s.z >= 0.0f) {
+    s.nq_dir = (c->k + 1u <= m->nq - 2u) ? 1 : 0;
+  } else {
+    s.nq_dir = (c->k >= 1u) ? -1 : 0;
+    s.z = -s.z;
+  }
+  return s;
 }
 
-/* The centred (25) over one step of table t at cell c (flux_map.h), with
- * the cell's corners f: the window [x - 1/2, x + 1/2] (steps) covers this
- * cell and the one after (fraction >= 1/2) or before it; at the grid's
- * edge the cell's plane continues (the neighbour is the cell itself). */
+/* The centred (25) of table t at cell c with the cell's corners f and the
+ * window s: the slope along d, (1 - v) of the lower row plus v of the
+ * upper, blended with the neighbour's by the share w, and alike along q.
+ * The neighbour shares two corners with the cell (f): two table words
+ * each (a cell and its neighbours are 8 words of a table, not 12). */
 FM_INLINE void centred(const flux_map_t *m, const uint32_t *t, const cell_t *c, const corners_t *f,
-                       uint32_t j, uint32_t k, float *l_d, float *l_q) {
+                       const window_t *s, float *l_d, float *l_q) {
+  const uint32_t o = c->o, nd = m->nd;
   const float sd = (1.0f - c->v) * (f->f10 - f->f00) + c->v * (f->f11 - f->f01);
   const float sq = (1.0f - c->u) * (f->f01 - f->f00) + c->u * (f->f11 - f->f10);
-  float w = c->u - 0.5f;
-  uint32_t on;
-  if (w >= 0.0f) {
-    on = (j + 1u <= m->nd - 2u) ? c->o + 1u : c->o;
-  } else {
-    on = (j >= 1u) ? c->o - 1u : c->o;
-    w = -w;
+  float nd_s = sd; /* the neighbour's slope along d */
+  if (s->nd_dir > 0) {
+    nd_s =
+        (1.0f - c->v) * (word_f32(t, o + 2u) - f->f10) + c->v * (word_f32(t, o + nd + 2u) - f->f11);
+  } else if (s->nd_dir < 0) {
+    nd_s =
+        (1.0f - c->v) * (f->f00 - word_f32(t, o - 1u)) + c->v * (f->f01 - word_f32(t, o + nd - 1u));
   }
-  *l_d = (sd + w * (slope_d(m, t, on, c->v) - sd)) * m->inv_did;
-  float z = c->v - 0.5f;
-  if (z >= 0.0f) {
-    on = (k + 1u <= m->nq - 2u) ? c->o + m->nd : c->o;
-  } else {
-    on = (k >= 1u) ? c->o - m->nd : c->o;
-    z = -z;
+  *l_d = (sd + s->w * (nd_s - sd)) * m->inv_did;
+  float nq_s = sq; /* along q */
+  if (s->nq_dir > 0) {
+    nq_s = (1.0f - c->u) * (word_f32(t, o + 2u * nd) - f->f01) +
+           c->u * (word_f32(t, o + 2u * nd + 1u) - f->f11);
+  } else if (s->nq_dir < 0) {
+    nq_s =
+        (1.0f - c->u) * (f->f00 - word_f32(t, o - nd)) + c->u * (f->f10 - word_f32(t, o - nd + 1u));
   }
-  *l_q = (sq + z * (slope_q(m, t, on, c->u) - sq)) * m->inv_diq;
+  *l_q = (sq + s->z * (nq_s - sq)) * m->inv_diq;
 }
 
 dq_t flux_map_flux_inductance(const flux_map_t *m, dq_t i, flux_map_ldq_t *l) {
   const cell_t c = cell_of(m, i);
-  const uint32_t k = c.o / m->nd;
-  const uint32_t j = c.o - k * m->nd;
+  const window_t s = window_of(m, &c);
   const corners_t d = corners(m, m->psi_d, c.o);
   const corners_t q = corners(m, m->psi_q, c.o);
-  centred(m, m->psi_d, &c, &d, j, k, &l->dd, &l->dq);
-  centred(m, m->psi_q, &c, &q, j, k, &l->qd, &l->qq);
+  centred(m, m->psi_d, &c, &d, &s, &l->dd, &l->dq);
+  centred(m, m->psi_q, &c, &q, &s, &l->qd, &l->qq);
   return (dq_t){bilinear(&d, c.u, c.v), bilinear(&q, c.u, c.v)};
 }
 

@@ -96,9 +96,11 @@ SAT_SIG(flux_mtpa)
 SAT_SIG(torque_mtpv)
 SAT_SIG(gain_a)
 SAT_SIG(gain_b)
-SAT_SIG(mtpa_angle)
 SAT_SIG(mtpv_angle)
 #undef SAT_SIG
+FD_COLD static double sig_mtpa_angle(const void *owner) {
+  return (double)dfvc_decoupled_tm_mtpa_angle(&((const ctrl_state_t *)owner)->dfvc_decoupled.tm);
+}
 
 static const signal_row_t sat_signals[] = {
     {"flux_mtpa", SIGNAL_F32, "Vs", "MTPA flux, table (29) or adapted online (32)", sig_flux_mtpa},

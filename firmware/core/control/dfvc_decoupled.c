@@ -34,29 +34,36 @@ FD_COLD void dfvc_decoupled_cfg_defaults(dfvc_decoupled_cfg_t *cfg, const machin
   cfg->lambda_min = 0.1f;
 }
 
+/* The step's blocks inlined into it at -Os too (as calls their arguments
+ * and results went through the stack: PIL). */
+#if defined(__GNUC__)
+#define DD_INLINE static inline __attribute__((always_inline))
+#else
+#define DD_INLINE static inline
+#endif
+
 /* The model quantities with the controller's map scaled (dfvc_decoupled.h) at the
  * current-model flux li and inductances l. sota 0 skips the gains of (17);
  * angles 0: no MTPV angle (LUT references), 1: the MTPV angle of (34), 2:
- * also the MTPA angle (below 2 the MTPA phase is its sine: telemetry, no
- * atan2 in the ISR). */
-static void dfvc_decoupled_model_at(const machine_t *m, dq_t s, dq_t lambda, dq_t i, dq_t li,
-                                    machine_ldq_t l, int sota, int angles,
-                                    dfvc_decoupled_model_t *q) {
+ * also the MTPA angle (below 2 it is not computed: the ISR's telemetry
+ * takes its sine from lambda^a and i where it is read,
+ * dfvc_decoupled_tm_mtpa_angle; no atan2 and no root in the ISR). */
+DD_INLINE void dfvc_decoupled_model_at(const machine_t *m, dq_t s, dq_t lambda, dq_t i, dq_t li,
+                                       machine_ldq_t l, int sota, int angles,
+                                       dfvc_decoupled_model_t *q) {
   q->lambda_i = li;
   q->l = l;
   const float l2 = lambda.d * lambda.d + lambda.q * lambda.q;
   const dq_t la = sfo_aux_flux(lambda, i, l);    /* (6) */
   const dq_t ia = sfo_aux_current(lambda, i, l); /* (9) */
-  q->mtpa_cross = sfo_mtpa_cross(la, i);         /* (7) */
-  q->mtpv_cross = sfo_mtpv_cross(lambda, ia);    /* (10) */
-  if (angles == 2) {
-    q->mtpa_angle = sfo_line_angle(i, la);
-  } else {
-    /* the ISR: the sine of the MTPA phase error (telemetry, no atan2) */
-    const float n = sqrtf((la.d * la.d + la.q * la.q) * (i.d * i.d + i.q * i.q));
-    q->mtpa_angle = (n > 1e-12f) ? fabsf(q->mtpa_cross) / n : 0.0f;
-  }
-  q->mtpv_angle = angles ? sfo_line_angle(lambda, ia) : 0.0f;
+  q->lambda_a = la;
+  q->mtpa_cross = sfo_mtpa_cross(la, i);      /* (7) */
+  q->mtpv_cross = sfo_mtpv_cross(lambda, ia); /* (10) */
+  q->mtpa_angle = (angles == 2) ? sfo_line_angle(i, la) : 0.0f;
+  /* sfo_line_angle(lambda, i^a): its sine term is -mtpv_cross, whose
+   * magnitude it takes (the same float, negated exactly) */
+  q->mtpv_angle =
+      angles ? fd_atan2f(fabsf(q->mtpv_cross), fabsf(lambda.d * ia.d + lambda.q * ia.q)) : 0.0f;
   q->prop.a = sfo_gain_a(lambda, l); /* (22) */
   q->prop.b = (l2 > 1e-12f) ? q->mtpv_cross / l2 : 0.0f;
   q->sota = (sfo_gains_t){0.0f, 0.0f};
@@ -70,6 +77,13 @@ static void dfvc_decoupled_model_at(const machine_t *m, dq_t s, dq_t lambda, dq_
         (lam > 1e-6f) ? (sincos_t){lambda.q / lam, lambda.d / lam} : (sincos_t){0.0f, 1.0f};
     q->sota = sfo_gains_sota(lam, scd, lad, laq, machine_pm_flux(m) * s.d); /* (17) */
   }
+}
+
+FD_COLD float dfvc_decoupled_tm_mtpa_angle(const dfvc_decoupled_tm_t *tm) {
+  const dq_t la = tm->mtpa_la;
+  const dq_t i = tm->mtpa_i;
+  const float n = sqrtf((la.d * la.d + la.q * la.q) * (i.d * i.d + i.q * i.q));
+  return (n > 1e-12f) ? fabsf(sfo_mtpa_cross(la, i)) / n : 0.0f;
 }
 
 /* The controller's map at i: flux and L_d (25), rows scaled by s
@@ -310,5 +324,5 @@ void dfvc_decoupled_step(dfvc_decoupled_t *c, const dfvc_decoupled_in_t *in,
   out->sat = po.sat;
   out->fault = 0u;
   c->tm =
-      (dfvc_decoupled_tm_t){r->lambda_mtpa, r->torque_mtpv, g.a, g.b, q.mtpa_angle, q.mtpv_angle};
+      (dfvc_decoupled_tm_t){r->lambda_mtpa, r->torque_mtpv, g.a, g.b, q.lambda_a, i, q.mtpv_angle};
 }

@@ -92,9 +92,14 @@ typedef struct {
   float torque_mtpv; /* (31) or (34) [N m] */
   float gain_a;      /* a_hat in use [1/H] */
   float gain_b;      /* b_hat in use [1/H] */
-  float mtpa_angle;  /* sine of the MTPA phase error */
+  dq_t mtpa_la;      /* lambda^a (6) [Vs] and i [A] of (7): the sine of the */
+  dq_t mtpa_i;       /* MTPA phase error where it is read, dfvc_decoupled_tm_mtpa_angle */
   float mtpv_angle;  /* MTPV angle of (34) [rad] (online references) */
 } dfvc_decoupled_tm_t;
+
+/* The sine of the MTPA phase error of the last step, |(7)| / (|lambda^a| |i|)
+ * (0 at zero current): telemetry, computed where it is read, not in the ISR. */
+float dfvc_decoupled_tm_mtpa_angle(const dfvc_decoupled_tm_t *tm);
 
 typedef struct {
   dfvc_decoupled_cfg_t cfg;
@@ -126,6 +131,7 @@ typedef struct {
   machine_ldq_t l;  /* L_d (25) [H] */
   sfo_gains_t prop; /* (22) */
   sfo_gains_t sota; /* (17) */
+  dq_t lambda_a;    /* auxiliary flux (6) [Vs] */
   float mtpa_cross, mtpv_cross, mtpa_angle, mtpv_angle;
 } dfvc_decoupled_model_t;
 void dfvc_decoupled_model(const machine_t *m, dq_t cm_scale, dq_t lambda, dq_t i,

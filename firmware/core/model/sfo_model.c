@@ -8,37 +8,10 @@
 
 #include "math/fast_trig.h"
 
-dq_t sfo_aux_current(dq_t lambda, dq_t i, machine_ldq_t l) {
-  const float det = l.dd * l.qq - l.dq * l.qd;
-  if (!(det > 0.0f)) {
-    return (dq_t){0.0f, 0.0f};
-  }
-  /* Varatharajan 2022, eq. (9): J i - L^-1 J lambda */
-  const dq_t ji = sfo_j(i);
-  const dq_t jl = sfo_j(lambda);
-  const float inv = 1.0f / det;
-  return (dq_t){ji.d - inv * (l.qq * jl.d - l.dq * jl.q), ji.q - inv * (l.dd * jl.q - l.qd * jl.d)};
-}
-
 float sfo_line_angle(dq_t x, dq_t y) {
   const float c = x.d * y.q - x.q * y.d; /* |x||y| sin */
   const float d = x.d * y.d + x.q * y.q; /* |x||y| cos */
   return fd_atan2f(fabsf(c), fabsf(d));
-}
-
-float sfo_gain_a(dq_t lambda, machine_ldq_t l) {
-  const float l2 = lambda.d * lambda.d + lambda.q * lambda.q;
-  const float ldq = 0.5f * (l.dq + l.qd);
-  const float det = l.dd * l.qq - ldq * ldq;
-  if (!(l2 > 1e-12f) || !(det > 0.0f)) {
-    return 0.0f;
-  }
-  /* sin 2delta, cos 2delta from the flux components */
-  const float s2 = 2.0f * lambda.d * lambda.q / l2;
-  const float c2 = (lambda.d * lambda.d - lambda.q * lambda.q) / l2;
-  const float l_delta = 0.5f * (l.dd - l.qq);
-  /* Varatharajan 2022, eq. (22), a */
-  return (l_delta * s2 - ldq * c2) / det;
 }
 
 sfo_gains_t sfo_gains(dq_t lambda, dq_t i, machine_ldq_t l) {

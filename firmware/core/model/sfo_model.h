@@ -65,8 +65,19 @@ static inline float sfo_mtpa_cross(dq_t lambda_a, dq_t i) {
   return sfo_cross(lambda_a, i);
 }
 /* Auxiliary-current vector (9): i^a = J i - L_d^-1 J lambda [A]; a singular
- * L_d (det <= 0) gives (0, 0). */
-dq_t sfo_aux_current(dq_t lambda, dq_t i, machine_ldq_t l);
+ * L_d (det <= 0) gives (0, 0). Inline, as sfo_gain_a (a call of each cost
+ * the decoupled DFVC's ISR more than its body, PIL). */
+static inline dq_t sfo_aux_current(dq_t lambda, dq_t i, machine_ldq_t l) {
+  const float det = l.dd * l.qq - l.dq * l.qd;
+  if (!(det > 0.0f)) {
+    return (dq_t){0.0f, 0.0f};
+  }
+  /* Varatharajan 2022, eq. (9): J i - L^-1 J lambda */
+  const dq_t ji = sfo_j(i);
+  const dq_t jl = sfo_j(lambda);
+  const float inv = 1.0f / det;
+  return (dq_t){ji.d - inv * (l.qq * jl.d - l.dq * jl.q), ji.q - inv * (l.dd * jl.q - l.qd * jl.d)};
+}
 /* MTPV condition (10): lambda^T J i^a, zero on the MTPV trajectory; dT/ddelta
  * of (8) is 3p/2 times it [Vs A]. */
 static inline float sfo_mtpv_cross(dq_t lambda, dq_t i_a) {
@@ -82,7 +93,20 @@ float sfo_line_angle(dq_t x, dq_t y);
  * a singular L_d gives (0, 0). */
 sfo_gains_t sfo_gains(dq_t lambda, dq_t i, machine_ldq_t l);
 /* The cross-coupling gain a of (22) alone (b = sfo_mtpv_cross / lambda^2). */
-float sfo_gain_a(dq_t lambda, machine_ldq_t l);
+static inline float sfo_gain_a(dq_t lambda, machine_ldq_t l) {
+  const float l2 = lambda.d * lambda.d + lambda.q * lambda.q;
+  const float ldq = 0.5f * (l.dq + l.qd);
+  const float det = l.dd * l.qq - ldq * ldq;
+  if (!(l2 > 1e-12f) || !(det > 0.0f)) {
+    return 0.0f;
+  }
+  /* sin 2delta, cos 2delta from the flux components */
+  const float s2 = 2.0f * lambda.d * lambda.q / l2;
+  const float c2 = (lambda.d * lambda.d - lambda.q * lambda.q) / l2;
+  const float l_delta = 0.5f * (l.dd - l.qq);
+  /* Varatharajan 2022, eq. (22), a */
+  return (l_delta * s2 - ldq * c2) / det;
+}
 /* The state-of-the-art gains (17) in the fluxdrive frame (header) from the
  * flux amplitude lambda, the load angle (sin, cos) and the apparent
  * inductances L_d, L_q [H] with the PM flux lambda_m [Vs]. */

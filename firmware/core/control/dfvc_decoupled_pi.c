@@ -22,6 +22,7 @@ FD_COLD int dfvc_decoupled_pi_init(dfvc_decoupled_pi_t *c, const dfvc_decoupled_
   /* mut: dfvc_decoupled_kp_half */
   c->kp = (1.0f - p * p) / k->ts;
   c->ki = (1.0f - p) * (1.0f - p) / (k->ts * k->ts);
+  c->kits = c->ki * k->ts;
   return 0;
 }
 
@@ -40,7 +41,7 @@ static float dfvc_decoupled_pi_clip(float x, float lim, int *sat) {
 void dfvc_decoupled_pi_step(dfvc_decoupled_pi_t *c, const dfvc_decoupled_pi_in_t *in,
                             dfvc_decoupled_pi_out_t *out) {
   const dfvc_decoupled_pi_cfg_t *k = &c->cfg;
-  const float kits = c->ki * k->ts;
+  const float kits = c->kits;
   /* the controlled variables at tau+1 (dfvc_decoupled_pi.h, delay) */
   const float itau_pred = in->i_ft.q + k->ts * c->u_t_prev;
   const float e_f = in->lambda_ref - in->lambda_next;

@@ -44,6 +44,7 @@ typedef struct {
 typedef struct {
   dfvc_decoupled_pi_cfg_t cfg;
   float kp, ki;   /* discrete (28) [1/s], [1/s^2] */
+  float kits;     /* ki Ts, the integrators' gain per period [1/s] */
   float integ_f;  /* integral part of u_f [V] */
   float integ_t;  /* integral part of u_tau [A/s] */
   float u_t_prev; /* u_tau applied over [tau, tau+1) [A/s] */

@@ -42,6 +42,7 @@ FD_COLD int dfvc_decoupled_refs_init(dfvc_decoupled_refs_t *r,
     return -1;
   }
   r->cfg = *cfg;
+  r->kt = 1.5f * c->machine->pole_pairs;
   dfvc_decoupled_refs_reset(r);
   return 0;
 }
@@ -56,7 +57,7 @@ void dfvc_decoupled_refs_reset(dfvc_decoupled_refs_t *r) {
 void dfvc_decoupled_refs_update(dfvc_decoupled_refs_t *r, const dfvc_decoupled_refs_in_t *in,
                                 dfvc_decoupled_refs_out_t *out) {
   const dfvc_decoupled_refs_cfg_t *c = &r->cfg;
-  const float kt = 1.5f * c->machine->pole_pairs;
+  const float kt = r->kt;
   unsigned lim = 0u;
   /* Varatharajan 2022, eq. (30), less the resistive drop at the filtered
    * current amplitude (see the header) */

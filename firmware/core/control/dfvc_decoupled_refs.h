@@ -86,6 +86,7 @@ typedef struct {
   float lambda_ref;  /* lambda* of the last update [Vs] */
   float i_amp_f;     /* current amplitude, low-passed (10 ms), for (30) [A] */
   float i_alpha;     /* its filter's gain per period */
+  float kt;          /* 3/2 p, the torque per flux and current of (13) (init) */
 } dfvc_decoupled_refs_t;
 
 typedef struct {

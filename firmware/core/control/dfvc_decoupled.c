@@ -98,8 +98,9 @@ static void dfvc_decoupled_map(const machine_t *m, dq_t s, dq_t i, dq_t *li, mac
   *l = (machine_ldq_t){s.d * k.dd, s.d * k.dq, s.q * k.qd, s.q * k.qq};
 }
 
-void dfvc_decoupled_model(const machine_t *m, dq_t cm_scale, dq_t lambda, dq_t i,
-                          dfvc_decoupled_model_t *q) {
+/* init, tests and tools (the step inlines its own dfvc_decoupled_model_at) */
+FD_COLD void dfvc_decoupled_model(const machine_t *m, dq_t cm_scale, dq_t lambda, dq_t i,
+                                  dfvc_decoupled_model_t *q) {
   dq_t li;
   machine_ldq_t l;
   dfvc_decoupled_map(m, cm_scale, i, &li, &l);

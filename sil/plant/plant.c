@@ -192,6 +192,7 @@ int plant_init(plant_t *pl, const plant_params_t *p, const char **field) {
       p->mech.mode == PLANT_MECH_IMPOSED ? profile_eval(&p->mech.speed, 0.0) : p->mech.omega0;
   pl->v_dc = p->dclink.v_source;
   a->cur.key[0] = NAN; /* no cached currents */
+  a->avgs = 1;
   plant_sensors_init(pl);
   plant_faults_init(pl);
   return 0;
@@ -348,6 +349,10 @@ int plant_set_power_faults(plant_t *pl, const plant_power_fault_t *f) {
   pl->aux.pf_any = (pl->aux.pf.open | pl->aux.pf.closed | pl->aux.pf.phase_open |
                     pl->aux.pf.ground | pl->aux.pf.shorted) != 0u;
   return 0;
+}
+
+void plant_set_averages(plant_t *pl, bool on) {
+  pl->aux.avgs = on ? 1 : 0;
 }
 
 bool plant_take_desat(plant_t *pl) {

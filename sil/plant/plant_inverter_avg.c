@@ -21,6 +21,12 @@
 
 #include <math.h>
 
+#if defined(__GNUC__)
+#define AVG_ALWAYS_INLINE __attribute__((always_inline)) inline
+#else
+#define AVG_ALWAYS_INLINE inline
+#endif
+
 /* d_eff for a leg with duty d and kd = td/Ts when 0 < d < 1, else kd = 0
  * (no switching, no dead time: d_eff = d - 0 = d; only a NaN current, i.e.
  * an already diverged state, gives NaN there). The clamps are branches:
@@ -58,10 +64,12 @@ typedef struct {
 
 /* Derivative at one stage, c and s being cos and sin of the stage's rotor
  * angle. The same expressions as plant_internal.h's inline mechanics and
- * DC link, with the parameters hoisted. */
-static inline void avg_deriv(const avg_k_t *restrict k, int ideal, int imposed, double c, double s,
-                             const double *restrict x, double m, double *restrict dx,
-                             const double *i_known) {
+ * DC link, with the parameters hoisted. `avgs`: integrate the period
+ * averages (v_an, v_bn, i_dc, torque, i_dq: the log's; plant_set_averages)
+ * as well; the star point's (X_VN, the sensors') always. */
+static AVG_ALWAYS_INLINE void avg_deriv(const avg_k_t *restrict k, int ideal, int imposed, int avgs,
+                                        double c, double s, const double *restrict x, double m,
+                                        double *restrict dx, const double *i_known) {
   double id, iq;
   if (i_known != NULL) { /* the state's currents, already computed (the plant's cache) */
     id = i_known[0];
@@ -86,9 +94,6 @@ static inline void avg_deriv(const avg_k_t *restrict k, int ideal, int imposed, 
   dx[X_LD] = vd - k->rs * id + we * x[X_LQ];
   dx[X_LQ] = vq - k->rs * iq - we * x[X_LD];
   const double te = 1.5 * k->pp * (x[X_LD] * iq - x[X_LQ] * id);
-  dx[X_TE] = te;
-  dx[X_ID] = id;
-  dx[X_IQ] = iq;
   if (imposed) {
     dx[X_TH] = m;
     dx[X_W] = 0.0;
@@ -96,30 +101,29 @@ static inline void avg_deriv(const avg_k_t *restrict k, int ideal, int imposed, 
     dx[X_TH] = x[X_W];
     dx[X_W] = (te - k->b * x[X_W] - m) * k->inv_j;
   }
-  const double idc = da * ia + db * ib + dc * ic;
+  dx[X_VN] = vn - 0.5 * vdc;
+  const double idc = avgs || !ideal ? da * ia + db * ib + dc * ic : 0.0;
   dx[X_VC] = ideal ? 0.0
                    : (plant_dclink_source(k->vsrc, x[X_VC], k->inv_r, k->one_way) -
                       x[X_VC] * k->g_chop - idc) *
                          k->inv_c;
-  dx[X_VA] = van;
-  dx[X_VB] = vbn;
-  dx[X_VN] = vn - 0.5 * vdc;
-  dx[X_IDC] = idc;
+  if (avgs) {
+    dx[X_IDC] = idc;
+    dx[X_TE] = te;
+    dx[X_ID] = id;
+    dx[X_IQ] = iq;
+    dx[X_VA] = van;
+    dx[X_VB] = vbn;
+  }
 }
 
-#if defined(__GNUC__)
-#define AVG_ALWAYS_INLINE __attribute__((always_inline)) inline
-#else
-#define AVG_ALWAYS_INLINE inline
-#endif
-
-/* The RK4 steps of one period; `ideal` and `imposed` are constants at each
- * call site (specialised copies). State entries whose derivative is
+/* The RK4 steps of one period; `ideal`, `imposed` and `avgs` are constants
+ * at each call site (specialised copies). State entries whose derivative is
  * identically zero (v_C on an ideal link, w under imposed speed) are left
  * as they are: x + h * 0 = x, the same result without the work. */
 static AVG_ALWAYS_INLINE void avg_rk4(const plant_t *pl, const avg_k_t *restrict kc, int ideal,
-                                      int imposed, angle_ref_t *restrict ar, double *restrict x,
-                                      double *restrict cs_end) {
+                                      int imposed, int avgs, angle_ref_t *restrict ar,
+                                      double *restrict x, double *restrict cs_end) {
   const int n = pl->aux.steps; /* the scenario's, more at speed (plant.h) */
   const double h = pl->p.ts / n, h2 = 0.5 * h, h6 = h / 6.0;
   const avg_k_t *restrict k = kc; /* not copied: a copy of the just-written struct would stall */
@@ -143,24 +147,24 @@ static AVG_ALWAYS_INLINE void avg_rk4(const plant_t *pl, const avg_k_t *restrict
       ar->c = c;
       ar->s = s;
     }
-    avg_deriv(k, ideal, imposed, ar->c, ar->s, x, m0, k1, j == 0 ? ar->i_known : NULL);
+    avg_deriv(k, ideal, imposed, avgs, ar->c, ar->s, x, m0, k1, j == 0 ? ar->i_known : NULL);
     for (int i = 0; i < X_VA; i++) { /* the integrals X_VA.. are not read */
       xs[i] = x[i] + h2 * k1[i];
     }
     stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
-    avg_deriv(k, ideal, imposed, c, s, xs, m1, k2, NULL);
+    avg_deriv(k, ideal, imposed, avgs, c, s, xs, m1, k2, NULL);
     for (int i = 0; i < X_VA; i++) {
       xs[i] = x[i] + h2 * k2[i];
     }
     stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
-    avg_deriv(k, ideal, imposed, c, s, xs, m1, k3, NULL);
+    avg_deriv(k, ideal, imposed, avgs, c, s, xs, m1, k3, NULL);
     for (int i = 0; i < X_VA; i++) {
       xs[i] = x[i] + h * k3[i];
     }
     stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
-    avg_deriv(k, ideal, imposed, c, s, xs, m2, k4, NULL);
+    avg_deriv(k, ideal, imposed, avgs, c, s, xs, m2, k4, NULL);
     for (int i = 0; i < X_N; i++) {
-      if ((ideal && i == X_VC) || (imposed && i == X_W)) {
+      if ((ideal && i == X_VC) || (imposed && i == X_W) || (!avgs && i != X_VN && i >= X_VA)) {
         continue;
       }
       x[i] += h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
@@ -217,9 +221,17 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
     ar.s = sin(ar.th);
     ar.i_known = NULL;
   }
-  if (k.ideal && !k.imposed) {
-    avg_rk4(pl, &k, 1, 0, &ar, x, cs_end); /* the usual case */
+  const int avgs = pl->aux.avgs;
+  if (k.ideal && !k.imposed) { /* the usual case */
+    if (avgs) {
+      avg_rk4(pl, &k, 1, 0, 1, &ar, x, cs_end);
+    } else {
+      avg_rk4(pl, &k, 1, 0, 0, &ar, x, cs_end);
+    }
   } else {
-    avg_rk4(pl, &k, k.ideal, k.imposed, &ar, x, cs_end);
+    avg_rk4(pl, &k, k.ideal, k.imposed, avgs, &ar, x, cs_end);
+  }
+  if (!avgs) { /* not integrated: the averages read NaN, never a stale value */
+    x[X_VA] = x[X_VB] = x[X_IDC] = x[X_TE] = x[X_ID] = x[X_IQ] = NAN;
   }
 }

@@ -280,6 +280,8 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
   if (sil_setup(&x, sc, err, errlen) != 0) {
     return -1;
   }
+  /* the plant's period averages are the observer's (the log) alone */
+  plant_set_averages(&x.plant, obs != NULL);
   if (opts == NULL) {
     opts = &no_opts;
   }

@@ -55,7 +55,7 @@ static inline void stage_cos_sin(const angle_ref_t *r, double th, double *c, dou
 
 /* Constants of one period, in locals (no reloads through pl in the stages). */
 typedef struct {
-  plant_mag_t mag;
+  const plant_mag_t *mag; /* the plant's (read only: no copy) */
   double pp, rs, nb, b, inv_j, vsrc, inv_r, inv_c, g_chop;
   int one_way;        /* rectifier link */
   double d[3], kd[3]; /* duties; td/Ts for a switching leg (0 < d < 1), else 0 */
@@ -75,7 +75,7 @@ static AVG_ALWAYS_INLINE void avg_deriv(const avg_k_t *restrict k, int ideal, in
     id = i_known[0];
     iq = i_known[1];
   } else {
-    plant_mag_current(&k->mag, x[X_LD], x[X_LQ], &id, &iq);
+    plant_mag_current(k->mag, x[X_LD], x[X_LQ], &id, &iq);
   }
   const double ial = id * c - iq * s, ibe = id * s + iq * c;
   const double ia = ial, ib = -0.5 * ial + PLANT_SQRT3_2 * ibe, ic = -ia - ib;
@@ -188,7 +188,7 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
   const plant_params_t *p = &pl->p;
   avg_k_t k;
   k.pp = (double)p->machine.pole_pairs;
-  k.mag = pl->aux.mag;
+  k.mag = &pl->aux.mag;
   k.rs = p->machine.rs;
   k.nb = pl->aux.inv_band;
   k.b = p->mech.b;
@@ -200,8 +200,7 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
   k.one_way = pl->aux.one_way;
   for (int j = 0; j < 3; j++) {
     k.d[j] = duty[j];
-    /* kdt or +0 (kdt >= 0 finite): both comparisons, no branch */
-    k.kd[j] = pl->aux.kdt * (double)((duty[j] > 0.0) & (duty[j] < 1.0));
+    k.kd[j] = duty[j] > 0.0 && duty[j] < 1.0 ? pl->aux.kdt : 0.0;
   }
   k.imposed = p->mech.mode == PLANT_MECH_IMPOSED;
   k.ideal = p->dclink.kind == PLANT_DC_IDEAL;

@@ -230,7 +230,4 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
   } else {
     avg_rk4(pl, &k, k.ideal, k.imposed, avgs, &ar, x, cs_end);
   }
-  if (!avgs) { /* not integrated: the averages read NaN, never a stale value */
-    x[X_VA] = x[X_VB] = x[X_IDC] = x[X_TE] = x[X_ID] = x[X_IQ] = NAN;
-  }
 }

@@ -103,10 +103,11 @@ static AVG_ALWAYS_INLINE void avg_deriv(const avg_k_t *restrict k, int ideal, in
   }
   dx[X_VN] = vn - 0.5 * vdc;
   const double idc = avgs || !ideal ? da * ia + db * ib + dc * ic : 0.0;
-  dx[X_VC] = ideal ? 0.0
-                   : (plant_dclink_source(k->vsrc, x[X_VC], k->inv_r, k->one_way) -
-                      x[X_VC] * k->g_chop - idc) *
-                         k->inv_c;
+  if (!ideal) { /* ideal: v_C is not integrated (avg_rk4) */
+    dx[X_VC] =
+        (plant_dclink_source(k->vsrc, x[X_VC], k->inv_r, k->one_way) - x[X_VC] * k->g_chop - idc) *
+        k->inv_c;
+  }
   if (avgs) {
     dx[X_IDC] = idc;
     dx[X_TE] = te;
@@ -124,6 +125,10 @@ static AVG_ALWAYS_INLINE void avg_deriv(const avg_k_t *restrict k, int ideal, in
 static AVG_ALWAYS_INLINE void avg_rk4(const plant_t *pl, const avg_k_t *restrict kc, int ideal,
                                       int imposed, int avgs, angle_ref_t *restrict ar,
                                       double *restrict x, double *restrict cs_end) {
+  /* a stage's state entry; v_C on an ideal link and w under imposed speed
+   * are not read by the derivative (nor is their derivative): the entry
+   * as it was */
+#define AVG_STAGE(i, v) (((ideal && (i) == X_VC) || (imposed && (i) == X_W)) ? x[i] : (v))
   const int n = pl->aux.steps; /* the scenario's, more at speed (plant.h) */
   const double h = pl->p.ts / n, h2 = 0.5 * h, h6 = h / 6.0;
   const avg_k_t *restrict k = kc; /* not copied: a copy of the just-written struct would stall */
@@ -149,17 +154,17 @@ static AVG_ALWAYS_INLINE void avg_rk4(const plant_t *pl, const avg_k_t *restrict
     }
     avg_deriv(k, ideal, imposed, avgs, ar->c, ar->s, x, m0, k1, j == 0 ? ar->i_known : NULL);
     for (int i = 0; i < X_VA; i++) { /* the integrals X_VA.. are not read */
-      xs[i] = x[i] + h2 * k1[i];
+      xs[i] = AVG_STAGE(i, x[i] + h2 * k1[i]);
     }
     stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
     avg_deriv(k, ideal, imposed, avgs, c, s, xs, m1, k2, NULL);
     for (int i = 0; i < X_VA; i++) {
-      xs[i] = x[i] + h2 * k2[i];
+      xs[i] = AVG_STAGE(i, x[i] + h2 * k2[i]);
     }
     stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
     avg_deriv(k, ideal, imposed, avgs, c, s, xs, m1, k3, NULL);
     for (int i = 0; i < X_VA; i++) {
-      xs[i] = x[i] + h * k3[i];
+      xs[i] = AVG_STAGE(i, x[i] + h * k3[i]);
     }
     stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
     avg_deriv(k, ideal, imposed, avgs, c, s, xs, m2, k4, NULL);
@@ -176,6 +181,7 @@ static AVG_ALWAYS_INLINE void avg_rk4(const plant_t *pl, const avg_k_t *restrict
     m0 = m2;
   }
   stage_cos_sin(ar, k->pp * x[X_TH], &cs_end[0], &cs_end[1]);
+#undef AVG_STAGE
 }
 
 /* One period with gates on: `substeps` classical RK4 steps. x holds the

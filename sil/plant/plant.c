@@ -96,7 +96,7 @@ int plant_steps_last(const plant_t *pl) {
 }
 
 double plant_speed_limit_e(const plant_t *pl) {
-  return PLANT_STEPS_SPEED_MAX * PLANT_HW_MAX / pl->p.ts;
+  return pl->aux.we_max;
 }
 
 bool plant_too_fast(const plant_t *pl) {
@@ -171,6 +171,7 @@ int plant_init(plant_t *pl, const plant_params_t *p, const char **field) {
   a->one_way = p->dclink.kind == PLANT_DC_RECTIFIER;
   a->kdt = p->inverter.dead_time / p->ts;
   a->inv_ts = 1.0 / p->ts;
+  a->we_max = PLANT_STEPS_SPEED_MAX * PLANT_HW_MAX / p->ts;
   plant_inverter_init(pl);
   for (int j = 0; j < 3; j++) {
     a->edge_t[j] = -1e30; /* no command edge yet */
@@ -192,6 +193,7 @@ int plant_init(plant_t *pl, const plant_params_t *p, const char **field) {
       p->mech.mode == PLANT_MECH_IMPOSED ? profile_eval(&p->mech.speed, 0.0) : p->mech.omega0;
   pl->v_dc = p->dclink.v_source;
   a->cur.key[0] = NAN; /* no cached currents */
+  a->avgs = 1;
   plant_sensors_init(pl);
   plant_faults_init(pl);
   return 0;
@@ -249,13 +251,15 @@ void plant_step_pattern(plant_t *pl, const double on_in[3], const double off_in[
   }
   plant_faults_period_end(pl, x, cs_end);
   const double inv_ts = pl->aux.inv_ts;
-  pl->v_abc_avg[0] = x[X_VA] * inv_ts;
-  pl->v_abc_avg[1] = x[X_VB] * inv_ts;
-  pl->v_abc_avg[2] = -(pl->v_abc_avg[0] + pl->v_abc_avg[1]);
-  pl->i_dc_avg = x[X_IDC] * inv_ts;
-  pl->torque_avg = x[X_TE] * inv_ts;
-  pl->i_dq_avg[0] = x[X_ID] * inv_ts;
-  pl->i_dq_avg[1] = x[X_IQ] * inv_ts;
+  if (pl->aux.avgs) { /* else NaN (plant_set_averages) */
+    pl->v_abc_avg[0] = x[X_VA] * inv_ts;
+    pl->v_abc_avg[1] = x[X_VB] * inv_ts;
+    pl->v_abc_avg[2] = -(pl->v_abc_avg[0] + pl->v_abc_avg[1]);
+    pl->i_dc_avg = x[X_IDC] * inv_ts;
+    pl->torque_avg = x[X_TE] * inv_ts;
+    pl->i_dq_avg[0] = x[X_ID] * inv_ts;
+    pl->i_dq_avg[1] = x[X_IQ] * inv_ts;
+  }
   if (avg) {
     pl->aux.v_star = x[X_VN] * inv_ts;
     for (int k = 0; k < pl->aux.star_n; k++) { /* no switching instants */
@@ -348,6 +352,14 @@ int plant_set_power_faults(plant_t *pl, const plant_power_fault_t *f) {
   pl->aux.pf_any = (pl->aux.pf.open | pl->aux.pf.closed | pl->aux.pf.phase_open |
                     pl->aux.pf.ground | pl->aux.pf.shorted) != 0u;
   return 0;
+}
+
+void plant_set_averages(plant_t *pl, bool on) {
+  pl->aux.avgs = on ? 1 : 0;
+  if (!on) {
+    pl->v_abc_avg[0] = pl->v_abc_avg[1] = pl->v_abc_avg[2] = NAN;
+    pl->i_dc_avg = pl->torque_avg = pl->i_dq_avg[0] = pl->i_dq_avg[1] = NAN;
+  }
 }
 
 bool plant_take_desat(plant_t *pl) {

@@ -257,6 +257,8 @@ typedef struct {
   double m_val, m_t0, m_t1;
   plant_cur_cache_t cur;
   int carry_n;
+  int avgs;      /* integrate the period averages (plant_set_averages) */
+  double we_max; /* plant_speed_limit_e */
   /* parameter faults (plant_faults.c): on at all, the nominal values they
    * scale, the Coulomb torque of this period (added to the mechanical
    * input), its direction of motion (+-1; 0: the rotor is held) */
@@ -374,6 +376,14 @@ void plant_star_gain(const plant_t *pl, double theta_e, double i_q, double g[3])
 /* Sensor readings at the present plant time (the carrier valley). */
 void plant_sample(plant_t *pl, plant_adc_t *out);
 void plant_get_state(const plant_t *pl, plant_state_t *out);
+/* Whether the average model integrates the period averages of the phase
+ * voltages, the DC-link current, the torque and the rotor-frame currents
+ * (plant_t's v_abc_avg, i_dc_avg, torque_avg, i_dq_avg; plant_state_t's
+ * v_abc, i_dc, torque_avg, i_dq_avg): on after plant_init. Off, they read
+ * NaN (and are not integrated by the average model): for a caller that
+ * never reads them (the runner without an observer, `--bench`); the
+ * state's evolution is the same, bit for bit. */
+void plant_set_averages(plant_t *pl, bool on);
 /* Power-stage faults from the next plant_step on (between steps; all zero:
  * healthy). They act on the switch-level circuit: with gates on they need
  * the switching model (the average model's periods are routed to it while

@@ -21,6 +21,12 @@
 
 #include <math.h>
 
+#if defined(__GNUC__)
+#define AVG_ALWAYS_INLINE __attribute__((always_inline)) inline
+#else
+#define AVG_ALWAYS_INLINE inline
+#endif
+
 /* d_eff for a leg with duty d and kd = td/Ts when 0 < d < 1, else kd = 0
  * (no switching, no dead time: d_eff = d - 0 = d; only a NaN current, i.e.
  * an already diverged state, gives NaN there). The clamps are branches:
@@ -49,7 +55,7 @@ static inline void stage_cos_sin(const angle_ref_t *r, double th, double *c, dou
 
 /* Constants of one period, in locals (no reloads through pl in the stages). */
 typedef struct {
-  plant_mag_t mag;
+  const plant_mag_t *mag; /* the plant's (read only: no copy) */
   double pp, rs, nb, b, inv_j, vsrc, inv_r, inv_c, g_chop;
   int one_way;        /* rectifier link */
   double d[3], kd[3]; /* duties; td/Ts for a switching leg (0 < d < 1), else 0 */
@@ -58,16 +64,18 @@ typedef struct {
 
 /* Derivative at one stage, c and s being cos and sin of the stage's rotor
  * angle. The same expressions as plant_internal.h's inline mechanics and
- * DC link, with the parameters hoisted. */
-static inline void avg_deriv(const avg_k_t *restrict k, int ideal, int imposed, double c, double s,
-                             const double *restrict x, double m, double *restrict dx,
-                             const double *i_known) {
+ * DC link, with the parameters hoisted. `avgs`: integrate the period
+ * averages (v_an, v_bn, i_dc, torque, i_dq: the log's; plant_set_averages)
+ * as well; the star point's (X_VN, the sensors') always. */
+static AVG_ALWAYS_INLINE void avg_deriv(const avg_k_t *restrict k, int ideal, int imposed, int avgs,
+                                        double c, double s, const double *restrict x, double m,
+                                        double *restrict dx, const double *i_known) {
   double id, iq;
   if (i_known != NULL) { /* the state's currents, already computed (the plant's cache) */
     id = i_known[0];
     iq = i_known[1];
   } else {
-    plant_mag_current(&k->mag, x[X_LD], x[X_LQ], &id, &iq);
+    plant_mag_current(k->mag, x[X_LD], x[X_LQ], &id, &iq);
   }
   const double ial = id * c - iq * s, ibe = id * s + iq * c;
   const double ia = ial, ib = -0.5 * ial + PLANT_SQRT3_2 * ibe, ic = -ia - ib;
@@ -86,9 +94,6 @@ static inline void avg_deriv(const avg_k_t *restrict k, int ideal, int imposed, 
   dx[X_LD] = vd - k->rs * id + we * x[X_LQ];
   dx[X_LQ] = vq - k->rs * iq - we * x[X_LD];
   const double te = 1.5 * k->pp * (x[X_LD] * iq - x[X_LQ] * id);
-  dx[X_TE] = te;
-  dx[X_ID] = id;
-  dx[X_IQ] = iq;
   if (imposed) {
     dx[X_TH] = m;
     dx[X_W] = 0.0;
@@ -96,30 +101,34 @@ static inline void avg_deriv(const avg_k_t *restrict k, int ideal, int imposed, 
     dx[X_TH] = x[X_W];
     dx[X_W] = (te - k->b * x[X_W] - m) * k->inv_j;
   }
-  const double idc = da * ia + db * ib + dc * ic;
-  dx[X_VC] = ideal ? 0.0
-                   : (plant_dclink_source(k->vsrc, x[X_VC], k->inv_r, k->one_way) -
-                      x[X_VC] * k->g_chop - idc) *
-                         k->inv_c;
-  dx[X_VA] = van;
-  dx[X_VB] = vbn;
   dx[X_VN] = vn - 0.5 * vdc;
-  dx[X_IDC] = idc;
+  const double idc = avgs || !ideal ? da * ia + db * ib + dc * ic : 0.0;
+  if (!ideal) { /* ideal: v_C is not integrated (avg_rk4) */
+    dx[X_VC] =
+        (plant_dclink_source(k->vsrc, x[X_VC], k->inv_r, k->one_way) - x[X_VC] * k->g_chop - idc) *
+        k->inv_c;
+  }
+  if (avgs) {
+    dx[X_IDC] = idc;
+    dx[X_TE] = te;
+    dx[X_ID] = id;
+    dx[X_IQ] = iq;
+    dx[X_VA] = van;
+    dx[X_VB] = vbn;
+  }
 }
 
-#if defined(__GNUC__)
-#define AVG_ALWAYS_INLINE __attribute__((always_inline)) inline
-#else
-#define AVG_ALWAYS_INLINE inline
-#endif
-
-/* The RK4 steps of one period; `ideal` and `imposed` are constants at each
- * call site (specialised copies). State entries whose derivative is
+/* The RK4 steps of one period; `ideal`, `imposed` and `avgs` are constants
+ * at each call site (specialised copies). State entries whose derivative is
  * identically zero (v_C on an ideal link, w under imposed speed) are left
  * as they are: x + h * 0 = x, the same result without the work. */
 static AVG_ALWAYS_INLINE void avg_rk4(const plant_t *pl, const avg_k_t *restrict kc, int ideal,
-                                      int imposed, angle_ref_t *restrict ar, double *restrict x,
-                                      double *restrict cs_end) {
+                                      int imposed, int avgs, angle_ref_t *restrict ar,
+                                      double *restrict x, double *restrict cs_end) {
+  /* a stage's state entry; v_C on an ideal link and w under imposed speed
+   * are not read by the derivative (nor is their derivative): the entry
+   * as it was */
+#define AVG_STAGE(i, v) (((ideal && (i) == X_VC) || (imposed && (i) == X_W)) ? x[i] : (v))
   const int n = pl->aux.steps; /* the scenario's, more at speed (plant.h) */
   const double h = pl->p.ts / n, h2 = 0.5 * h, h6 = h / 6.0;
   const avg_k_t *restrict k = kc; /* not copied: a copy of the just-written struct would stall */
@@ -143,24 +152,24 @@ static AVG_ALWAYS_INLINE void avg_rk4(const plant_t *pl, const avg_k_t *restrict
       ar->c = c;
       ar->s = s;
     }
-    avg_deriv(k, ideal, imposed, ar->c, ar->s, x, m0, k1, j == 0 ? ar->i_known : NULL);
+    avg_deriv(k, ideal, imposed, avgs, ar->c, ar->s, x, m0, k1, j == 0 ? ar->i_known : NULL);
     for (int i = 0; i < X_VA; i++) { /* the integrals X_VA.. are not read */
-      xs[i] = x[i] + h2 * k1[i];
+      xs[i] = AVG_STAGE(i, x[i] + h2 * k1[i]);
     }
     stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
-    avg_deriv(k, ideal, imposed, c, s, xs, m1, k2, NULL);
+    avg_deriv(k, ideal, imposed, avgs, c, s, xs, m1, k2, NULL);
     for (int i = 0; i < X_VA; i++) {
-      xs[i] = x[i] + h2 * k2[i];
+      xs[i] = AVG_STAGE(i, x[i] + h2 * k2[i]);
     }
     stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
-    avg_deriv(k, ideal, imposed, c, s, xs, m1, k3, NULL);
+    avg_deriv(k, ideal, imposed, avgs, c, s, xs, m1, k3, NULL);
     for (int i = 0; i < X_VA; i++) {
-      xs[i] = x[i] + h * k3[i];
+      xs[i] = AVG_STAGE(i, x[i] + h * k3[i]);
     }
     stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
-    avg_deriv(k, ideal, imposed, c, s, xs, m2, k4, NULL);
+    avg_deriv(k, ideal, imposed, avgs, c, s, xs, m2, k4, NULL);
     for (int i = 0; i < X_N; i++) {
-      if ((ideal && i == X_VC) || (imposed && i == X_W)) {
+      if ((ideal && i == X_VC) || (imposed && i == X_W) || (!avgs && i != X_VN && i >= X_VA)) {
         continue;
       }
       x[i] += h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
@@ -172,6 +181,7 @@ static AVG_ALWAYS_INLINE void avg_rk4(const plant_t *pl, const avg_k_t *restrict
     m0 = m2;
   }
   stage_cos_sin(ar, k->pp * x[X_TH], &cs_end[0], &cs_end[1]);
+#undef AVG_STAGE
 }
 
 /* One period with gates on: `substeps` classical RK4 steps. x holds the
@@ -184,7 +194,7 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
   const plant_params_t *p = &pl->p;
   avg_k_t k;
   k.pp = (double)p->machine.pole_pairs;
-  k.mag = pl->aux.mag;
+  k.mag = &pl->aux.mag;
   k.rs = p->machine.rs;
   k.nb = pl->aux.inv_band;
   k.b = p->mech.b;
@@ -196,8 +206,7 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
   k.one_way = pl->aux.one_way;
   for (int j = 0; j < 3; j++) {
     k.d[j] = duty[j];
-    /* kdt or +0 (kdt >= 0 finite): both comparisons, no branch */
-    k.kd[j] = pl->aux.kdt * (double)((duty[j] > 0.0) & (duty[j] < 1.0));
+    k.kd[j] = duty[j] > 0.0 && duty[j] < 1.0 ? pl->aux.kdt : 0.0;
   }
   k.imposed = p->mech.mode == PLANT_MECH_IMPOSED;
   k.ideal = p->dclink.kind == PLANT_DC_IDEAL;
@@ -217,9 +226,14 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
     ar.s = sin(ar.th);
     ar.i_known = NULL;
   }
-  if (k.ideal && !k.imposed) {
-    avg_rk4(pl, &k, 1, 0, &ar, x, cs_end); /* the usual case */
+  const int avgs = pl->aux.avgs;
+  if (k.ideal && !k.imposed) { /* the usual case */
+    if (avgs) {
+      avg_rk4(pl, &k, 1, 0, 1, &ar, x, cs_end);
+    } else {
+      avg_rk4(pl, &k, 1, 0, 0, &ar, x, cs_end);
+    }
   } else {
-    avg_rk4(pl, &k, k.ideal, k.imposed, &ar, x, cs_end);
+    avg_rk4(pl, &k, k.ideal, k.imposed, avgs, &ar, x, cs_end);
   }
 }

@@ -222,6 +222,9 @@ void plant_star_request(plant_t *pl, int n, const double t_req[]) {
 int plant_star_read(plant_t *pl, double v[PLANT_STAR_MAX]) {
   const plant_sensors_t *s = &pl->p.sensors;
   const plant_aux_t *a = &pl->aux;
+  if (a->star_n == 0) { /* the usual period: none requested */
+    return 0;
+  }
   const double fs = s->star_full_scale > 0.0 ? s->star_full_scale : 0.5 * s->v_full_scale;
   const double lsb = 2.0 * fs / a->adc_levels;
   for (int k = 0; k < a->star_n; k++) {

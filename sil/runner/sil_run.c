@@ -158,6 +158,9 @@ int sil_setup(sil_ctx_t *x, const scenario_t *sc, char *err, size_t errlen) {
   x->cm_last[1] = 0.0f;
   sil_adc_faults_reset(&x->adc_faults);
   sil_enc_faults_reset(&x->enc_faults, &sc->encoder_faults);
+  const sil_enc_faults_t *ef = &sc->encoder_faults;
+  x->enc_faults_on =
+      ef->frozen.n > 0 || ef->reversed.n > 0 || ef->jitter > 0.0 || ef->missing > 0.0;
   return 0;
 }
 
@@ -168,8 +171,8 @@ void sil_sample(sil_ctx_t *x, const scenario_t *sc, double t) {
     x->enc_err = profile_eval_span(&sc->encoder_error, t, &x->enc_err_end);
   }
   to_hal_sample(&adc, x, x->enc_err, !injected(&sc->encoder_invalid, t), &x->hal.sample);
-  const sil_enc_faults_t *ef = &sc->encoder_faults;
-  if (ef->frozen.n > 0 || ef->reversed.n > 0 || ef->jitter > 0.0 || ef->missing > 0.0) {
+  if (x->enc_faults_on) {
+    const sil_enc_faults_t *ef = &sc->encoder_faults;
     const int cpr = sc->plant.sensors.encoder_cpr;
     x->hal.sample.enc_angle =
         (float)sil_enc_faults_apply(ef, &x->enc_faults, t, adc.enc_angle + x->enc_err,
@@ -280,6 +283,8 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
   if (sil_setup(&x, sc, err, errlen) != 0) {
     return -1;
   }
+  /* the plant's period averages are the observer's (the log) alone */
+  plant_set_averages(&x.plant, obs != NULL);
   if (opts == NULL) {
     opts = &no_opts;
   }
@@ -312,10 +317,14 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
   plant_brief_t br; /* what the metrics need: cheaper than plant_state_t */
   const double t_start = wall_now();
   uint64_t k = 0;
+  unsigned slow_left = 0u; /* periods to the next main-loop period (k % slow_div == 0) */
   for (; k < n; ++k) {
     const double t = (double)k * ts;
-    x.hal.time_us = (uint32_t)(uint64_t)(t * 1e6);
-    if (k % sc->drive.slow_div == 0) {
+    /* t * 1e6 < 2^63 (a run of 292,000 years): the signed conversion, one
+     * instruction, gives what the unsigned one (a branch and two) gives */
+    x.hal.time_us = (uint32_t)(int64_t)(t * 1e6);
+    if (slow_left == 0u) {
+      slow_left = sc->drive.slow_div;
       if (opts->stop != NULL && *opts->stop) {
         res->stopped = true;
         break;
@@ -343,6 +352,7 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
         sleep_s(t - (wall_now() - t_start));
       }
     }
+    slow_left--;
     /* 1. sample */
     sil_sample(&x, sc, t);
     /* 2. ISR (unless the interrupt is stuck) */

@@ -132,6 +132,7 @@ typedef struct {
   double v_src, v_src_end;     /* DC source profile, constant until _end */
   sil_adc_state_t adc_faults;  /* the current-ADC faults' memory */
   sil_enc_state_t enc_faults;  /* the encoder faults' memory */
+  bool enc_faults_on;          /* any encoder fault in the scenario (sil_setup) */
   bool isr_late;               /* ISR k overran: its pattern misses t_{k+1} */
   hal_pwm_t pwm_before;        /* then: the pattern written before it */
   bool trip_posted;            /* inject.trip_at done (once per run, resets included) */

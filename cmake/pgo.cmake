@@ -51,10 +51,8 @@ function(fd_sil_pgo)
     SOURCE_DIR ${PROJECT_SOURCE_DIR}
     BINARY_DIR ${pgo}/build
     PREFIX ${pgo}/ep
-    # the same compiler and flags: the profile must match the code it optimises
     CMAKE_ARGS -DCMAKE_BUILD_TYPE=Release -DBUILD_TESTING=OFF -DFD_SIL_PGO=OFF
                -DFD_SIL_PGO_GENERATE=${pgo}/profile -DCMAKE_C_COMPILER=${CMAKE_C_COMPILER}
-               "-DCMAKE_C_FLAGS=${CMAKE_C_FLAGS}" "-DCMAKE_C_FLAGS_RELEASE=${CMAKE_C_FLAGS_RELEASE}"
     BUILD_COMMAND ${CMAKE_COMMAND} --build <BINARY_DIR> --target fluxdrive-sil
     BUILD_ALWAYS TRUE
     BUILD_BYPRODUCTS ${runner}

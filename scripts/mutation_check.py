@@ -290,11 +290,7 @@ class Runner:
         self.build = src / BUILD_REL
 
     def configure(self) -> None:
-        # without the profile-guided optimisation (cmake/pgo.cmake): a
-        # mutant would rebuild and rerun the instrumented runner, and one
-        # that breaks a training scenario would fail its build, not a test
-        rc, out = sh(["cmake", "--preset", "host-release", f"-DFD_PYTHON={self.python}",
-                      "-DFD_SIL_PGO=OFF"],
+        rc, out = sh(["cmake", "--preset", "host-release", f"-DFD_PYTHON={self.python}"],
                      self.src, log=self.log)
         if rc != 0:
             raise RuntimeError(f"configure failed:\n{out[-3000:]}")

@@ -77,11 +77,10 @@ static void dfvc_law_reset(ctrl_state_t *s) {
 static void dfvc_law_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *in,
                           ctrl_out_t *out) {
   dfvc_out_t d;
-  /* the core writes the telemetry where the drive publishes it (also on
-   * the period it faults: zero then) */
-  d.tm = out->tm;
-  /* the drive's sample read in place (ctrl_in_t is the core's law_in_t) */
-  dfvc_step(&s->dfvc.core, s->dfvc.law, in, &d);
+  /* the drive's sample read in place (ctrl_in_t is the core's law_in_t);
+   * the telemetry written where the drive publishes it (also on the
+   * period it faults: zero then) */
+  dfvc_step(&s->dfvc.core, s->dfvc.law, in, &d, out->tm);
   out->v_ref = d.v_ab_ref;
   out->i_pred = d.i_ab_mid;
   /* rotor-frame currents: from the law's sin/cos of theta_e unless it

@@ -55,8 +55,7 @@ static void loop_step(loop_t *l, double torque, dfvc_out_t *out) {
   in.v_lin = (float)(l->vdc / sqrt(3.0));
   in.torque_ref = (float)torque;
   in.flux_ref = 0.0f;
-  out->tm = &l->tm;
-  dfvc_step(&l->c, l->law, &in, out);
+  dfvc_step(&l->c, l->law, &in, out, &l->tm);
   assert_int_equal(out->fault, 0);
   spm_plant_step(&l->m, l->v_prev.alpha + I * l->v_prev.beta);
   l->v_prev = out->v_ab_ref;
@@ -101,8 +100,8 @@ static step_result_t run_step(const dfvc_cfg_t *cfg, dfvc_law_t law, double rpm,
     iqs[n] = spm_plant_iqs(&l.m); /* true value at k0 + n */
     flux[n] = cabs(spm_plant_flux(&l.m));
     loop_step(&l, t1, &out);
-    lref = out.tm->flux_ref;
-    iqs_ref = out.tm->i_qs_ref;
+    lref = l.tm.flux_ref;
+    iqs_ref = l.tm.i_qs_ref;
     if (verbose && n < 14) {
       printf("    n=%2d iqs %.4f (ref %.4f, pred %.4f) flux %.5f (ref %.5f) vds %.1f vqs %.1f "
              "T %.3f\n",
@@ -208,14 +207,14 @@ static void run_fw(const dfvc_cfg_t *cfg, double *flux_err, double *delta, doubl
     *vmag = fmax(*vmag, hypot(out.v_ab_ref.alpha, out.v_ab_ref.beta));
   }
   const double complex lam = spm_plant_flux(&l.m);
-  *flux_err = (cabs(lam) - out.tm->flux_ref) / out.tm->flux_ref;
+  *flux_err = (cabs(lam) - l.tm.flux_ref) / l.tm.flux_ref;
   *delta = remainder(carg(lam) - l.m.theta, 6.283185307179586);
   *torque = spm_plant_torque(&l.m);
   *limits = out.limits;
   printf("  1200 rpm, T* = 20 N m, rot_advance %.1f: lambda %.4f Vs (ref %.4f, err %.3f %%), "
          "delta %.2f deg, T %.3f N m (%.0f W), i_qs %.3f (ref %.3f), T_max %.3f, |v| max %.1f V\n",
-         cfg->rot_advance, cabs(lam), out.tm->flux_ref, 100.0 * *flux_err, *delta * 57.29578,
-         *torque, *torque * l.m.w / cfg->machine->pole_pairs, spm_plant_iqs(&l.m), out.tm->i_qs_ref,
+         cfg->rot_advance, cabs(lam), l.tm.flux_ref, 100.0 * *flux_err, *delta * 57.29578, *torque,
+         *torque * l.m.w / cfg->machine->pole_pairs, spm_plant_iqs(&l.m), l.tm.i_qs_ref,
          out.torque_max, *vmag);
 }
 
@@ -257,15 +256,14 @@ static void test_faults_and_switch(void **state) {
   in.torque_ref = 10.0f;
   in.i_ab.alpha = NAN;
   const dfvc_t before = l.c;
-  dfvc_step(&l.c, DFVC_LAW_DEADBEAT, &in, &out);
+  dfvc_step(&l.c, DFVC_LAW_DEADBEAT, &in, &out, &l.tm);
   assert_int_equal(out.fault, DFVC_FAULT_INPUT);
   assert_true(fabsf(out.v_ab_ref.alpha) < 1e-30f && fabsf(out.v_ab_ref.beta) < 1e-30f);
-  /* the telemetry zeroed in place, the caller's pointer kept */
-  assert_ptr_equal(out.tm, &l.tm);
+  /* the telemetry zeroed in place */
   assert_true(l.tm.flux == 0.0f && l.tm.torque == 0.0f && l.tm.obs_err == 0.0f);
   assert_memory_equal(&before.obs, &l.c.obs, sizeof(before.obs));
   in.i_ab.alpha = 0.1f;
-  dfvc_step(&l.c, (dfvc_law_t)5, &in, &out);
+  dfvc_step(&l.c, (dfvc_law_t)5, &in, &out, &l.tm);
   assert_int_equal(out.fault, DFVC_FAULT_INPUT);
 
   /* law switch DB -> PI at 10 N m: the PI starts from the feed-forwards, no kick */
@@ -273,10 +271,10 @@ static void test_faults_and_switch(void **state) {
   double worst = 0.0;
   for (int k = 0; k < 200; ++k) {
     loop_step(&l, 10.0, &out);
-    worst = fmax(worst, fabs(spm_plant_iqs(&l.m) - out.tm->i_qs_ref));
+    worst = fmax(worst, fabs(spm_plant_iqs(&l.m) - l.tm.i_qs_ref));
   }
   printf("  DB -> PI switch: worst |i_qs - ref| %.4f A\n", worst);
-  assert_true(worst < 0.05 * fabs(out.tm->i_qs_ref));
+  assert_true(worst < 0.05 * fabs(l.tm.i_qs_ref));
 
   /* collapse threshold above the actual flux */
   dfvc_cfg_t c2 = cfg;
@@ -284,9 +282,9 @@ static void test_faults_and_switch(void **state) {
   dfvc_t d;
   assert_int_equal(dfvc_init(&d, &c2), 0);
   in.i_ab = (dfvc_in_t){0}.i_ab;
-  dfvc_step(&d, DFVC_LAW_DEADBEAT, &in, &out);
+  dfvc_step(&d, DFVC_LAW_DEADBEAT, &in, &out, &l.tm);
   assert_int_equal(out.fault, DFVC_FAULT_FLUX_COLLAPSE);
-  assert_true(fabsf(out.tm->flux - 0.19f) < 1e-5f);
+  assert_true(fabsf(l.tm.flux - 0.19f) < 1e-5f);
   assert_true(hypotf(out.v_ab_ref.alpha, out.v_ab_ref.beta) > 1.0f);
 
   /* invalid configuration */

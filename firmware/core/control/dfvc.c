@@ -68,13 +68,11 @@ void dfvc_reset(dfvc_t *c) {
   c->last_law = DFVC_LAW_DEADBEAT;
 }
 
-/* A fault's outputs: all zero (no voltage), the telemetry too, the
- * caller's telemetry pointer kept. Out of line: off the period's path. */
-static FD_NOINLINE void dfvc_out_fault(dfvc_out_t *out, uint32_t fault) {
-  law_telemetry_t *tm = out->tm;
+/* A fault's outputs: all zero (no voltage), the telemetry too. Out of
+ * line: off the period's path. */
+static FD_NOINLINE void dfvc_out_fault(dfvc_out_t *out, law_telemetry_t *tm, uint32_t fault) {
   memset(out, 0, sizeof(*out));
   memset(tm, 0, sizeof(*tm));
-  out->tm = tm;
   out->fault = fault;
 }
 
@@ -98,12 +96,13 @@ static float dfvc_delta_next(const dfvc_in_t *in, const flux_observer_out_t *o, 
   return frames_wrap_pi(fd_atan2f(o->sc_s_next.s, o->sc_s_next.c) - theta_r1);
 }
 
-void dfvc_step(dfvc_t *c, dfvc_law_t law, const dfvc_in_t *in, dfvc_out_t *out) {
+void dfvc_step(dfvc_t *c, dfvc_law_t law, const dfvc_in_t *in, dfvc_out_t *out,
+               law_telemetry_t *tm) {
   const dfvc_cfg_t *k = &c->cfg;
   /* every field of *out is written below (no zeroing per ISR); the fault
    * paths clear it */
   if (!dfvc_inputs_ok(law, in)) {
-    dfvc_out_fault(out, DFVC_FAULT_INPUT);
+    dfvc_out_fault(out, tm, DFVC_FAULT_INPUT);
     return;
   }
 
@@ -198,7 +197,7 @@ void dfvc_step(dfvc_t *c, dfvc_law_t law, const dfvc_in_t *in, dfvc_out_t *out) 
                   fd_zero_if_finite(r.iqs_ref);
   if (!fd_isfinite(z)) {
     dfvc_reset(c);
-    dfvc_out_fault(out, DFVC_FAULT_STATE);
+    dfvc_out_fault(out, tm, DFVC_FAULT_STATE);
     return;
   }
 
@@ -212,7 +211,6 @@ void dfvc_step(dfvc_t *c, dfvc_law_t law, const dfvc_in_t *in, dfvc_out_t *out) 
   out->v_dqs = v_dqs;
   out->limits = lim;
   /* the telemetry where the caller publishes it (no copy) */
-  law_telemetry_t *tm = out->tm;
   tm->flux = o.lambda_s;
   tm->flux_ref = r.lambda_ref;
   tm->delta = o.delta; /* the load-angle limit's: taken every period */

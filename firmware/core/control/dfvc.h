@@ -22,7 +22,7 @@
  *
  * Typical use per ISR:
  *   in.i_ab = measured; in.v_applied = mod.v_applied (from last period);
- *   out.tm = &telemetry; dfvc_step(&c, DFVC_LAW_DEADBEAT, &in, &out);
+ *   dfvc_step(&c, DFVC_LAW_DEADBEAT, &in, &out, &telemetry);
  *   mod = modulation_minmax(out.v_ab_ref, v_dc, duty_min, duty_max);
  *   deadtime_comp_apply(&dt, mod.duty, frames_clarke_inv(out.i_ab_mid), duty);
  *   if (out.fault) -> app decides (gates off, latch)
@@ -125,13 +125,6 @@ enum {
 };
 
 typedef struct {
-  /* set by the caller: where the telemetry goes, written in place (every
-   * field, each period; zeroed with the outputs on a fault): flux =
-   * observed |lambda_s| at tau, flux_ref = lambda*, delta = load angle,
-   * i_ds, i_qs = stator-flux frame currents, i_qs_ref = limited i_qs*,
-   * torque = 3/2 p lambda_s i_qs, obs_err = |lambda_hat - lambda_cm| at
-   * tau (observer vs current model); lam_d, lam_q 0, delta_lazy false */
-  law_telemetry_t *tm;
   ab_t v_ab_ref; /* voltage to apply over [tau+1, tau+2) [V], |v| <= v_lin */
   /* mean of the MPE currents at tau+1 and at tau+2 with v_ab_ref: over
    * [tau+1, tau+2), for dead-time comp [A]. The two predictions, the
@@ -164,8 +157,14 @@ int dfvc_init(dfvc_t *c, const dfvc_cfg_t *cfg);
 /* Observer restarts from the current model, PI integrals cleared. */
 void dfvc_reset(dfvc_t *c);
 /* One control period of the voltage law `law` (DFVC_LAW_DEADBEAT or
- * DFVC_LAW_PI; may change between calls); out is fully written, and
- * *out->tm (set by the caller). */
-void dfvc_step(dfvc_t *c, dfvc_law_t law, const dfvc_in_t *in, dfvc_out_t *out);
+ * DFVC_LAW_PI; may change between calls); out is fully written, and the
+ * telemetry in place at tm, where the caller publishes it (every field,
+ * each period; zeroed with the outputs on a fault): flux = observed
+ * |lambda_s| at tau, flux_ref = lambda*, delta = load angle, i_ds, i_qs =
+ * stator-flux frame currents, i_qs_ref = limited i_qs*, torque = 3/2 p
+ * lambda_s i_qs, obs_err = |lambda_hat - lambda_cm| at tau (observer vs
+ * current model); lam_d, lam_q 0, delta_lazy false. */
+void dfvc_step(dfvc_t *c, dfvc_law_t law, const dfvc_in_t *in, dfvc_out_t *out,
+               law_telemetry_t *tm);
 
 #endif

@@ -5,49 +5,109 @@
  * centred; edges rounded to the timer's compare steps (counts per period,
  * 0 = exact). A NaN request gives the middle of the range (no voltage).
  * The STM32G4 HAL does the same with its registers (hal/stm32g4/pwm_tim1.c).
+ *
+ * The timer is taken once (hal_pattern_init: the range's middle, the
+ * counts as floats, the features), not at every write: the write is the
+ * PIL's stand-in for the board's register HAL, counted in the ISR's
+ * instructions (docs/pil.md), and the SIL's every period.
  */
 #ifndef FLUXDRIVE_HAL_PATTERN_H
 #define FLUXDRIVE_HAL_PATTERN_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "hal.h"
 
-static inline float hal_pattern_clamp(float x, float lo, float hi) {
-  if (!(x >= lo)) {
-    return x < lo ? lo : 0.5f * (lo + hi); /* NaN: the middle */
+/* -Os would call the leg's helpers three times: inline, as one pattern */
+#if defined(__GNUC__)
+#define HAL_PATTERN_INLINE static inline __attribute__((always_inline))
+#else
+#define HAL_PATTERN_INLINE static inline
+#endif
+
+/* A timer as the write sees it (hal_pattern_init). */
+typedef struct {
+  float lo, hi;    /* the duty range the write limits to */
+  float mid;       /* a NaN request's duty */
+  uint32_t counts; /* compare steps per period; 0: exact */
+  float n;         /* counts as a float: the duty's steps */
+  float n2;        /* 2 counts: the edges' steps (centre-aligned timer) */
+  bool asym;       /* HAL_CAP_ASYM_EDGES: the edges as asked */
+  bool star;       /* HAL_CAP_STAR_POINT: star-point samples kept */
+} hal_pattern_t;
+
+/* The board's duty range and its middle; with rounding, both from 0 up: a
+ * duty below 0 rounds to count 0, so limiting it to 0 first gives the same
+ * pattern and the rounding needs no test of its sign. */
+static inline void hal_pattern_init(hal_pattern_t *m, const hal_caps_t *caps, uint32_t counts) {
+  const float mid = 0.5f * (caps->duty_min + caps->duty_max);
+  m->lo = caps->duty_min;
+  m->hi = caps->duty_max;
+  m->mid = mid;
+  if (counts != 0u) {
+    m->lo = m->lo > 0.0f ? m->lo : 0.0f;
+    m->mid = mid > 0.0f ? mid : 0.0f;
   }
-  return x > hi ? hi : x;
+  m->counts = counts;
+  m->n = (float)counts;
+  m->n2 = (float)(2u * counts);
+  m->asym = (caps->features & HAL_CAP_ASYM_EDGES) != 0u;
+  m->star = (caps->features & HAL_CAP_STAR_POINT) != 0u;
 }
 
-/* To the nearest count, as the board's duty_to_ccr (x >= 0 here: a clamped
- * duty or an edge inside the period; no libm call in the ISR). */
-static inline float hal_pattern_round(float x, uint32_t counts) {
-  if (counts == 0u) {
-    return x;
-  }
-  const float n = x > 0.0f ? x * (float)counts + 0.5f : 0.0f;
-  return (float)(uint32_t)n / (float)counts;
+/* To the nearest of n steps (n > 0), as the board's duty_to_ccr, for x >=
+ * 0 (a duty limited by hal_pattern_duty, an edge inside the period; no
+ * libm call in the ISR). The step count divides (not a reciprocal's
+ * product): the same float as the board's count over its period. */
+HAL_PATTERN_INLINE float hal_pattern_round(float x, float n) {
+  return (float)(uint32_t)(x * n + 0.5f) / n;
 }
 
-static inline void hal_pattern_apply(const hal_pwm_t *p, const hal_caps_t *caps, uint32_t counts,
-                                     hal_pwm_t *out) {
-  *out = *p;
+/* A leg's duty as the timer makes it: limited to the range, rounded. */
+HAL_PATTERN_INLINE float hal_pattern_duty(const hal_pattern_t *m, float on, float off) {
+  const float x = off - on;
+  float d;
+  if (!(x >= m->lo)) {
+    d = x < m->lo ? m->lo : m->mid; /* NaN: the middle */
+  } else {
+    d = x > m->hi ? m->hi : x;
+  }
+  return m->counts != 0u ? hal_pattern_round(d, m->n) : d;
+}
+
+/* Every field of *out written; each leg of p read before its store. */
+static inline void hal_pattern_apply(const hal_pattern_t *m, const hal_pwm_t *p, hal_pwm_t *out) {
+  out->test_vector = p->test_vector;
+  out->n_star = m->star ? p->n_star : 0u;
+  for (int k = 0; k < HAL_STAR_MAX; ++k) {
+    out->t_star_req[k] = p->t_star_req[k];
+  }
+  if (!m->asym) {
+    /* centred pulses (the usual timer): the legs straight through */
+#pragma GCC unroll 3
+    for (int x = 0; x < 3; ++x) {
+      /* 0.5 -+ 0.5 d: the same floats as 0.5 (1 -+ d) (halving is exact) */
+      const float h = 0.5f * hal_pattern_duty(m, p->on[x], p->off[x]);
+      out->on[x] = 0.5f - h;
+      out->off[x] = 0.5f + h;
+    }
+    return;
+  }
   for (int x = 0; x < 3; ++x) {
-    const float d = hal_pattern_round(
-        hal_pattern_clamp(p->off[x] - p->on[x], caps->duty_min, caps->duty_max), counts);
-    if ((caps->features & HAL_CAP_ASYM_EDGES) != 0u && p->on[x] >= 0.0f && p->off[x] <= 1.0f) {
+    const float on = p->on[x];
+    const float off = p->off[x];
+    const float d = hal_pattern_duty(m, on, off);
+    if (on >= 0.0f && off <= 1.0f) {
       /* the edges as asked, the pulse limited from its end; 2 counts per
        * compare step of a centre-aligned timer */
-      out->on[x] = hal_pattern_round(p->on[x], 2u * counts);
-      out->off[x] = out->on[x] + d;
+      const float e = m->counts != 0u ? hal_pattern_round(on, m->n2) : on;
+      out->on[x] = e;
+      out->off[x] = e + d;
     } else {
       out->on[x] = 0.5f * (1.0f - d);
       out->off[x] = 0.5f * (1.0f + d);
     }
-  }
-  if ((caps->features & HAL_CAP_STAR_POINT) == 0u) {
-    out->n_star = 0u;
   }
 }
 

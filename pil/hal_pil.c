@@ -7,7 +7,7 @@
 #include "hal.h"
 
 static hal_caps_t caps;
-static uint32_t counts;
+static hal_pattern_t timer; /* the timer model of caps (hal_pattern.h) */
 static hal_sample_t sample;
 static hal_pwm_t pwm;
 static bool gates_on;
@@ -18,7 +18,7 @@ static uint32_t time_us;
 
 void hal_pil_set_caps(const hal_caps_t *c, uint32_t timer_counts) {
   caps = *c;
-  counts = timer_counts;
+  hal_pattern_init(&timer, c, timer_counts);
   pwm = hal_pwm_centred(0.5f, 0.5f, 0.5f);
 }
 
@@ -63,7 +63,7 @@ void hal_adc_read(hal_sample_t *s) {
 }
 
 void hal_pwm_write(const hal_pwm_t *p, hal_pwm_t *applied) {
-  hal_pattern_apply(p, &caps, counts, &pwm);
+  hal_pattern_apply(&timer, p, &pwm);
   if (applied != 0) {
     *applied = pwm;
   }

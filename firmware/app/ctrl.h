@@ -22,6 +22,7 @@
 #include "control/deadtime_comp.h"
 #include "control/dfvc.h"
 #include "control/dfvc_decoupled.h"
+#include "control/law_io.h"
 #include "drive_config.h"
 #include "math/fast_trig.h"
 #include "math/fd_math.h"
@@ -29,20 +30,9 @@
 #include "model/machine.h"
 #include "signal_row.h"
 
-/* Law-specific telemetry (zero where a law has no such quantity). */
-typedef struct {
-  float flux;     /* stator flux amplitude estimate [Vs] */
-  float flux_ref; /* [Vs] */
-  float delta;    /* load angle [rad], unless delta_lazy: ctrl_tm_delta */
-  float lam_d;    /* delta_lazy: the flux in the rotor frame whose angle it is [Vs] */
-  float lam_q;
-  bool delta_lazy; /* a law whose ISR needs no load angle leaves it to the readers */
-  float i_ds;      /* stator-flux frame currents [A] */
-  float i_qs;
-  float i_qs_ref;
-  float torque;  /* torque estimate [N m] */
-  float obs_err; /* |observer flux - current-model flux| [Vs] (flux laws) */
-} ctrl_telemetry_t;
+/* Law-specific telemetry (zero where a law has no such quantity): the
+ * core's type, so that a core law writes it in place (control/law_io.h). */
+typedef law_telemetry_t ctrl_telemetry_t;
 
 /* The load angle of a telemetry copy (main loop, logs): one atan2 where
  * it is read, not every ISR (the decoupled DFVC's: telemetry only). */
@@ -50,17 +40,10 @@ static inline float ctrl_tm_delta(const ctrl_telemetry_t *t) {
   return t->delta_lazy ? fd_atan2f(t->lam_q, t->lam_d) : t->delta;
 }
 
-typedef struct {
-  ab_t i_ab;      /* measured currents at the sampling instant [A] */
-  ab_t v_applied; /* voltage applied over the period ending at the sample [V] */
-  float theta_e;  /* electrical angle at the sampling instant [rad] */
-  float omega_e;  /* electrical speed [rad/s] */
-  float v_lin;    /* voltage amplitude the modulator can apply linearly now [V] */
-  drive_mode_t mode;
-  float torque_ref;     /* [N m] */
-  float id_ref, iq_ref; /* current mode [A] */
-  float flux_ref;       /* 0 = automatic [Vs] */
-} ctrl_in_t;
+/* One period's sample and references (current: the mode in force is
+ * DRIVE_MODE_CURRENT): the core's type, so that a core law reads it where
+ * the drive filled it (control/law_io.h). */
+typedef law_in_t ctrl_in_t;
 
 typedef struct {
   ab_t v_ref;                   /* voltage for the next period [V] */

@@ -227,6 +227,7 @@ FD_COLD static int drive_configure(drive_t *drv, const drive_config_t *cfg, driv
     return -1;
   }
   drv->cfg = *cfg;
+  drv->slow_wait = 0u; /* the schedule's next phase from slow_div in force */
   drive_machine_copy(&drv->machine, &drv->map, &m, &map);
   drive_derive(drv);
   const char *reason = "";
@@ -511,7 +512,7 @@ FD_COLD static FD_NOINLINE uint32_t drive_protect_values(const drive_t *drv, con
 /* Loss of control (protect/lc_monitor.h): each condition must hold for its
  * time before the trip. */
 static void drive_monitor(drive_t *drv, const ctrl_in_t *in, const ctrl_out_t *out) {
-  const uint32_t checks = drv->lc_checks; /* in.mode is drv->mode (drive_mode_refresh) */
+  const uint32_t checks = drv->lc_checks; /* of drv->mode, as in.current (drive_mode_refresh) */
   const ctrl_telemetry_t *t = out->tm;
   const protect_lc_view_t v = {out->i_dq.d,     out->i_dq.q,     t->torque, in->torque_ref,
                                out->torque_min, out->torque_max, t->delta,  t->flux,
@@ -735,12 +736,21 @@ static const drive_slow_row_t drive_slow_rows[] = {
  * the rates of the previous slow_div periods): the rows whose phase this
  * ISR is. */
 static void drive_schedule(drive_t *drv) {
+  /* the usual ISR: no row, a count down to the next phase instead of a
+   * division of the ISR count (issue 24 point 8) */
+  if (drv->slow_wait > 1u) {
+    drv->slow_wait--;
+    return;
+  }
   const uint32_t div = drv->cfg.slow_div;
   const uint32_t k = drv->isr_count - 1u;
   const uint32_t at = k % div;
   const uint32_t mid = div / 2u;
+  /* the ISRs to the next phase, from this ISR's place in the slow period
+   * (from any place: the count restarts here after a new slow_div) */
+  drv->slow_wait = at < mid ? mid - at : div - at;
   if (at != 0u && at != mid) {
-    return; /* the usual ISR: no row */
+    return;
   }
   const uint32_t slow_n = k / div;
   /* the mid phase's rows first: with slow_div 1 both phases are this ISR */
@@ -749,6 +759,9 @@ static void drive_schedule(drive_t *drv) {
     if (at != (pass == 0u ? mid : 0u)) {
       continue;
     }
+    /* unrolled: the table is constant, so each row's phase and divider
+     * fold at compile time and the ISR calls its phase's rows only */
+#pragma GCC unroll 16
     for (unsigned r = 0; r < DRIVE_SLOW_ROWS; ++r) {
       const drive_slow_row_t *row = &drive_slow_rows[r];
       if (row->phase == phase) {
@@ -766,8 +779,8 @@ static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
   in.theta_e = frames_wrap_pi(drv->pos.out.theta + drv->pos.out.omega * (s->t_i - drv->pos.out.t));
   in.omega_e = drv->pos.out.omega;
   in.v_lin = drv->v_lin;
-  in.mode = drv->mode;
-  in.torque_ref = in.mode == DRIVE_MODE_SPEED ? drv->speed_torque : drv->cmd.torque;
+  in.current = drv->mode == DRIVE_MODE_CURRENT;
+  in.torque_ref = drv->mode == DRIVE_MODE_SPEED ? drv->speed_torque : drv->cmd.torque;
   in.id_ref = drv->cmd.id;
   in.iq_ref = drv->cmd.iq;
   in.flux_ref = drv->cmd.flux;

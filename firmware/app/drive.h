@@ -145,6 +145,8 @@ typedef struct drive_s {
   float omega_m;  /* mechanical speed (source, per ISR) [rad/s] */
   float rate_acc; /* sum of the angle rate over the speed-loop period */
   uint32_t rate_n;
+  uint32_t slow_wait; /* ISRs to the slow-rate schedule's next phase (drive_schedule;
+                         0 or 1: this ISR's phase is computed) */
 
   /* control */
   ab_t v_applied;     /* voltage applied over the period ending at this sample */

@@ -76,18 +76,11 @@ static void dfvc_law_reset(ctrl_state_t *s) {
 /* Both rows' step: the voltage law their init chose (ctrl_dfvc_t.law). */
 static void dfvc_law_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *in,
                           ctrl_out_t *out) {
-  const dfvc_in_t din = {
-      .law = s->dfvc.law,
-      .i_ab = in->i_ab,
-      .v_ab_applied = in->v_applied,
-      .theta_r = in->theta_e,
-      .omega_r = in->omega_e,
-      .v_lin = in->v_lin,
-      .torque_ref = in->torque_ref,
-      .lambda_ref = in->flux_ref,
-  };
   dfvc_out_t d;
-  dfvc_step(&s->dfvc.core, &din, &d);
+  /* the drive's sample read in place (ctrl_in_t is the core's law_in_t);
+   * the telemetry written where the drive publishes it (also on the
+   * period it faults: zero then) */
+  dfvc_step(&s->dfvc.core, s->dfvc.law, in, &d, out->tm);
   out->v_ref = d.v_ab_ref;
   out->i_pred = d.i_ab_mid;
   /* rotor-frame currents: from the law's sin/cos of theta_e unless it
@@ -98,19 +91,6 @@ static void dfvc_law_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in
   out->torque_min = fd_maxf(d.torque_min, -su->cfg->torque_max);
   out->torque_max = fd_minf(d.torque_max, su->cfg->torque_max);
   out->fault = d.fault;
-  /* every field written (no zero-fill call in the ISR) */
-  ctrl_telemetry_t *tm = out->tm; /* where the drive publishes it */
-  tm->flux = d.lambda_s;
-  tm->flux_ref = d.lambda_ref;
-  tm->delta = d.delta; /* the load-angle limit's: taken every ISR */
-  tm->lam_d = 0.0f;
-  tm->lam_q = 0.0f;
-  tm->delta_lazy = false;
-  tm->i_ds = d.i_ds;
-  tm->i_qs = d.i_qs;
-  tm->i_qs_ref = d.i_qs_ref;
-  tm->torque = d.torque;
-  tm->obs_err = d.obs_err;
 }
 
 const ctrl_law_t ctrl_law_pi_dfvc = {"pi_dfvc",      CTRL_CAP_FLUX | CTRL_CAP_DELTA,

@@ -55,7 +55,7 @@ static void foc_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *i
   const dq_t i = frames_park(in->i_ab, sc);
   const float t_lim = fd_minf(su->cfg->torque_max, s->foc.t_mtpa_max);
   dq_t i_ref;
-  if (in->mode == DRIVE_MODE_CURRENT) {
+  if (in->current) {
     i_ref = (dq_t){in->id_ref, in->iq_ref};
   } else {
     i_ref = foc_mtpa(&s->foc, m, clamp_sym_nan(in->torque_ref, t_lim));

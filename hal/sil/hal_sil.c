@@ -24,6 +24,7 @@ void hal_sil_init(hal_sil_t *h, const hal_sil_board_t *board) {
   h->caps.features = HAL_CAP_ENCODER | HAL_CAP_STAR_POINT | HAL_CAP_I_ABC |
                      (board->asym_edges ? HAL_CAP_ASYM_EDGES : 0u);
   h->timer_counts = board->timer_counts;
+  hal_pattern_init(&h->timer, &h->caps, board->timer_counts);
   h->watchdog_timeout_us = board->watchdog_ms * 1000u;
   h->pwm = hal_pwm_centred(0.5f, 0.5f, 0.5f);
 }
@@ -49,7 +50,7 @@ void hal_pwm_write(const hal_pwm_t *p, hal_pwm_t *applied) {
       break;
     }
   }
-  hal_pattern_apply(p, &bound->caps, bound->timer_counts, &bound->pwm);
+  hal_pattern_apply(&bound->timer, p, &bound->pwm);
   if (applied != NULL) {
     *applied = bound->pwm;
   }

@@ -16,6 +16,7 @@
 #include <stdint.h>
 
 #include "hal.h"
+#include "hal_pattern.h"
 
 #define HAL_SIL_CAN_QUEUE 256
 
@@ -39,6 +40,7 @@ typedef struct {
 typedef struct {
   hal_caps_t caps;
   uint32_t timer_counts;
+  hal_pattern_t timer;  /* the timer model of caps and timer_counts (hal_pattern.h) */
   hal_sample_t sample;  /* what hal_adc_read returns */
   hal_pwm_t pwm;        /* preloaded pattern (acts from the next period) */
   uint32_t pwm_clamped; /* writes with a leg outside the duty range (caps): the

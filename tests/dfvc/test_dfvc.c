@@ -30,6 +30,7 @@ typedef struct {
   ab_t v_prev; /* applied over [k, k+1) */
   dfvc_law_t law;
   double vdc;
+  law_telemetry_t tm; /* where dfvc_step writes the telemetry */
 } loop_t;
 
 static void loop_init(loop_t *l, const dfvc_cfg_t *cfg, double rpm, dfvc_law_t law) {
@@ -46,16 +47,15 @@ static void loop_init(loop_t *l, const dfvc_cfg_t *cfg, double rpm, dfvc_law_t l
 /* One period: sample at k, control, plant over [k, k+1) with the previous
  * command, latch the new one for [k+1, k+2). */
 static void loop_step(loop_t *l, double torque, dfvc_out_t *out) {
-  dfvc_in_t in;
-  in.law = l->law;
+  dfvc_in_t in = {0};
   in.i_ab = (ab_t){(float)creal(l->m.i), (float)cimag(l->m.i)};
-  in.v_ab_applied = l->v_prev;
-  in.theta_r = (float)l->m.theta;
-  in.omega_r = (float)l->m.w;
+  in.v_applied = l->v_prev;
+  in.theta_e = (float)l->m.theta;
+  in.omega_e = (float)l->m.w;
   in.v_lin = (float)(l->vdc / sqrt(3.0));
   in.torque_ref = (float)torque;
-  in.lambda_ref = 0.0f;
-  dfvc_step(&l->c, &in, out);
+  in.flux_ref = 0.0f;
+  dfvc_step(&l->c, l->law, &in, out, &l->tm);
   assert_int_equal(out->fault, 0);
   spm_plant_step(&l->m, l->v_prev.alpha + I * l->v_prev.beta);
   l->v_prev = out->v_ab_ref;
@@ -100,8 +100,8 @@ static step_result_t run_step(const dfvc_cfg_t *cfg, dfvc_law_t law, double rpm,
     iqs[n] = spm_plant_iqs(&l.m); /* true value at k0 + n */
     flux[n] = cabs(spm_plant_flux(&l.m));
     loop_step(&l, t1, &out);
-    lref = out.lambda_ref;
-    iqs_ref = out.i_qs_ref;
+    lref = l.tm.flux_ref;
+    iqs_ref = l.tm.i_qs_ref;
     if (verbose && n < 14) {
       printf("    n=%2d iqs %.4f (ref %.4f, pred %.4f) flux %.5f (ref %.5f) vds %.1f vqs %.1f "
              "T %.3f\n",
@@ -207,14 +207,14 @@ static void run_fw(const dfvc_cfg_t *cfg, double *flux_err, double *delta, doubl
     *vmag = fmax(*vmag, hypot(out.v_ab_ref.alpha, out.v_ab_ref.beta));
   }
   const double complex lam = spm_plant_flux(&l.m);
-  *flux_err = (cabs(lam) - out.lambda_ref) / out.lambda_ref;
+  *flux_err = (cabs(lam) - l.tm.flux_ref) / l.tm.flux_ref;
   *delta = remainder(carg(lam) - l.m.theta, 6.283185307179586);
   *torque = spm_plant_torque(&l.m);
   *limits = out.limits;
   printf("  1200 rpm, T* = 20 N m, rot_advance %.1f: lambda %.4f Vs (ref %.4f, err %.3f %%), "
          "delta %.2f deg, T %.3f N m (%.0f W), i_qs %.3f (ref %.3f), T_max %.3f, |v| max %.1f V\n",
-         cfg->rot_advance, cabs(lam), out.lambda_ref, 100.0 * *flux_err, *delta * 57.29578, *torque,
-         *torque * l.m.w / cfg->machine->pole_pairs, spm_plant_iqs(&l.m), out.i_qs_ref,
+         cfg->rot_advance, cabs(lam), l.tm.flux_ref, 100.0 * *flux_err, *delta * 57.29578, *torque,
+         *torque * l.m.w / cfg->machine->pole_pairs, spm_plant_iqs(&l.m), l.tm.i_qs_ref,
          out.torque_max, *vmag);
 }
 
@@ -250,16 +250,20 @@ static void test_faults_and_switch(void **state) {
   for (int k = 0; k < 400; ++k) {
     loop_step(&l, 10.0, &out);
   }
-  dfvc_in_t in = {DFVC_LAW_DEADBEAT, {0.1f, 0.2f}, {0.0f, 0.0f}, 0.0f, 0.0f, 179.0f, 10.0f, 0.0f};
+  dfvc_in_t in = {0};
+  in.i_ab = (ab_t){0.1f, 0.2f};
+  in.v_lin = 179.0f;
+  in.torque_ref = 10.0f;
   in.i_ab.alpha = NAN;
   const dfvc_t before = l.c;
-  dfvc_step(&l.c, &in, &out);
+  dfvc_step(&l.c, DFVC_LAW_DEADBEAT, &in, &out, &l.tm);
   assert_int_equal(out.fault, DFVC_FAULT_INPUT);
   assert_true(fabsf(out.v_ab_ref.alpha) < 1e-30f && fabsf(out.v_ab_ref.beta) < 1e-30f);
+  /* the telemetry zeroed in place */
+  assert_true(l.tm.flux == 0.0f && l.tm.torque == 0.0f && l.tm.obs_err == 0.0f);
   assert_memory_equal(&before.obs, &l.c.obs, sizeof(before.obs));
   in.i_ab.alpha = 0.1f;
-  in.law = (dfvc_law_t)5;
-  dfvc_step(&l.c, &in, &out);
+  dfvc_step(&l.c, (dfvc_law_t)5, &in, &out, &l.tm);
   assert_int_equal(out.fault, DFVC_FAULT_INPUT);
 
   /* law switch DB -> PI at 10 N m: the PI starts from the feed-forwards, no kick */
@@ -267,21 +271,20 @@ static void test_faults_and_switch(void **state) {
   double worst = 0.0;
   for (int k = 0; k < 200; ++k) {
     loop_step(&l, 10.0, &out);
-    worst = fmax(worst, fabs(spm_plant_iqs(&l.m) - out.i_qs_ref));
+    worst = fmax(worst, fabs(spm_plant_iqs(&l.m) - l.tm.i_qs_ref));
   }
   printf("  DB -> PI switch: worst |i_qs - ref| %.4f A\n", worst);
-  assert_true(worst < 0.05 * fabs(out.i_qs_ref));
+  assert_true(worst < 0.05 * fabs(l.tm.i_qs_ref));
 
   /* collapse threshold above the actual flux */
   dfvc_cfg_t c2 = cfg;
   c2.lambda_collapse = 0.5f;
   dfvc_t d;
   assert_int_equal(dfvc_init(&d, &c2), 0);
-  in.law = DFVC_LAW_DEADBEAT;
   in.i_ab = (dfvc_in_t){0}.i_ab;
-  dfvc_step(&d, &in, &out);
+  dfvc_step(&d, DFVC_LAW_DEADBEAT, &in, &out, &l.tm);
   assert_int_equal(out.fault, DFVC_FAULT_FLUX_COLLAPSE);
-  assert_true(fabsf(out.lambda_s - 0.19f) < 1e-5f);
+  assert_true(fabsf(l.tm.flux - 0.19f) < 1e-5f);
   assert_true(hypotf(out.v_ab_ref.alpha, out.v_ab_ref.beta) > 1.0f);
 
   /* invalid configuration */

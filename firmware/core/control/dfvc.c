@@ -68,33 +68,41 @@ void dfvc_reset(dfvc_t *c) {
   c->last_law = DFVC_LAW_DEADBEAT;
 }
 
+/* A fault's outputs: all zero (no voltage), the telemetry too. Out of
+ * line: off the period's path. */
+static FD_NOINLINE void dfvc_out_fault(dfvc_out_t *out, law_telemetry_t *tm, uint32_t fault) {
+  memset(out, 0, sizeof(*out));
+  memset(tm, 0, sizeof(*tm));
+  out->fault = fault;
+}
+
 /* 0 for a finite vector, NaN otherwise (fd_zero_if_finite) */
 static inline float dfvc_zero_if_finite_ab(ab_t x) {
   return fd_zero_if_finite(x.alpha) + fd_zero_if_finite(x.beta);
 }
 
-static int dfvc_inputs_ok(const dfvc_in_t *in) {
-  const float z = dfvc_zero_if_finite_ab(in->i_ab) + dfvc_zero_if_finite_ab(in->v_ab_applied) +
-                  fd_zero_if_finite(in->theta_r) + fd_zero_if_finite(in->omega_r) +
+static int dfvc_inputs_ok(dfvc_law_t law, const dfvc_in_t *in) {
+  const float z = dfvc_zero_if_finite_ab(in->i_ab) + dfvc_zero_if_finite_ab(in->v_applied) +
+                  fd_zero_if_finite(in->theta_e) + fd_zero_if_finite(in->omega_e) +
                   fd_zero_if_finite(in->v_lin) + fd_zero_if_finite(in->torque_ref) +
-                  fd_zero_if_finite(in->lambda_ref);
-  return (in->law == DFVC_LAW_DEADBEAT || in->law == DFVC_LAW_PI) && fd_isfinite(z);
+                  fd_zero_if_finite(in->flux_ref);
+  return (law == DFVC_LAW_DEADBEAT || law == DFVC_LAW_PI) && fd_isfinite(z);
 }
 
 /* delta(tau+1) = theta_s(tau+1) - theta_r(tau+1), wrapped; theta_r(tau+1)
  * = theta_r + omega_r Ts (dfvc.h) */
 static float dfvc_delta_next(const dfvc_in_t *in, const flux_observer_out_t *o, float ts) {
-  const float theta_r1 = in->theta_r + in->omega_r * ts;
+  const float theta_r1 = in->theta_e + in->omega_e * ts;
   return frames_wrap_pi(fd_atan2f(o->sc_s_next.s, o->sc_s_next.c) - theta_r1);
 }
 
-void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
+void dfvc_step(dfvc_t *c, dfvc_law_t law, const dfvc_in_t *in, dfvc_out_t *out,
+               law_telemetry_t *tm) {
   const dfvc_cfg_t *k = &c->cfg;
   /* every field of *out is written below (no zeroing per ISR); the fault
    * paths clear it */
-  if (!dfvc_inputs_ok(in)) {
-    memset(out, 0, sizeof(*out));
-    out->fault = DFVC_FAULT_INPUT;
+  if (!dfvc_inputs_ok(law, in)) {
+    dfvc_out_fault(out, tm, DFVC_FAULT_INPUT);
     return;
   }
 
@@ -102,24 +110,23 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
    * (with the model's coefficients) per ISR; the other angles' sin/cos are
    * products of these unit vectors. */
   current_predictor_speed_t w;
-  current_predictor_speed(&c->mpe, in->omega_r, &w);
-  const sincos_t scr = frames_sincos(in->theta_r);
+  current_predictor_speed(&c->mpe, in->omega_e, &w);
+  const sincos_t scr = frames_sincos(in->theta_e);
   const sincos_t scr1 = frames_sincos_add(scr, w.rot); /* theta_r(tau+1) */
 
   /* MPE, eq. (21): current at tau+1 */
-  const ab_t i1 = current_predictor_step_sc(&c->mpe, &w, in->i_ab, in->v_ab_applied, scr);
+  const ab_t i1 = current_predictor_step_sc(&c->mpe, &w, in->i_ab, in->v_applied, scr);
 
   /* stator flux at tau and its prediction at tau+1, Fig. 3, eqs. (19)-(20) */
   flux_observer_out_t o;
-  flux_observer_update_sc(&c->obs, in->i_ab, i1, in->v_ab_applied, in->theta_r, scr, in->omega_r,
-                          &o);
+  flux_observer_update_sc(&c->obs, in->i_ab, i1, in->v_applied, in->theta_e, scr, in->omega_e, &o);
   const dq_t i1_dqs = frames_park(i1, o.sc_s_next);
   const sincos_t sc_delta1 = frames_sincos_sub(o.sc_s_next, scr1);
 
   /* references, Fig. 5, eqs. (22)-(26), from the quantities at tau; the
    * current limit (25) at tau+2 from the MPE prediction (dfvc_refs.h) */
-  const dfvc_refs_in_t ri = {in->torque_ref, in->lambda_ref, in->omega_r, in->v_lin,
-                             o.i_dqs.d,      o.i_dqs.q,      i1_dqs,      sc_delta1};
+  const dfvc_refs_in_t ri = {in->torque_ref, in->flux_ref, in->omega_e, in->v_lin,
+                             o.i_dqs.d,      o.i_dqs.q,    i1_dqs,      sc_delta1};
   dfvc_refs_out_t r;
   dfvc_refs_update(&c->refs, &ri, &r);
 
@@ -127,13 +134,13 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
   const float v_max = fd_maxf(in->v_lin, 0.0f);
   dq_t v_dqs;
   uint32_t lim = r.limits;
-  if (in->law == DFVC_LAW_DEADBEAT) {
+  if (law == DFVC_LAW_DEADBEAT) {
     dfvc_deadbeat_in_t di;
     di.lambda_ref = r.lambda_ref;
     di.iqs_ref = r.iqs_ref;
     di.lambda_s_next = o.lambda_s_next;
     di.i_dqs_next = i1_dqs;
-    di.omega_r = in->omega_r;
+    di.omega_r = in->omega_e;
     /* delta(tau+1) as an angle (an atan2) only where it is read: the
      * observed rate, and the target's branch beyond |delta| = pi/2 (the
      * asin of dfvc_deadbeat_omega_delta_target_sc; 0 is not read there) */
@@ -160,8 +167,8 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
     pin.iqs_ref = r.iqs_ref;
     pin.lambda_s = o.lambda_s;
     pin.i_dqs = o.i_dqs;
-    pin.omega_r = in->omega_r;
-    pin.omega_delta = o.omega_s - in->omega_r;
+    pin.omega_r = in->omega_e;
+    pin.omega_delta = o.omega_s - in->omega_e;
     pin.v_max = v_max;
     dfvc_pi_out_t pout;
     /* Rubino 2020, section IV.7 */
@@ -170,13 +177,13 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
     lim |= ((pout.sat & DFVC_PI_SAT_D) ? DFVC_LIMIT_VD : 0u) |
            ((pout.sat & DFVC_PI_SAT_Q) ? DFVC_LIMIT_VQ : 0u);
   }
-  c->last_law = in->law;
+  c->last_law = law;
 
   /* (ds, qs) -> (alpha, beta) at the predicted flux angle theta_s(tau+1)
    * (Rubino 2020, Fig. 7), advanced by rot_advance * omega_r * Ts */
   /* at the default half period this is the predictor's half-angle
    * evaluation: (0.5 omega_r) Ts and 0.5 (omega_r Ts) are the same float */
-  const sincos_t adv = c->adv_half ? w.half : frames_sincos(k->rot_advance * in->omega_r * k->ts);
+  const sincos_t adv = c->adv_half ? w.half : frames_sincos(k->rot_advance * in->omega_e * k->ts);
   sincos_t scv;
   scv.c = o.sc_s_next.c * adv.c - o.sc_s_next.s * adv.s;
   scv.s = o.sc_s_next.s * adv.c + o.sc_s_next.c * adv.s;
@@ -190,30 +197,33 @@ void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out) {
                   fd_zero_if_finite(r.iqs_ref);
   if (!fd_isfinite(z)) {
     dfvc_reset(c);
-    memset(out, 0, sizeof(*out));
-    out->fault = DFVC_FAULT_STATE;
+    dfvc_out_fault(out, tm, DFVC_FAULT_STATE);
     return;
   }
 
   out->v_ab_ref = v_ab;
   out->i_ab_mid.alpha = 0.5f * (i1.alpha + i2.alpha);
   out->i_ab_mid.beta = 0.5f * (i1.beta + i2.beta);
-  out->lambda_s = o.lambda_s;
-  out->lambda_ref = r.lambda_ref;
-  out->delta = o.delta;
-  out->i_ds = o.i_dqs.d;
-  out->i_qs = o.i_dqs.q;
-  out->i_qs_ref = r.iqs_ref;
   out->i_qs_pred = i1_dqs.q;
   out->i_dq_r = frames_park(in->i_ab, scr);
-  out->torque = o.torque;
-  {
-    const float ea = o.lambda.alpha - o.lambda_cm.alpha, eb = o.lambda.beta - o.lambda_cm.beta;
-    out->obs_err = sqrtf(ea * ea + eb * eb);
-  }
   out->torque_min = r.torque_min;
   out->torque_max = r.torque_max;
   out->v_dqs = v_dqs;
   out->limits = lim;
+  /* the telemetry where the caller publishes it (no copy) */
+  tm->flux = o.lambda_s;
+  tm->flux_ref = r.lambda_ref;
+  tm->delta = o.delta; /* the load-angle limit's: taken every period */
+  tm->lam_d = 0.0f;
+  tm->lam_q = 0.0f;
+  tm->delta_lazy = false;
+  tm->i_ds = o.i_dqs.d;
+  tm->i_qs = o.i_dqs.q;
+  tm->i_qs_ref = r.iqs_ref;
+  tm->torque = o.torque;
+  {
+    const float ea = o.lambda.alpha - o.lambda_cm.alpha, eb = o.lambda.beta - o.lambda_cm.beta;
+    tm->obs_err = sqrtf(ea * ea + eb * eb);
+  }
   out->fault = (o.lambda_s < k->lambda_collapse) ? DFVC_FAULT_FLUX_COLLAPSE : 0u;
 }

@@ -12,7 +12,7 @@
  * caller on the duties, with the predicted currents reported here.
  *
  * Timing (ARCHITECTURE.md, paper eq. (28)): call dfvc_step() once per
- * period with the samples taken at tau. in.v_ab_applied is the voltage that
+ * period with the samples taken at tau. in.v_applied is the voltage that
  * the modulator applies over [tau, tau+1), i.e. the previous call's
  * out.v_ab_ref as actually applied (modulation_out_t.v_applied). The
  * returned out.v_ab_ref is to be applied over [tau+1, tau+2).
@@ -21,8 +21,8 @@
  * lambda_s; load angle delta = theta_s - theta_r (from d to ds).
  *
  * Typical use per ISR:
- *   in.i_ab = measured; in.v_ab_applied = mod.v_applied (from last period);
- *   dfvc_step(&c, &in, &out);
+ *   in.i_ab = measured; in.v_applied = mod.v_applied (from last period);
+ *   dfvc_step(&c, DFVC_LAW_DEADBEAT, &in, &out, &telemetry);
  *   mod = modulation_minmax(out.v_ab_ref, v_dc, duty_min, duty_max);
  *   deadtime_comp_apply(&dt, mod.duty, frames_clarke_inv(out.i_ab_mid), duty);
  *   if (out.fault) -> app decides (gates off, latch)
@@ -66,6 +66,7 @@
 #include "control/dfvc_deadbeat.h"
 #include "control/dfvc_pi.h"
 #include "control/dfvc_refs.h"
+#include "control/law_io.h"
 #include "estimation/current_predictor.h"
 #include "estimation/flux_observer.h"
 #include "math/frames.h"
@@ -101,16 +102,14 @@ typedef struct {
   float rot_advance; /* [0, 1], fraction of omega_r Ts added to theta_s(t+1) */
 } dfvc_cfg_t;
 
-typedef struct {
-  dfvc_law_t law;    /* DFVC_LAW_DEADBEAT or DFVC_LAW_PI (may change between calls) */
-  ab_t i_ab;         /* measured current at tau [A] */
-  ab_t v_ab_applied; /* voltage applied over [tau, tau+1) [V] */
-  float theta_r;     /* electrical rotor angle at tau [rad] */
-  float omega_r;     /* electrical rotor speed at tau [rad/s] */
-  float v_lin;       /* linear voltage range of the modulator now (v_dc/sqrt(3)) [V] */
-  float torque_ref;  /* T* [N m] */
-  float lambda_ref;  /* flux reference override [Vs]; 0 = automatic (MTPA/FW) */
-} dfvc_in_t;
+/* The period's inputs, the core's law input (control/law_io.h), read in
+ * place: i_ab = measured current at tau [A]; v_applied = voltage applied
+ * over [tau, tau+1) [V]; theta_e, omega_e = electrical rotor angle and
+ * speed at tau; v_lin = linear voltage range of the modulator now
+ * (v_dc/sqrt(3)) [V]; torque_ref = T* [N m]; flux_ref = flux reference
+ * override [Vs], 0 = automatic (MTPA/FW). current, id_ref, iq_ref: not
+ * read. */
+typedef law_in_t dfvc_in_t;
 
 /* Fault bits (values only; nothing is latched or switched off here). */
 enum {
@@ -132,16 +131,8 @@ typedef struct {
    * predicted flux and torque and the flux angle and speed are not outputs
    * (nothing read them; their stores cost the ISR, issue 24 point 8) */
   ab_t i_ab_mid;
-  /* telemetry at tau unless stated */
-  float lambda_s;   /* observed flux amplitude [Vs] */
-  float lambda_ref; /* lambda* [Vs] */
-  float delta;      /* load angle [rad] */
-  float i_ds, i_qs; /* stator-flux frame currents [A] */
-  float i_qs_ref;   /* limited i_qs* [A] */
-  float i_qs_pred;  /* predicted at tau+1 [A] */
-  dq_t i_dq_r;      /* rotor-frame currents at tau (telemetry) [A] */
-  float torque;     /* 3/2 p lambda_s i_qs [N m] */
-  float obs_err;    /* |lambda_hat - lambda_cm| at tau: observer vs current model [Vs] */
+  float i_qs_pred;              /* predicted at tau+1 [A] */
+  dq_t i_dq_r;                  /* rotor-frame currents at tau [A] */
   float torque_min, torque_max; /* deliverable now [N m] (dfvc_refs.h) */
   dq_t v_dqs;                   /* (ds, qs) voltage reference [V] */
   uint32_t limits;              /* DFVC_REFS_* | DFVC_LIMIT_* */
@@ -165,7 +156,15 @@ void dfvc_cfg_defaults(dfvc_cfg_t *cfg, const machine_t *machine);
 int dfvc_init(dfvc_t *c, const dfvc_cfg_t *cfg);
 /* Observer restarts from the current model, PI integrals cleared. */
 void dfvc_reset(dfvc_t *c);
-/* One control period; out is fully written. */
-void dfvc_step(dfvc_t *c, const dfvc_in_t *in, dfvc_out_t *out);
+/* One control period of the voltage law `law` (DFVC_LAW_DEADBEAT or
+ * DFVC_LAW_PI; may change between calls); out is fully written, and the
+ * telemetry in place at tm, where the caller publishes it (every field,
+ * each period; zeroed with the outputs on a fault): flux = observed
+ * |lambda_s| at tau, flux_ref = lambda*, delta = load angle, i_ds, i_qs =
+ * stator-flux frame currents, i_qs_ref = limited i_qs*, torque = 3/2 p
+ * lambda_s i_qs, obs_err = |lambda_hat - lambda_cm| at tau (observer vs
+ * current model); lam_d, lam_q 0, delta_lazy false. */
+void dfvc_step(dfvc_t *c, dfvc_law_t law, const dfvc_in_t *in, dfvc_out_t *out,
+               law_telemetry_t *tm);
 
 #endif

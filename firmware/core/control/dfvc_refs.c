@@ -10,6 +10,12 @@
 #include "math/fast_trig.h"
 #include "math/fd_math.h"
 
+#if defined(__GNUC__)
+#define DFVC_REFS_INLINE static inline __attribute__((always_inline))
+#else
+#define DFVC_REFS_INLINE static inline
+#endif
+
 #define DFVC_REFS_HALF_PI 1.57079632679490f
 #define DFVC_REFS_W_MIN   1.0f /* floor of |omega_r| in (23) [rad/s] */
 
@@ -82,8 +88,9 @@ float dfvc_refs_lambda_vlim(const dfvc_refs_t *r, float v_lin, float omega_r, fl
                            1.0f / fd_maxf(fabsf(omega_r), DFVC_REFS_W_MIN), omega_r, i_qs);
 }
 
-/* |i_qs*| clipped by (25) then (26), with the limit bits */
-static float dfvc_refs_limit_iqs(const dfvc_refs_out_t *out, float iq, unsigned *lim) {
+/* |i_qs*| clipped by (25) then (26), with the limit bits; inline (-Os
+ * would call it: its two call sites are on the period's path) */
+DFVC_REFS_INLINE float dfvc_refs_limit_iqs(const dfvc_refs_out_t *out, float iq, unsigned *lim) {
   if (fabsf(iq) > out->iqs_max_i) {
     iq = copysignf(out->iqs_max_i, iq);
     *lim |= DFVC_REFS_IQS_IMAX;

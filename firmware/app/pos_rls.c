@@ -40,6 +40,7 @@ FD_COLD static void rls_init(pos_state_t *s, const drive_config_t *cfg) {
   s->star.id.avg[0] = 0.0f; /* not settled before its updates (rls_health) */
   s->star.id.avg[1] = 0.0f;
   s->star.id.warm2 = 1.0f;
+  s->star.id.health_due = false;
   rls_guarded(&s->star.id.rls, cfg, &s->star.meas.dc); /* the RLS's start, guarded */
 }
 
@@ -112,12 +113,20 @@ static bool rls_health(pos_state_t *s, const drive_config_t *cfg) {
   return ok && am > 0.25f * a0 && am < 4.0f * a0 && fabsf(r->x[1]) < POS_DFC_P_MAX * am;
 }
 
-/* One period: the update, and after one the health (rls_ok) */
+/* One period: the health (rls_ok) of the last period's update, then the
+ * update. The health waits a period: the update's period (every third)
+ * carries the update, the IVD's a, b and the warm gain, and the ISR's
+ * worst case is where it meets the slow-rate rows (the speed loop and the
+ * torque reference's MTPA current). It is taken before any further
+ * update, on that update's a, b and covariance: the rls_ok the update's
+ * period would have taken, a period (62.5 us) later. */
 static void rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v,
                      const sincos_t *u, pos_estimate_t *out) {
-  if (rls_update(s, cfg, v, u)) {
+  if (s->star.id.health_due) {
+    s->star.id.health_due = false;
     out->rls_ok = rls_health(s, cfg);
   }
+  s->star.id.health_due = rls_update(s, cfg, v, u);
 }
 
 /* the warm start's gain at the a, b in force (pos_star_align: once per start) */

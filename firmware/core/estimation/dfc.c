@@ -202,7 +202,8 @@ static inline __attribute__((always_inline)) bool ivd_run(const dfc_cfg_t *c, co
   const float inv_a = 1.0f / c->a;
   const float zr = -v->al * inv_a, zi = v->be * inv_a; /* zeta = e^{j2th} - p e^{-j4th} */
   const bool full = c->method == DFC_FULL_IVD;
-  float ra[2] = {1.0f, 0.0f}, rb[2] = {1.0f, 0.0f}; /* the Full IVD's turns */
+  float ra[2], rb[2];                         /* the Full IVD's turns e^{-j phi_a}, e^{-j phi_b} */
+  const float *turn_a = NULL, *turn_b = NULL; /* (the plain IVD: none) */
   if (full) {
     const sincos_t pa = frames_sincos(c->phi_a * i_q), pb = frames_sincos(c->phi_b * i_q);
     ra[0] = pa.c;
@@ -210,14 +211,16 @@ static inline __attribute__((always_inline)) bool ivd_run(const dfc_cfg_t *c, co
     ra[1] = -pa.s;
     rb[0] = pb.c;
     rb[1] = -pb.s;
+    turn_a = ra;
+    turn_b = rb;
   }
   if (from_raw) { /* (3.8) / (3.98): the raw estimate */
     if (!dfc_normalise(zr, zi, ur, ui)) {
       return false;
     }
-    if (full) {
-      const float r = *ur * ra[0] - *ui * ra[1];
-      *ui = *ur * ra[1] + *ui * ra[0];
+    if (turn_a != NULL) {
+      const float r = *ur * turn_a[0] - *ui * turn_a[1];
+      *ui = *ur * turn_a[1] + *ui * turn_a[0];
       *ur = r;
     }
     if (trace != NULL) {
@@ -230,7 +233,7 @@ static inline __attribute__((always_inline)) bool ivd_run(const dfc_cfg_t *c, co
                          : 0u;
   const float p = c->b * inv_a;
   for (uint32_t k = 1u; k <= n; ++k) { /* (3.76) / (3.100) */
-    if (!dfc_ivd_step(zr, zi, p, v->k, full ? rb : NULL, full ? ra : NULL, ur, ui)) {
+    if (!dfc_ivd_step(zr, zi, p, v->k, turn_b, turn_a, ur, ui)) {
       return false;
     }
     if (trace != NULL) {

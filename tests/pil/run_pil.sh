@@ -61,9 +61,9 @@ export PYTHONPATH="$src/tools/src${PYTHONPATH:+:$PYTHONPATH}"
 # the Kalman filter on speed, angle and load torque under FOC, from
 # standstill to 500 rpm: agreement, the issue's goals per call (KF: predict
 # + update <= 360, RLS <= 220; measured 158 and 146) and for the whole ISR:
-# issue 24 point 8's software mean < 2600 (measured 2486) and, with the
+# issue 24 point 8's software mean < 2600 (measured 2485) and, with the
 # core's trigonometry on the STM32G474's CORDIC co-processor, < 2500
-# (measured 2421; the issue's target 2300 not reached yet:
+# (measured 2420; the issue's target 2300 not reached yet:
 # docs/benchmarks.md, "Sensorless: Kalman filter, EKF, RLS"); then the EKF
 # (<= 790; measured 251)
 "$python" -m fluxdrive pil "$src/sil/scenarios/pil_ivd_kf_rls.json" --law foc --isrs all \

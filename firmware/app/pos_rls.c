@@ -40,6 +40,7 @@ FD_COLD static void rls_init(pos_state_t *s, const drive_config_t *cfg) {
   s->star.id.avg[0] = 0.0f; /* not settled before its updates (rls_health) */
   s->star.id.avg[1] = 0.0f;
   s->star.id.warm2 = 1.0f;
+  s->star.id.health_due = false;
   rls_guarded(&s->star.id.rls, cfg, &s->star.meas.dc); /* the RLS's start, guarded */
 }
 
@@ -59,7 +60,7 @@ static void warm_gain(pos_state_t *s) {
 }
 
 /* The RLS of a, b (4.51)-(4.57) on this vector at the filter's predicted
- * angle u, and the IVD's a, b from it, within the guards (header). One
+ * angle u (the IVD's a, b from it in the next period: rls_step). One
  * update per refresh of the whole vector (when component a is the newest:
  * every third period, 5.3 kHz, the thesis's DFC rate): successive updates
  * then share no sample, as the RLS's independent noise assumes. */
@@ -72,10 +73,6 @@ static bool rls_update(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_
       fabsf(pos_track_omega(s)) > cfg->rls_w_min) {
     r->cfg = rls_cfg_of(cfg); /* the live tuning, for this update and rls_health */
     upd = rls_ab_update(r, v->al, v->be, u->c, u->s, v->k);
-  }
-  if (upd) { /* the IVD's a, b move only here (pos_star_update keeps them) */
-    rls_guarded(r, cfg, &s->star.meas.dc);
-    warm_gain(s);
   }
   return upd;
 }
@@ -112,12 +109,24 @@ static bool rls_health(pos_state_t *s, const drive_config_t *cfg) {
   return ok && am > 0.25f * a0 && am < 4.0f * a0 && fabsf(r->x[1]) < POS_DFC_P_MAX * am;
 }
 
-/* One period: the update, and after one the health (rls_ok) */
+/* One period: the last period's update into the IVD's a, b (within the
+ * guards; they move only here, pos_star_update keeps them), the warm
+ * gain and the health (rls_ok), then this period's update. The update's
+ * period (every third) carries the update alone, the next one the rest:
+ * the ISR's worst case is where one of them meets the slow-rate rows (the
+ * speed loop and the torque reference's MTPA current), and the two halves
+ * are about equal (about 150 instructions each). They come before any
+ * further update, on that update's a, b and covariance: the IVD takes the
+ * new a, b and rls_ok is set a period (62.5 us) after the update. */
 static void rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v,
                      const sincos_t *u, pos_estimate_t *out) {
-  if (rls_update(s, cfg, v, u)) {
+  if (s->star.id.health_due) {
+    s->star.id.health_due = false;
+    rls_guarded(&s->star.id.rls, cfg, &s->star.meas.dc);
+    warm_gain(s);
     out->rls_ok = rls_health(s, cfg);
   }
+  s->star.id.health_due = rls_update(s, cfg, v, u);
 }
 
 /* the warm start's gain at the a, b in force (pos_star_align: once per start) */

@@ -94,8 +94,9 @@ typedef struct {
 
 typedef struct {
   rls_ab_t rls;
-  float avg[2]; /* a, b low-passed over the RLS's updates (pos_rls.c, rls_health) */
-  float warm2;  /* ((2|p|)^n)^2 of the warm-started IVD at the RLS's a, b (pos_rls.c) */
+  float avg[2];    /* a, b low-passed over the RLS's updates (pos_rls.c, rls_health) */
+  float warm2;     /* ((2|p|)^n)^2 of the warm-started IVD at the RLS's a, b (pos_rls.c) */
+  bool health_due; /* an update's a, b, warm gain and health go in in the next period (pos_rls.c) */
 } pos_ident_state_t;
 
 typedef struct {

@@ -113,10 +113,13 @@ void dfc_signals_vector(const dfc_signals_t *s, float w2, dfc_vec_t *v) {
      * so Gamma_x projects it on c_x e^{-j phi} (d); the 4theta term was
      * e^{-j2phi} behind: on c_x e^{+j2phi} (e) */
     const float phi = w2 * (t_new - s->t[x]);
-    float co, si, co2, si2;
+    float co, si;
     /* mut: dfc_sequentiality_sign */
     dfc_turn(-phi, &co, &si);
-    dfc_turn(2.0f * phi, &co2, &si2);
+    /* e^{j2phi} = conj(e^{-j phi})^2: the double angle, three products
+     * (more accurate than the series at 2 phi: its error is 2 x^6 / 720
+     * against 64 x^6 / 720) */
+    const float co2 = co * co - si * si, si2 = -2.0f * co * si;
     const float d1 = cx[x][0] * co - cx[x][1] * si, d2 = cx[x][0] * si + cx[x][1] * co;
     const float e1 = cx[x][0] * co2 - cx[x][1] * si2, e2 = cx[x][0] * si2 + cx[x][1] * co2;
     a11 += d1 * d1;
@@ -156,10 +159,15 @@ static inline bool dfc_normalise(float wr, float wi, float *ur, float *ui) {
 
 FD_NOINLINE bool dfc_ivd_step(float zr, float zi, float p, const float k[4], const float rb[2],
                               const float ra[2], float *ur, float *ui) {
-  /* e^{-j4theta_{k-1}} = conj(u)^2; times r_b = e^{-j phi_b} (3.100); the
-   * sequentiality map K */
-  const float sr = *ur * *ur - *ui * *ui, si = -2.0f * *ur * *ui;
-  const float tr = sr * rb[0] - si * rb[1], ti = sr * rb[1] + si * rb[0];
+  /* e^{-j4theta_{k-1}} = conj(u)^2; times r_b = e^{-j phi_b} (3.100), the
+   * Full IVD's (the plain IVD's r_b, r_a are 1: no turn); the sequentiality
+   * map K */
+  float tr = *ur * *ur - *ui * *ui, ti = -2.0f * *ur * *ui;
+  if (rb != NULL) {
+    const float sr = tr;
+    tr = sr * rb[0] - ti * rb[1];
+    ti = sr * rb[1] + ti * rb[0];
+  }
   const float qr = k[0] * tr + k[1] * ti, qi = k[2] * tr + k[3] * ti;
   float vr, vi;
   /* mut: dfc_ivd_no_b_term */
@@ -167,8 +175,13 @@ FD_NOINLINE bool dfc_ivd_step(float zr, float zi, float p, const float k[4], con
     return false;
   }
   /* minus phi_a: times r_a = e^{-j phi_a} */
-  *ur = vr * ra[0] - vi * ra[1];
-  *ui = vr * ra[1] + vi * ra[0];
+  if (ra != NULL) {
+    *ur = vr * ra[0] - vi * ra[1];
+    *ui = vr * ra[1] + vi * ra[0];
+  } else {
+    *ur = vr;
+    *ui = vi;
+  }
   return true;
 }
 
@@ -189,7 +202,8 @@ static inline __attribute__((always_inline)) bool ivd_run(const dfc_cfg_t *c, co
   const float inv_a = 1.0f / c->a;
   const float zr = -v->al * inv_a, zi = v->be * inv_a; /* zeta = e^{j2th} - p e^{-j4th} */
   const bool full = c->method == DFC_FULL_IVD;
-  float ra[2] = {1.0f, 0.0f}, rb[2] = {1.0f, 0.0f};
+  float ra[2], rb[2];                         /* the Full IVD's turns e^{-j phi_a}, e^{-j phi_b} */
+  const float *turn_a = NULL, *turn_b = NULL; /* (the plain IVD: none) */
   if (full) {
     const sincos_t pa = frames_sincos(c->phi_a * i_q), pb = frames_sincos(c->phi_b * i_q);
     ra[0] = pa.c;
@@ -197,14 +211,16 @@ static inline __attribute__((always_inline)) bool ivd_run(const dfc_cfg_t *c, co
     ra[1] = -pa.s;
     rb[0] = pb.c;
     rb[1] = -pb.s;
+    turn_a = ra;
+    turn_b = rb;
   }
   if (from_raw) { /* (3.8) / (3.98): the raw estimate */
     if (!dfc_normalise(zr, zi, ur, ui)) {
       return false;
     }
-    if (full) {
-      const float r = *ur * ra[0] - *ui * ra[1];
-      *ui = *ur * ra[1] + *ui * ra[0];
+    if (turn_a != NULL) {
+      const float r = *ur * turn_a[0] - *ui * turn_a[1];
+      *ui = *ur * turn_a[1] + *ui * turn_a[0];
       *ur = r;
     }
     if (trace != NULL) {
@@ -217,7 +233,7 @@ static inline __attribute__((always_inline)) bool ivd_run(const dfc_cfg_t *c, co
                          : 0u;
   const float p = c->b * inv_a;
   for (uint32_t k = 1u; k <= n; ++k) { /* (3.76) / (3.100) */
-    if (!dfc_ivd_step(zr, zi, p, v->k, rb, ra, ur, ui)) {
+    if (!dfc_ivd_step(zr, zi, p, v->k, turn_b, turn_a, ur, ui)) {
       return false;
     }
     if (trace != NULL) {

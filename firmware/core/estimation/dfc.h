@@ -141,8 +141,8 @@ float dfc_angle2(const dfc_cfg_t *c, const float g[3], float i_q, bool *ok);
 
 /* One IVD iteration on unit vectors (exposed for the cost benchmark):
  * u <- normalise(zeta + p K r_b conj(u)^2) r_a, with r_a = e^{-j phi_a},
- * r_b = e^{-j phi_b} (1, 0 for the plain IVD), K of dfc_vec_t. false: no
- * direction. */
+ * r_b = e^{-j phi_b} (NULL, NULL for the plain IVD: no turn), K of
+ * dfc_vec_t. false: no direction. */
 bool dfc_ivd_step(float zr, float zi, float p, const float k[4], const float rb[2],
                   const float ra[2], float *ur, float *ui);
 

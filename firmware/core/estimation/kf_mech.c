@@ -143,9 +143,3 @@ bool kf_mech_update_ekf(kf_mech_t *k, float g_al, float g_be, float a, float b, 
   p[P33] += w * c3 * c3;
   return true;
 }
-
-float kf_mech_r_speed(float r0, float m, float omega_f, float m2, float omega) {
-  const float w = fabsf(omega);
-  const float lin = w > omega_f ? m * (w - omega_f) : 0.0f;
-  return r0 + lin + m2 * w * w;
-}

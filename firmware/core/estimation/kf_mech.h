@@ -25,6 +25,7 @@
 #ifndef FD_ESTIMATION_KF_MECH_H
 #define FD_ESTIMATION_KF_MECH_H
 
+#include <math.h>
 #include <stdbool.h>
 
 typedef struct {
@@ -67,7 +68,12 @@ static inline float kf_mech_var_theta(const kf_mech_t *k) {
  * is kf_mech_predict's (the model is linear). */
 bool kf_mech_update_ekf(kf_mech_t *k, float g_al, float g_be, float a, float b, const float km[4],
                         float r);
-/* (4.42) and (4.43) in one: r0 + m max(|omega| - omega_f, 0) + m2 omega^2. */
-float kf_mech_r_speed(float r0, float m, float omega_f, float m2, float omega);
+/* (4.42) and (4.43) in one: r0 + m max(|omega| - omega_f, 0) + m2 omega^2
+ * (inline: every period's measurement variance, pos_track.c). */
+static inline float kf_mech_r_speed(float r0, float m, float omega_f, float m2, float omega) {
+  const float w = fabsf(omega);
+  const float lin = w > omega_f ? m * (w - omega_f) : 0.0f;
+  return r0 + lin + m2 * w * w;
+}
 
 #endif

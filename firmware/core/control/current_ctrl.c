@@ -46,8 +46,7 @@ dq_t current_ctrl_update(current_ctrl_t *cc, dq_t i_ref, dq_t i, float we, float
   return current_ctrl_step(cc, i_ref, i, machine_flux(cc->cfg.machine, i), we, v_max);
 }
 
-dq_t current_ctrl_step(current_ctrl_t *cc, dq_t i_ref, dq_t i, dq_t flux_i, float we,
-                       float v_max) {
+dq_t current_ctrl_step(current_ctrl_t *cc, dq_t i_ref, dq_t i, dq_t flux_i, float we, float v_max) {
   dq_t v = {0.0f, 0.0f};
   if (!(v_max > 0.0f) || !fd_isfinite(v_max)) {
     cc->limited = 1; /* no voltage available: output zero, keep integrators */

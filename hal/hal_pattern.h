@@ -64,16 +64,62 @@ HAL_PATTERN_INLINE float hal_pattern_round(float x, float n) {
   return (float)(uint32_t)(x * n + 0.5f) / n;
 }
 
+/* A leg's duty limited to the range (a NaN request: the middle). */
+HAL_PATTERN_INLINE float hal_pattern_limit(const hal_pattern_t *m, float on, float off) {
+  const float x = off - on;
+  if (!(x >= m->lo)) {
+    return x < m->lo ? m->lo : m->mid; /* NaN: the middle */
+  }
+  return x > m->hi ? m->hi : x;
+}
+
 /* A leg's duty as the timer makes it: limited to the range, rounded. */
 HAL_PATTERN_INLINE float hal_pattern_duty(const hal_pattern_t *m, float on, float off) {
-  const float x = off - on;
-  float d;
-  if (!(x >= m->lo)) {
-    d = x < m->lo ? m->lo : m->mid; /* NaN: the middle */
-  } else {
-    d = x > m->hi ? m->hi : x;
-  }
+  const float d = hal_pattern_limit(m, on, off);
   return m->counts != 0u ? hal_pattern_round(d, m->n) : d;
+}
+
+/* A leg of a timer with asymmetric edges: the edges as asked, the pulse
+ * limited from its end (2 counts per compare step of a centre-aligned
+ * timer); a pulse out of the period, centred. `rounded` is a constant at
+ * each call (m->counts != 0): two straight-through loops, not a test per
+ * leg. */
+HAL_PATTERN_INLINE void hal_pattern_asym_leg(const hal_pattern_t *m, float on, float off,
+                                             float *e_on, float *e_off, bool rounded) {
+  const float dl = hal_pattern_limit(m, on, off);
+  const float d = rounded ? hal_pattern_round(dl, m->n) : dl;
+  if (on >= 0.0f && off <= 1.0f) {
+    const float e = rounded ? hal_pattern_round(on, m->n2) : on;
+    *e_on = e;
+    *e_off = e + d;
+  } else {
+    *e_on = 0.5f * (1.0f - d);
+    *e_off = 0.5f * (1.0f + d);
+  }
+}
+
+/* The asymmetric edges' pattern: the timer and the request's edges in
+ * locals first (a store to *out could alias either, which would read them
+ * again per leg), then the legs straight through. */
+HAL_PATTERN_INLINE void hal_pattern_asym(const hal_pattern_t *m, const hal_pwm_t *p, hal_pwm_t *out,
+                                         bool rounded) {
+  const hal_pattern_t t = *m;
+  float on[3];
+  float off[3];
+#pragma GCC unroll 3
+  for (int x = 0; x < 3; ++x) {
+    on[x] = p->on[x];
+    off[x] = p->off[x];
+  }
+#pragma GCC unroll 3
+  for (int x = 0; x < 3; ++x) {
+    hal_pattern_asym_leg(&t, on[x], off[x], &on[x], &off[x], rounded);
+  }
+#pragma GCC unroll 3
+  for (int x = 0; x < 3; ++x) {
+    out->on[x] = on[x];
+    out->off[x] = off[x];
+  }
 }
 
 /* Every field of *out written; each leg of p read before its store. */
@@ -94,20 +140,11 @@ static inline void hal_pattern_apply(const hal_pattern_t *m, const hal_pwm_t *p,
     }
     return;
   }
-  for (int x = 0; x < 3; ++x) {
-    const float on = p->on[x];
-    const float off = p->off[x];
-    const float d = hal_pattern_duty(m, on, off);
-    if (on >= 0.0f && off <= 1.0f) {
-      /* the edges as asked, the pulse limited from its end; 2 counts per
-       * compare step of a centre-aligned timer */
-      const float e = m->counts != 0u ? hal_pattern_round(on, m->n2) : on;
-      out->on[x] = e;
-      out->off[x] = e + d;
-    } else {
-      out->on[x] = 0.5f * (1.0f - d);
-      out->off[x] = 0.5f * (1.0f + d);
-    }
+  /* asymmetric edges (the DFC window's timer): rounded or exact */
+  if (m->counts != 0u) {
+    hal_pattern_asym(m, p, out, true);
+  } else {
+    hal_pattern_asym(m, p, out, false);
   }
 }
 

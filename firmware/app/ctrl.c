@@ -1,7 +1,8 @@
 /*
  * ctrl.c - the law table and what every law shares: selection with the
  * gates off, the availability check, the applied-voltage memory and the
- * predictive dead-time compensation (Rubino 2020, Fig. 8).
+ * predictive dead-time compensation's setup (Rubino 2020, Fig. 8; its
+ * per-period delta is inline in ctrl.h).
  */
 #include "ctrl.h"
 
@@ -88,18 +89,4 @@ FD_COLD int ctrl_init(ctrl_t *c, const drive_config_t *cfg, const machine_t *mac
 
 void ctrl_reset(ctrl_t *c) {
   c->impl->reset(&c->st);
-}
-
-void ctrl_deadtime_delta(const ctrl_t *c, const ctrl_out_t *out, float delta[3]) {
-  /* mut: deadtime_comp_sign */
-  const abc_t i = frames_clarke_inv(out->i_pred);
-  /* all three before the first store: a store through delta could alias
-   * *c, and would make the compiler read i_band and dt_ratio again per phase */
-  const float r = c->dtc.dt_ratio;
-  const float sa = deadtime_comp_sign(&c->dtc, i.a);
-  const float sb = deadtime_comp_sign(&c->dtc, i.b);
-  const float sc = deadtime_comp_sign(&c->dtc, i.c);
-  delta[0] = r * sa;
-  delta[1] = r * sb;
-  delta[2] = r * sc;
 }

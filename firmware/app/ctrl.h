@@ -151,7 +151,20 @@ static inline void ctrl_step(ctrl_t *c, const ctrl_in_t *in, ctrl_out_t *out) {
 }
 /* Predictive dead-time compensation (Rubino 2020, Fig. 8) with the
  * currents the law expects over the period the duties act: the duty
- * change it adds per phase. */
-void ctrl_deadtime_delta(const ctrl_t *c, const ctrl_out_t *out, float delta[3]);
+ * change it adds per phase. Inline (one caller, the ISR's run path): no
+ * call, and the deltas stay in registers on their way to the duties. */
+static inline void ctrl_deadtime_delta(const ctrl_t *c, const ctrl_out_t *out, float delta[3]) {
+  /* mut: deadtime_comp_sign */
+  const abc_t i = frames_clarke_inv(out->i_pred);
+  /* all three before the first store: a store through delta could alias
+   * *c, and would make the compiler read i_band and dt_ratio again per phase */
+  const float r = c->dtc.dt_ratio;
+  const float sa = deadtime_comp_sign(&c->dtc, i.a);
+  const float sb = deadtime_comp_sign(&c->dtc, i.b);
+  const float sc = deadtime_comp_sign(&c->dtc, i.c);
+  delta[0] = r * sa;
+  delta[1] = r * sb;
+  delta[2] = r * sc;
+}
 
 #endif

@@ -563,21 +563,28 @@ static ab_t drive_write(drive_t *drv, const float duty[3], const float dtc[3], f
   /* the correction may not take a leg out of the board's range: the drive
    * asks only for what the board can do (the HAL would clamp the same) */
   float dc[3];
-  hal_pwm_t req;     /* centred pulses (hal_pwm_centred), built in the same loop */
+  const float lo = drv->duty_lo;
+  const float hi = drv->duty_hi;
 #pragma GCC unroll 3 /* -Os keeps loops: three legs straight through save their overhead */
   for (int x = 0; x < 3; ++x) {
-    dc[x] = fd_clampf(duty[x] + dtc[x], drv->duty_lo, drv->duty_hi);
-    req.on[x] = 0.5f - 0.5f * dc[x];
-    req.off[x] = 0.5f + 0.5f * dc[x];
+    dc[x] = fd_clampf(duty[x] + dtc[x], lo, hi);
   }
-  req.test_vector = 0u;
-  req.n_star = 0u;
-  req.t_star_req[0] = 0.0f;
-  req.t_star_req[1] = 0.0f;
+  hal_pwm_t req;
   /* mut: held_start_pulses_windowed */
   const bool window = drv->gated && !drv->plain;
   if (window) {
-    drive_window_pattern(drv, dc, &req);
+    drive_window_pattern(drv, dc, &req); /* every field of req */
+  } else {
+    /* centred pulses (hal_pwm_centred) */
+#pragma GCC unroll 3
+    for (int x = 0; x < 3; ++x) {
+      req.on[x] = 0.5f - 0.5f * dc[x];
+      req.off[x] = 0.5f + 0.5f * dc[x];
+    }
+    req.test_vector = 0u;
+    req.n_star = 0u;
+    req.t_star_req[0] = 0.0f;
+    req.t_star_req[1] = 0.0f;
   }
   hal_pwm_t got;
   hal_pwm_write(&req, &got);

@@ -53,6 +53,7 @@ static void foc_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *i
   const float i_max = su->cfg->i_max;
   const sincos_t sc = frames_sincos(in->theta_e);
   const dq_t i = frames_park(in->i_ab, sc);
+  out->i_dq = i;
   const float t_lim = fd_minf(su->cfg->torque_max, s->foc.t_mtpa_max);
   dq_t i_ref;
   if (in->current) {
@@ -65,17 +66,34 @@ static void foc_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *i
     i_ref.d *= i_max / mag;
     i_ref.q *= i_max / mag;
   }
-  const float v_max = su->cfg->v_margin * in->v_lin;
-  const dq_t v = current_ctrl_update(&s->foc.cc, i_ref, i, in->omega_e, v_max);
-  const sincos_t sc_next = frames_sincos(in->theta_e + in->omega_e * su->t_out);
-  out->v_ref = frames_park_inv(v, sc_next);
-  out->i_dq = i;
-  /* Expected current over the next period: the reference (the loop tracks
-   * it), rotated to the centre of that period. */
-  out->i_pred = frames_park_inv(i_ref, sc_next);
-  out->fault = 0u;
-  const dq_t flux = machine_flux(m, i); /* one lookup for both (a map's is not free) */
+  /* one model evaluation for the torque, the telemetry and the loop's
+   * feed-forward; what only reports is done before the calls below, so
+   * that the fewest values live across them */
+  const dq_t flux = machine_flux(m, i);
   const float t_now = 1.5f * m->pole_pairs * (flux.d * i.q - flux.q * i.d);
+  /* every field written (no zero-fill call in the ISR): FOC has no flux
+   * loop, load angle or observer */
+  ctrl_telemetry_t *tm = out->tm; /* where the drive publishes it */
+  tm->flux = sqrtf(flux.d * flux.d + flux.q * flux.q);
+  tm->flux_ref = 0.0f;
+  tm->delta = 0.0f;
+  tm->lam_d = 0.0f;
+  tm->lam_q = 0.0f;
+  tm->delta_lazy = false;
+  tm->i_ds = 0.0f;
+  tm->i_qs = 0.0f;
+  tm->i_qs_ref = 0.0f;
+  tm->torque = t_now;
+  tm->obs_err = 0.0f;
+  /* The voltage acts over the next period: the angle at its centre. The
+   * current expected over it is the reference (the loop tracks it), rotated
+   * there. */
+  const sincos_t sc_next = frames_sincos(in->theta_e + in->omega_e * su->t_out);
+  out->i_pred = frames_park_inv(i_ref, sc_next);
+  const float v_max = su->cfg->v_margin * in->v_lin;
+  const dq_t v = current_ctrl_step(&s->foc.cc, i_ref, i, flux, in->omega_e, v_max);
+  out->v_ref = frames_park_inv(v, sc_next);
+  out->fault = 0u;
   /* The torque deliverable now. On the voltage limit (the current loop's
    * output on the circle v_margin v_lin: a DC-link sag, a speed beyond what
    * the voltage allows) the present current's torque is all the voltage
@@ -93,20 +111,6 @@ static void foc_step(ctrl_state_t *s, const ctrl_setup_t *su, const ctrl_in_t *i
       out->torque_min = fd_clampf(t_now, -t_lim, 0.0f);
     }
   }
-  /* every field written (no zero-fill call in the ISR): FOC has no flux
-   * loop, load angle or observer */
-  ctrl_telemetry_t *tm = out->tm; /* where the drive publishes it */
-  tm->flux = sqrtf(flux.d * flux.d + flux.q * flux.q);
-  tm->flux_ref = 0.0f;
-  tm->delta = 0.0f;
-  tm->lam_d = 0.0f;
-  tm->lam_q = 0.0f;
-  tm->delta_lazy = false;
-  tm->i_ds = 0.0f;
-  tm->i_qs = 0.0f;
-  tm->i_qs_ref = 0.0f;
-  tm->torque = t_now;
-  tm->obs_err = 0.0f;
 }
 
 const ctrl_law_t ctrl_law_foc = {"foc",     CTRL_CAP_CURRENT, foc_check, foc_init,

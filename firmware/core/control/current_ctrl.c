@@ -43,6 +43,10 @@ void current_ctrl_reset(current_ctrl_t *cc) {
 }
 
 dq_t current_ctrl_update(current_ctrl_t *cc, dq_t i_ref, dq_t i, float we, float v_max) {
+  return current_ctrl_step(cc, i_ref, i, machine_flux(cc->cfg.machine, i), we, v_max);
+}
+
+dq_t current_ctrl_step(current_ctrl_t *cc, dq_t i_ref, dq_t i, dq_t flux_i, float we, float v_max) {
   dq_t v = {0.0f, 0.0f};
   if (!(v_max > 0.0f) || !fd_isfinite(v_max)) {
     cc->limited = 1; /* no voltage available: output zero, keep integrators */
@@ -51,6 +55,12 @@ dq_t current_ctrl_update(current_ctrl_t *cc, dq_t i_ref, dq_t i, float we, float
   if (!fd_isfinite(we)) {
     we = 0.0f;
   }
+  /* the errors and the decoupling feed-forward first (what the map's call
+   * below would otherwise keep on the stack): v = Rs i + L di/dt + we J lambda(i) */
+  const float e_d = i_ref.d - i.d;
+  const float e_q = i_ref.q - i.q;
+  const float ff_d = -we * flux_i.q;
+  const float ff_q = we * flux_i.d;
   const machine_t *m = cc->cfg.machine;
   /* mut: foc_map_constant_gains */
   if (m->kind == MACHINE_FLUX_MAP) {
@@ -59,17 +69,14 @@ dq_t current_ctrl_update(current_ctrl_t *cc, dq_t i_ref, dq_t i, float we, float
     /* mut: foc_map_q_gain */
     cc->pi_q.kp = cc->cfg.bandwidth * l.qq;
   }
-  /* decoupling feed-forward: v = Rs i + L di/dt + we J lambda(i) */
-  const dq_t flux = machine_flux(m, i);
-  const float ff_d = -we * flux.q;
-  const float ff_q = we * flux.d;
 
-  pi_ctrl_set_limits(&cc->pi_d, -v_max, v_max);
-  v.d = pi_ctrl_update(&cc->pi_d, i_ref.d - i.d, ff_d);
+  /* symmetric limits, v_max finite and > 0 (above) and vq_max finite and
+   * >= 0 (a NaN room gives 0): the PI's limit checks cannot fire, so the
+   * limits are stored and the step runs inline (pi_ctrl_update_sym) */
+  v.d = pi_ctrl_update_sym(&cc->pi_d, e_d, ff_d, v_max);
   const float vq_room_sq = v_max * v_max - v.d * v.d;
   const float vq_max = (vq_room_sq > 0.0f) ? sqrtf(vq_room_sq) : 0.0f;
-  pi_ctrl_set_limits(&cc->pi_q, -vq_max, vq_max);
-  v.q = pi_ctrl_update(&cc->pi_q, i_ref.q - i.q, ff_q);
+  v.q = pi_ctrl_update_sym(&cc->pi_q, e_q, ff_q, vq_max);
 
   cc->limited = (fabsf(v.d) >= v_max || fabsf(v.q) >= vq_max) ? 1 : 0;
   return v;

@@ -32,5 +32,9 @@ void current_ctrl_reset(current_ctrl_t *cc);
 /* i_ref, i: dq currents [A]; we: electrical speed [rad/s]; v_max: available
  * voltage amplitude [V]. Returns the dq voltage reference, |v| <= v_max. */
 dq_t current_ctrl_update(current_ctrl_t *cc, dq_t i_ref, dq_t i, float we, float v_max);
+/* current_ctrl_update with the flux linkage at the measured current,
+ * flux_i = machine_flux(machine, i), given by a caller that needs it too
+ * (law_foc's torque estimate: one model evaluation per period, not two). */
+dq_t current_ctrl_step(current_ctrl_t *cc, dq_t i_ref, dq_t i, dq_t flux_i, float we, float v_max);
 
 #endif

@@ -12,16 +12,14 @@
  *    error reverses; a large proportional term in the direction of the limit
  *    never drags the integral away (that would leave a long tail once the
  *    error shrinks), it only caps it at the limit minus the feed-forward.
+ * The step itself is pi_ctrl_step (pi_ctrl.h), inline for the current
+ * loop's symmetric limits (pi_ctrl_update_sym).
  */
 #include "math/pi_ctrl.h"
 
 #include <math.h>
 
 #include "math/fd_math.h"
-
-static float pi_clamp(float x, float lo, float hi) {
-  return (x > hi) ? hi : ((x < lo) ? lo : x);
-}
 
 void pi_ctrl_init(pi_ctrl_t *pi, float kp, float ki, float ts, float out_min, float out_max) {
   pi->kp = kp;
@@ -35,7 +33,7 @@ void pi_ctrl_init(pi_ctrl_t *pi, float kp, float ki, float ts, float out_min, fl
 
 /* Preset the integral (bumpless transfer: output = integ at zero error). */
 void pi_ctrl_reset(pi_ctrl_t *pi, float integ) {
-  pi->integ = fd_isfinite(integ) ? pi_clamp(integ, pi->out_min, pi->out_max) : 0.0f;
+  pi->integ = fd_isfinite(integ) ? pi_ctrl_clamp(integ, pi->out_min, pi->out_max) : 0.0f;
 }
 
 /* NaN limits are ignored (previous kept); crossed limits collapse to their
@@ -54,31 +52,5 @@ void pi_ctrl_set_limits(pi_ctrl_t *pi, float out_min, float out_max) {
 }
 
 float pi_ctrl_update(pi_ctrl_t *pi, float err, float ff) {
-  if (!fd_isfinite(err)) {
-    err = 0.0f; /* hold the integral, no proportional kick */
-  }
-  if (!fd_isfinite(ff)) {
-    ff = 0.0f;
-  }
-  const float p = pi->kp * err;
-  const float i_old = pi->integ;
-  float integ = i_old + pi->ki * pi->ts * err;
-  /* 1. conditional integration */
-  const float to_max = pi->out_max - p - ff; /* integral that puts u on out_max */
-  const float to_min = pi->out_min - p - ff;
-  if (err > 0.0f && integ > to_max) {
-    const float cap = (i_old > to_max) ? i_old : to_max;
-    integ = (integ < cap) ? integ : cap;
-  } else if (err < 0.0f && integ < to_min) {
-    const float cap = (i_old < to_min) ? i_old : to_min;
-    integ = (integ > cap) ? integ : cap;
-  }
-  /* 2. back-calculation: re-align against the limits */
-  const float hi = pi->out_max - ff - ((p < 0.0f) ? p : 0.0f);
-  const float lo = pi->out_min - ff - ((p > 0.0f) ? p : 0.0f);
-  integ = pi_clamp(integ, lo, hi);
-  if (fd_isfinite(integ)) {
-    pi->integ = integ;
-  }
-  return pi_clamp(p + pi->integ + ff, pi->out_min, pi->out_max);
+  return pi_ctrl_step(pi, err, ff, pi->out_min, pi->out_max);
 }

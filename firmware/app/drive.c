@@ -736,6 +736,8 @@ static const drive_slow_row_t drive_slow_rows[] = {
  * the rates of the previous slow_div periods): the rows whose phase this
  * ISR is. */
 static void drive_schedule(drive_t *drv) {
+  /* the position check's window: the last period's voltage, every ISR */
+  protect_pos_integrate(&drv->pos_chk, drv->tm.v_ab_applied);
   /* the usual ISR: no row, a count down to the next phase instead of a
    * division of the ISR count (issue 24 point 8) */
   if (drv->slow_wait > 1u) {

@@ -726,10 +726,11 @@ static void drive_torque_row(drive_t *drv, bool due) {
  * slow_div < 3: MID, NEXT, START). The phases split the slow work so that
  * the worst-case ISR does not carry it all: the speed loop and its
  * run-away check, the current-sum check at the start, the speed loop's
- * torque to the law (and the law's work on it) in the next ISR, the
- * position check (one sine, one model evaluation) and the overrun check
- * half a slow period later (issue 24 point 8: out of the speed loop's ISR,
- * the worst). The current-sum check stays at the start: it samples one
+ * torque to the law (and the law's work on it) and the overrun check in
+ * the next ISR, the position check (one sine, one model evaluation) half a
+ * slow period later (issue 24 point 8: the overrun check out of the speed
+ * loop's ISR, the worst with FOC, and out of the position check's, the
+ * worst with DFVC on an encoder). The current-sum check stays at the start: it samples one
  * period a slow period, and at another place in the slow period its trip
  * in sil/test_adc_faults (a channel stuck at 0 at 0.2 N m) came at
  * 25.5 ms, not 11 ms (the samples fall elsewhere on the currents' wave). A new slow check is one
@@ -746,8 +747,8 @@ typedef struct {
 
 static const drive_slow_row_t drive_slow_rows[] = {
     {"pos_check", DRIVE_PHASE_MID, DRIVE_POS_CHECK_DIV, drive_pos_check_row},
-    {"overrun", DRIVE_PHASE_MID, 1u, drive_overrun_row},
     {"torque_ref", DRIVE_PHASE_NEXT, 1u, drive_torque_row},
+    {"overrun", DRIVE_PHASE_NEXT, 1u, drive_overrun_row},
     {"current_sum", DRIVE_PHASE_START, 1u, drive_isum_row},
     {"speed_loop", DRIVE_PHASE_START, 1u, drive_speed_row},
 };

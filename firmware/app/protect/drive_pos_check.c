@@ -65,8 +65,10 @@
  * the window's end is t_out - Ts/2 after the last period's sample (the
  * model's flux and current turned there by w_e (t_out - Ts/2)) and the
  * last summed voltage, which acts after it, opens the next window. One
- * sine/cosine and one model evaluation per check (two sines in the
- * fallback).
+ * sine/cosine and one model evaluation per check (the derivative form:
+ * the sine at the last voltage's centre, t_out after its sample); the form
+ * is chosen on the window's turn at the check's speed, and a change of
+ * form starts a new window (no test).
  */
 #include "protect/drive_pos_check.h"
 
@@ -96,51 +98,61 @@ uint32_t protect_pos_step(protect_pos_t *p, const protect_pos_view_t *v) {
   const float w = v->omega_e;
   const float ts = v->ts;
   const dq_t i = v->i_dq;
-  /* the window's end (the model's flux and current turned there) */
+  /* the form: the integral one up to POS_TURN_MAX per window */
+  const bool integral = fabsf(w) * (float)v->periods * ts <= POS_TURN_MAX;
+  /* the angle: the window's end (integral form: the model's flux and
+   * current turned there) or the last voltage's centre (derivative form) */
+  const float tau = integral ? v->t_out - 0.5f * ts : v->t_out;
   sincos_t sc;
   /* mut: pos_check_emf_sign */
-  fd_sincosf(v->theta_e + w * (v->t_out - 0.5f * ts), &sc.s, &sc.c);
+  fd_sincosf(v->theta_e + w * tau, &sc.s, &sc.c);
   const dq_t psi = machine_flux(v->machine, i);
-  const ab_t psi_ab = frames_park_inv(psi, sc);
-  const ab_t pm_ab = frames_park_inv(v->psi0, sc);
-  const ab_t i_ab = frames_park_inv(i, sc);
   const float i_abs = sqrtf(i.d * i.d + i.q * i.q);
-  /* the window: the sums before the last voltage (it opens the next) */
-  const bool window = p->psi_ok && p->v_n > 1u;
+  /* the window: the sums before the last voltage (it opens the next), on
+   * a start taken in the same form; its changes are read before the end
+   * becomes the next window's start */
+  const bool window = p->psi_ok && p->v_n > 1u && p->ab_ok == integral;
   const float t_win = (float)(p->v_n - 1u) * ts;
-  const ab_t sum = {p->v_sum.alpha - v->v_ab.alpha, p->v_sum.beta - v->v_ab.beta};
-  const protect_pos_t start = *p;
-  p->v_sum = v->v_ab;
-  p->v_n = 1u;
-  p->psi = psi;
-  p->psi_ab = psi_ab;
-  p->psi_pm_ab = pm_ab;
-  p->i_ab = i_ab;
-  p->i_abs = i_abs;
-  p->psi_ok = true;
-  if (!window) {
-    return 0u;
-  }
   const float inv_t = 1.0f / t_win;
+  const dq_t dpsi_dq = {psi.d - p->psi.d, psi.q - p->psi.q};
+  p->psi = psi;
+  p->psi_ok = true;
+  p->ab_ok = integral;
   float rd, rq, emf, ir;
-  if (fabsf(w) * t_win <= POS_TURN_MAX) {
-    /* the integral form, stator frame: (rd, rq) = (alpha, beta) */
-    rd = (sum.alpha * ts - (psi_ab.alpha - start.psi_ab.alpha)) * inv_t -
-         0.5f * v->rs * (i_ab.alpha + start.i_ab.alpha);
-    rq = (sum.beta * ts - (psi_ab.beta - start.psi_ab.beta)) * inv_t -
-         0.5f * v->rs * (i_ab.beta + start.i_ab.beta);
-    const ab_t dpm = {pm_ab.alpha - start.psi_pm_ab.alpha, pm_ab.beta - start.psi_pm_ab.beta};
-    const ab_t dpi = {psi_ab.alpha - pm_ab.alpha - (start.psi_ab.alpha - start.psi_pm_ab.alpha),
-                      psi_ab.beta - pm_ab.beta - (start.psi_ab.beta - start.psi_pm_ab.beta)};
+  if (integral) {
+    /* the flux's two parts, the magnet's and the currents', turned */
+    const ab_t pm_ab = frames_park_inv(v->psi0, sc);
+    const ab_t pi_ab = frames_park_inv((dq_t){psi.d - v->psi0.d, psi.q - v->psi0.q}, sc);
+    const ab_t i_ab = frames_park_inv(i, sc);
+    const ab_t sum = {p->v_sum.alpha - v->v_ab.alpha, p->v_sum.beta - v->v_ab.beta};
+    const ab_t dpm = {pm_ab.alpha - p->psi_pm_ab.alpha, pm_ab.beta - p->psi_pm_ab.beta};
+    const ab_t dpi = {pi_ab.alpha - p->psi_i_ab.alpha, pi_ab.beta - p->psi_i_ab.beta};
+    const ab_t i2 = {i_ab.alpha + p->i_ab.alpha, i_ab.beta + p->i_ab.beta};
+    const float i_abs2 = i_abs + p->i_abs;
+    p->v_sum = v->v_ab;
+    p->v_n = 1u;
+    p->psi_pm_ab = pm_ab;
+    p->psi_i_ab = pi_ab;
+    p->i_ab = i_ab;
+    p->i_abs = i_abs;
+    if (!window) {
+      return 0u;
+    }
+    /* stator frame: (rd, rq) = (alpha, beta) */
+    rd = (sum.alpha * ts - (dpm.alpha + dpi.alpha)) * inv_t - 0.5f * v->rs * i2.alpha;
+    rq = (sum.beta * ts - (dpm.beta + dpi.beta)) * inv_t - 0.5f * v->rs * i2.beta;
     emf = (ab_abs(dpm) + ab_abs(dpi)) * inv_t;
-    ir = 0.5f * v->rs * (i_abs + start.i_abs);
+    ir = 0.5f * v->rs * i_abs2;
   } else {
     /* the derivative form, the source's rotor frame: the last voltage
-     * acts around t_out after the sample, w_e Ts / 2 past the window's end */
-    sincos_t half;
-    fd_sincosf(0.5f * w * ts, &half.s, &half.c);
-    const dq_t u = frames_park(v->v_ab, frames_sincos_add(sc, half));
-    const dq_t dpsi = {(psi.d - start.psi.d) * inv_t, (psi.q - start.psi.q) * inv_t};
+     * around t_out after the sample */
+    p->v_sum = v->v_ab;
+    p->v_n = 1u;
+    if (!window) {
+      return 0u;
+    }
+    const dq_t u = frames_park(v->v_ab, sc);
+    const dq_t dpsi = {dpsi_dq.d * inv_t, dpsi_dq.q * inv_t};
     rd = u.d - (v->rs * i.d + dpsi.d - w * psi.q);
     rq = u.q - (v->rs * i.q + dpsi.q + w * psi.d);
     const float pd = psi.d - v->psi0.d, pq = psi.q - v->psi0.q;

@@ -20,10 +20,12 @@ typedef struct {
   float res;      /* residual / tolerance at the last check (logs: drive_t.pos_emf_res) */
   dq_t psi;       /* the model flux at the last check [Vs] */
   bool psi_ok;    /* ... taken in this run (and the window's start below) */
+  bool ab_ok;     /* ... in the integral form (the start below taken) */
   ab_t v_sum;     /* the applied voltages summed since the window's start [V] */
   uint32_t v_n;   /* ... how many */
-  ab_t psi_ab;    /* the window's start: the model flux turned to the stator frame [Vs] */
-  ab_t psi_pm_ab; /* ... its magnet part (the flux at zero current) [Vs] */
+  ab_t psi_pm_ab; /* the window's start: the model flux's magnet part (the flux at zero
+                     current) turned to the stator frame [Vs] */
+  ab_t psi_i_ab;  /* ... its currents' part [Vs] */
   ab_t i_ab;      /* ... the current [A] */
   float i_abs;    /* ... |i| [A] */
 } protect_pos_t;

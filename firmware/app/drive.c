@@ -758,8 +758,6 @@ static const drive_slow_row_t drive_slow_rows[] = {
  * the rates of the previous slow_div periods): the rows whose phase this
  * ISR is. */
 static void drive_schedule(drive_t *drv) {
-  /* the position check's window: the last period's voltage, every ISR */
-  protect_pos_integrate(&drv->pos_chk, drv->tm.v_ab_applied);
   /* the usual ISR: no row, a count down to the next phase instead of a
    * division of the ISR count (issue 24 point 8) */
   if (drv->slow_wait > 1u) {
@@ -984,6 +982,7 @@ static void drive_publish(drive_t *drv, const hal_sample_t *s, const float i[3])
   tm->i_abc[2] = i[2];
   tm->v_ab_applied[0] = drv->v_applied.alpha;
   tm->v_ab_applied[1] = drv->v_applied.beta;
+  protect_pos_integrate(&drv->pos_chk, drv->v_applied); /* the position check's window */
   tm->v_ab_filt[0] += DRIVE_VF_K * (drv->v_applied.alpha - tm->v_ab_filt[0]);
   tm->v_ab_filt[1] += DRIVE_VF_K * (drv->v_applied.beta - tm->v_ab_filt[1]);
   tm->omega_m = drv->omega_m;

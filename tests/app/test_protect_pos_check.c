@@ -99,8 +99,7 @@ static uint32_t one_check(protect_pos_t *p, sim_t *s, protect_pos_view_t v) {
     const ab_t err = frames_park_inv((dq_t){s->dv_d, 0.0f}, (sincos_t){sinf(th), cosf(th)});
     v_ab.alpha = (p1.alpha - p0.alpha) / v.ts + 0.5f * v.rs * (i0.alpha + i1.alpha) + err.alpha;
     v_ab.beta = (p1.beta - p0.beta) / v.ts + 0.5f * v.rs * (i0.beta + i1.beta) + err.beta;
-    const float vf[2] = {v_ab.alpha, v_ab.beta};
-    protect_pos_integrate(p, vf);
+    protect_pos_integrate(p, v_ab);
   }
   v.theta_e = frames_wrap_pi(v.omega_e * (float)(s->m - 1) * v.ts);
   v.i_dq = current_at(s->m - 1, s->step);

@@ -57,10 +57,14 @@
  * table, drive.c: the ISR cost). Only in run, and only for sources that
  * measure with the gates off (the encoder): the star-point sources are
  * themselves voltage measurements, checked by their own prediction
- * (pos_err_max). The first check of a run starts the window (no test).
+ * (pos_err_max). The first check of a run starts the window (no test);
+ * a window is the `periods` ISRs between two checks (after a live change
+ * of slow_div the first one is not: one count at most, of the 8 that
+ * trip).
  *
- * The window: protect_pos_integrate sums the last period's applied
- * voltage every ISR before this row; the voltage computed at sample k
+ * The window: protect_pos_integrate sums the applied voltage every ISR
+ * (the drive's publication, after the law; this row runs before it, so at
+ * a check the sum ends with the last period's voltage); the voltage computed at sample k
  * acts from t_k + t_out - Ts/2 to t_k + t_out + Ts/2 (drive_t_out), so
  * the window's end is t_out - Ts/2 after the last period's sample (the
  * model's flux and current turned there by w_e (t_out - Ts/2)) and the
@@ -111,8 +115,8 @@ uint32_t protect_pos_step(protect_pos_t *p, const protect_pos_view_t *v) {
   /* the window: the sums before the last voltage (it opens the next), on
    * a start taken in the same form; its changes are read before the end
    * becomes the next window's start */
-  const bool window = p->psi_ok && p->v_n > 1u && p->ab_ok == integral;
-  const float t_win = (float)(p->v_n - 1u) * ts;
+  const bool window = p->psi_ok && p->ab_ok == integral;
+  const float t_win = (float)v->periods * ts;
   const float inv_t = 1.0f / t_win;
   const dq_t dpsi_dq = {psi.d - p->psi.d, psi.q - p->psi.q};
   p->psi = psi;
@@ -130,7 +134,6 @@ uint32_t protect_pos_step(protect_pos_t *p, const protect_pos_view_t *v) {
     const ab_t i2 = {i_ab.alpha + p->i_ab.alpha, i_ab.beta + p->i_ab.beta};
     const float i_abs2 = i_abs + p->i_abs;
     p->v_sum = v->v_ab;
-    p->v_n = 1u;
     p->psi_pm_ab = pm_ab;
     p->psi_i_ab = pi_ab;
     p->i_ab = i_ab;
@@ -147,7 +150,6 @@ uint32_t protect_pos_step(protect_pos_t *p, const protect_pos_view_t *v) {
     /* the derivative form, the source's rotor frame: the last voltage
      * around t_out after the sample */
     p->v_sum = v->v_ab;
-    p->v_n = 1u;
     if (!window) {
       return 0u;
     }

@@ -22,7 +22,6 @@ typedef struct {
   bool psi_ok;    /* ... taken in this run (and the window's start below) */
   bool ab_ok;     /* ... in the integral form (the start below taken) */
   ab_t v_sum;     /* the applied voltages summed since the window's start [V] */
-  uint32_t v_n;   /* ... how many */
   ab_t psi_pm_ab; /* the window's start: the model flux's magnet part (the flux at zero
                      current) turned to the stator frame [Vs] */
   ab_t psi_i_ab;  /* ... its currents' part [Vs] */
@@ -30,12 +29,12 @@ typedef struct {
   float i_abs;    /* ... |i| [A] */
 } protect_pos_t;
 
-/* Every ISR, before the check's row (drive_schedule): the last period's
- * applied voltage into the window's sum (drive_pos_check.c). Two adds. */
-static inline void protect_pos_integrate(protect_pos_t *p, const float v_ab[2]) {
-  p->v_sum.alpha += v_ab[0];
-  p->v_sum.beta += v_ab[1];
-  p->v_n++;
+/* Every ISR, where the drive publishes the voltage it will apply
+ * (drive_publish): into the window's sum (drive_pos_check.c). Two adds;
+ * the window is the `periods` ISRs between two checks. */
+static inline void protect_pos_integrate(protect_pos_t *p, ab_t v_ab) {
+  p->v_sum.alpha += v_ab.alpha;
+  p->v_sum.beta += v_ab.beta;
 }
 
 /* What the check reads (filled by drive.c, on the telemetry of the last
@@ -45,7 +44,8 @@ typedef struct {
                                with the gates off (not a star-point one), pos_emf_tol > 0
                                and the last DC link finite: otherwise the check restarts */
   bool due;                 /* this slow period is one of the check's (the schedule's divider) */
-  uint32_t periods;         /* ISR periods between two checks (the leaky count's time) */
+  uint32_t periods;         /* ISR periods between two checks (the window; the leaky
+                               count's time) */
   float omega_e;            /* the source's speed [rad/s electrical] */
   float theta_e;            /* the angle at the last period's sample [rad] */
   dq_t i_dq;                /* the last period's rotor-frame currents [A] */

@@ -20,6 +20,7 @@ typedef struct {
   double *iamp_meas, *delta_est, *torque_est, *torque_ref, *flux_est, *flux_ref, *obs_err;
   double *flux, *delta, *theta_err; /* true flux amplitude, load angle, used - true angle */
   double *duty_max;                 /* largest duty of the pattern the HAL applies */
+  double *pos_res;                  /* the position check's residual / tolerance (its last check) */
   unsigned *faults, *state, *gates, *lc_cause;
   unsigned *asc; /* active short circuit over [t_k, t_k+1) */
 } trace_t;
@@ -56,6 +57,7 @@ static inline void trace_observer(void *user, const sil_step_t *st) {
   tr->theta_err[k] = remainder(tm->theta_e - p->theta_e, 2.0 * 3.14159265358979323846);
   tr->lc_cause[k] = tm->lc_cause;
   tr->duty_max[k] = fmax(tm->duty[0], fmax(tm->duty[1], tm->duty[2]));
+  tr->pos_res[k] = st->drive->pos_emf_res;
   tr->faults[k] = st->drive->faults;
   tr->state[k] = st->drive->state;
   tr->gates[k] = st->gates_on;
@@ -69,7 +71,7 @@ static inline void trace_alloc(trace_t *tr, size_t cap) {
                   &tr->v_dc,      &tr->imax_abs,  &tr->speed_ref, &tr->v_dc_meas,  &tr->imax_meas,
                   &tr->speed_est, &tr->iamp_meas, &tr->delta_est, &tr->torque_est, &tr->torque_ref,
                   &tr->flux_est,  &tr->flux_ref,  &tr->obs_err,   &tr->flux,       &tr->delta,
-                  &tr->theta_err, &tr->duty_max};
+                  &tr->theta_err, &tr->duty_max,  &tr->pos_res};
   for (size_t i = 0; i < sizeof d / sizeof d[0]; ++i) {
     *d[i] = calloc(cap, sizeof(double));
   }
@@ -84,7 +86,7 @@ static inline void trace_free(trace_t *tr) {
                  tr->v_dc,      tr->imax_abs,  tr->speed_ref, tr->v_dc_meas,  tr->imax_meas,
                  tr->speed_est, tr->iamp_meas, tr->delta_est, tr->torque_est, tr->torque_ref,
                  tr->flux_est,  tr->flux_ref,  tr->obs_err,   tr->flux,       tr->delta,
-                 tr->theta_err, tr->duty_max};
+                 tr->theta_err, tr->duty_max,  tr->pos_res};
   for (size_t i = 0; i < sizeof d / sizeof d[0]; ++i) {
     free(d[i]);
   }

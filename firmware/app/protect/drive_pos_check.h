@@ -16,11 +16,26 @@
 #include "model/machine.h"
 
 typedef struct {
-  int32_t n;   /* the leaky count */
-  float res;   /* residual / tolerance at the last check (logs: drive_t.pos_emf_res) */
-  dq_t psi;    /* the model flux at the last check [Vs] */
-  bool psi_ok; /* ... taken in this run */
+  int32_t n;      /* the leaky count */
+  float res;      /* residual / tolerance at the last check (logs: drive_t.pos_emf_res) */
+  dq_t psi;       /* the model flux at the last check [Vs] */
+  bool psi_ok;    /* ... taken in this run (and the window's start below) */
+  bool ab_ok;     /* ... in the integral form (the start below taken) */
+  ab_t v_sum;     /* the applied voltages summed since the window's start [V] */
+  ab_t psi_pm_ab; /* the window's start: the model flux's magnet part (the flux at zero
+                     current) turned to the stator frame [Vs] */
+  ab_t psi_i_ab;  /* ... its currents' part [Vs] */
+  ab_t i_ab;      /* ... the current [A] */
+  float i_abs;    /* ... |i| [A] */
 } protect_pos_t;
+
+/* Every ISR, where the drive publishes the voltage it will apply
+ * (drive_publish): into the window's sum (drive_pos_check.c). Two adds;
+ * the window is the `periods` ISRs between two checks. */
+static inline void protect_pos_integrate(protect_pos_t *p, ab_t v_ab) {
+  p->v_sum.alpha += v_ab.alpha;
+  p->v_sum.beta += v_ab.beta;
+}
 
 /* What the check reads (filled by drive.c, on the telemetry of the last
  * period and the source's speed). */
@@ -29,11 +44,13 @@ typedef struct {
                                with the gates off (not a star-point one), pos_emf_tol > 0
                                and the last DC link finite: otherwise the check restarts */
   bool due;                 /* this slow period is one of the check's (the schedule's divider) */
-  uint32_t periods;         /* ISR periods between two checks */
+  uint32_t periods;         /* ISR periods between two checks (the window; the leaky
+                               count's time) */
   float omega_e;            /* the source's speed [rad/s electrical] */
   float theta_e;            /* the angle at the last period's sample [rad] */
   dq_t i_dq;                /* the last period's rotor-frame currents [A] */
-  ab_t v_ab;                /* the voltage applied after that sample [V] */
+  ab_t v_ab;                /* the voltage applied after that sample [V] (the last one
+                               protect_pos_integrate summed) */
   float v_dc;               /* [V] */
   float t_out;              /* from the sample to the output's centre (1.5 Ts - t_i) [s] */
   float ts;                 /* [s] */
@@ -45,8 +62,8 @@ typedef struct {
 } protect_pos_view_t;
 
 /* Once per slow period (the drive's schedule table), before the position
- * source's update. Returns DRIVE_FAULT_POSITION when the check trips,
- * else 0. */
+ * source's update, after protect_pos_integrate of the period. Returns DRIVE_FAULT_POSITION when the
+ * check trips, else 0. */
 uint32_t protect_pos_step(protect_pos_t *p, const protect_pos_view_t *v);
 
 #endif

@@ -90,7 +90,7 @@
   X(121, asc_hold,      F32,  "s",      0.05f,       1e-3f,   10.0f,    LIVE, "controller.asc_hold",       \
     "safe state: shortest active short circuit (its current transient decays before the speed is judged from the current vector)") \
   X(122, pos_emf_tol,   F32,  "",       0.5f,        0.0f,    10.0f,    LIVE, "controller.pos_emf_tol",    \
-    "position plausibility (encoder): trips position when the applied voltage differs from the model's at the source's angle by more than pos_emf_tol (back-EMF + R i) + 5 % v_dc; 0: off") \
+    "position plausibility (encoder): trips position when the voltage applied over the check's window differs from the model's flux change at the source's angle (+ R i) by more than pos_emf_tol (each flux part's change + R i) + 5 % v_dc; 0: off") \
   X(130, overrun_n,     U16,  "",       16.0f,       1.0f,    32.0f,    LIVE, "controller.overrun_n",      \
     "ISR overrun check: window of slow periods (main-loop periods, slow_div ISRs each)")                  \
   X(131, overrun_k,     U16,  "",       4.0f,        1.0f,    32.0f,    LIVE, "controller.overrun_k",      \

@@ -161,6 +161,10 @@ FD_COLD static void drive_derive(drive_t *drv) {
   drv->inv_pole_pairs = 1.0f / c->pole_pairs;
 }
 
+/* The position check runs every DRIVE_POS_CHECK_DIV-th slow period (its
+ * ISR cost: one sine, one model evaluation). */
+#define DRIVE_POS_CHECK_DIV 2u
+
 /* The protections' limits from the parameter set in force (LIVE ones
  * included: called again when they change) and the machine's scales. */
 FD_COLD static void drive_protect_configure(drive_t *drv) {
@@ -170,6 +174,15 @@ FD_COLD static void drive_protect_configure(drive_t *drv) {
                                drv->torque_scale, drv->flux_scale};
   protect_lc_configure(&drv->lc, &lc);
   protect_ra_configure(&drv->ra, c->speed_max, (float)c->slow_div * c->ts);
+  const protect_pos_cfg_t pc = {DRIVE_POS_CHECK_DIV * (uint32_t)c->slow_div,
+                                drive_t_out(drv, c),
+                                c->ts,
+                                c->rs,
+                                c->pos_emf_tol,
+                                &drv->machine,
+                                drv->psi0,
+                                drv->psi_pm};
+  protect_pos_configure(&drv->pos_chk, &pc);
 }
 
 FD_COLD int drive_config_fits_board(const drive_config_t *cfg, const hal_caps_t *caps,
@@ -620,10 +633,6 @@ static FD_NOINLINE void drive_window_sample(const drive_t *drv, float i[3], floa
 
 /* ------------------------------------------------- the slow-rate schedule */
 
-/* The position check runs every DRIVE_POS_CHECK_DIV-th slow period (its
- * ISR cost: one sine, one model evaluation). */
-#define DRIVE_POS_CHECK_DIV 2u
-
 /* The current-sum check (protect/isum.h) on the last period's currents. */
 static FD_NOINLINE void drive_isum_row(drive_t *drv, bool due) {
   (void)due;
@@ -655,21 +664,12 @@ FD_COLD static FD_NOINLINE void drive_pos_check_row(drive_t *drv, bool due) {
       c->pos_emf_tol > 0.0f && drv->state == DRIVE_STATE_RUN && tm->state == DRIVE_STATE_RUN &&
           (drv->pos_src->caps & POS_CAP_GATED) == 0u && fd_isfinite(tm->v_dc),
       due,
-      DRIVE_POS_CHECK_DIV * (uint32_t)c->slow_div,
       drv->pos.out.omega,
       tm->theta_e,
       (dq_t){tm->i_dq[0], tm->i_dq[1]},
       (ab_t){tm->v_ab_applied[0], tm->v_ab_applied[1]},
-      tm->v_dc,
-      drive_t_out(drv, c),
-      c->ts,
-      c->rs,
-      c->pos_emf_tol,
-      &drv->machine,
-      drv->psi0,
-      drv->psi_pm};
+      tm->v_dc};
   const uint32_t pf = protect_pos_step(&drv->pos_chk, &v);
-  drv->pos_emf_res = drv->pos_chk.res;
   if (pf != 0u) {
     drive_trip(drv, pf);
   }

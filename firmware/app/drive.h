@@ -221,7 +221,6 @@ typedef struct drive_s {
   protect_pos_t pos_chk;     /* the position plausibility check */
   protect_overrun_t overrun; /* the ISR overrun check */
   protect_safe_t safe;       /* the safe state with the gates not modulating */
-  float pos_emf_res;         /* pos_chk.res published for the logs (sil/runner/log_npy.c) */
   float torque_scale;        /* torque on MTPA at i_max [N m] */
   float flux_scale;          /* flux amplitude on MTPA at i_max [Vs] */
   float psi_pm;              /* |flux linkage at zero current| of the model [Vs] */

@@ -89,7 +89,7 @@
   X(rls_ok,          BOOL, "0/1",   s->tm->rls_ok ? 1.0f : 0.0f, RLS_OK,       1.0f, "",                    \
     "ivd+kf+rls: 1 when the identified a, b have settled (docs/dfc.md, RLS health); 0 before, "           \
     "when they cannot, and for the other sources")                                                        \
-  X(pos_emf_res,     F32,  "1",     s->drv->pos_emf_res,      NONE,            1.0f, "",                    \
+  X(pos_emf_res,     F32,  "1",     s->drv->pos_chk.res,       NONE,            1.0f, "",                    \
     "position plausibility (encoder): the voltage-model residual over its tolerance at the last "         \
     "slow-period check (above 1: counted towards the position trip; docs/faults.md)")
 /* clang-format on */

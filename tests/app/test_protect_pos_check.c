@@ -33,22 +33,21 @@ static machine_t m;
  * 0.3 (11 + 1) + 0.05 * 48 = 6 V. The view's angle, current and voltage
  * are the simulated machine's (one_check). */
 static protect_pos_view_t view(float dv_d) {
-  const protect_pos_view_t v = {true,
-                                true,
-                                32u,
-                                100.0f,
-                                0.0f,
-                                (dq_t){0.0f, 10.0f},
-                                (ab_t){-1.0f + dv_d, 11.0f},
-                                48.0f,
-                                0.0f,
-                                1.0f / 16384.0f,
-                                0.1f,
-                                0.3f,
-                                &m,
-                                (dq_t){0.1f, 0.0f},
-                                0.1f};
+  const protect_pos_view_t v = {
+      true, true, 100.0f, 0.0f, (dq_t){0.0f, 10.0f}, (ab_t){-1.0f + dv_d, 11.0f}, 48.0f};
   return v;
+}
+
+/* The check's parameters: 32 periods, t_out 0, Ts, R, pos_emf_tol 0.3,
+ * the machine and its flux at zero current. */
+static const protect_pos_cfg_t cfg = {32u,  0.0f, 1.0f / 16384.0f, 0.1f,
+                                      0.3f, &m,   {0.1f, 0.0f},    0.1f};
+
+/* A check as the drive holds it: zeroed, then configured with the set. */
+static protect_pos_t check_new(void) {
+  protect_pos_t p = {0};
+  protect_pos_configure(&p, &cfg);
+  return p;
 }
 
 static int setup(void **state) {
@@ -79,7 +78,7 @@ typedef struct {
 /* The machine's stator flux at the boundary of period j (t_out 0: the
  * voltage of sample j acts from (j - 1/2) Ts to (j + 1/2) Ts). */
 static ab_t flux_at(const sim_t *s, const protect_pos_view_t *v, long j, ab_t *i_ab) {
-  const float th = v->omega_e * ((float)j - 0.5f) * v->ts + s->delta;
+  const float th = v->omega_e * ((float)j - 0.5f) * cfg.ts + s->delta;
   const sincos_t sc = {sinf(th), cosf(th)};
   const dq_t i = current_at(j, s->step);
   *i_ab = frames_park_inv(i, sc);
@@ -95,13 +94,13 @@ static uint32_t one_check(protect_pos_t *p, sim_t *s, protect_pos_view_t v) {
     const long j = s->m++; /* the voltage of sample j, read in ISR j + 1 */
     ab_t i0, i1;
     const ab_t p0 = flux_at(s, &v, j, &i0), p1 = flux_at(s, &v, j + 1, &i1);
-    const float th = v.omega_e * (float)j * v.ts;
+    const float th = v.omega_e * (float)j * cfg.ts;
     const ab_t err = frames_park_inv((dq_t){s->dv_d, 0.0f}, (sincos_t){sinf(th), cosf(th)});
-    v_ab.alpha = (p1.alpha - p0.alpha) / v.ts + 0.5f * v.rs * (i0.alpha + i1.alpha) + err.alpha;
-    v_ab.beta = (p1.beta - p0.beta) / v.ts + 0.5f * v.rs * (i0.beta + i1.beta) + err.beta;
+    v_ab.alpha = (p1.alpha - p0.alpha) / cfg.ts + 0.5f * cfg.rs * (i0.alpha + i1.alpha) + err.alpha;
+    v_ab.beta = (p1.beta - p0.beta) / cfg.ts + 0.5f * cfg.rs * (i0.beta + i1.beta) + err.beta;
     protect_pos_integrate(p, v_ab);
   }
-  v.theta_e = frames_wrap_pi(v.omega_e * (float)(s->m - 1) * v.ts);
+  v.theta_e = frames_wrap_pi(v.omega_e * (float)(s->m - 1) * cfg.ts);
   v.i_dq = current_at(s->m - 1, s->step);
   v.v_ab = v_ab;
   return protect_pos_step(p, &v);
@@ -118,7 +117,7 @@ static int checks_to_trip(protect_pos_t *p, sim_t *s, const protect_pos_view_t *
 
 static void the_machine_passes(void **state) {
   (void)state;
-  protect_pos_t p = {0};
+  protect_pos_t p = check_new();
   sim_t s = {0};
   const protect_pos_view_t v = view(0.0f);
   assert_int_equal(checks_to_trip(&p, &s, &v, 100), 0);
@@ -127,7 +126,7 @@ static void the_machine_passes(void **state) {
 
 static void a_current_step_passes(void **state) {
   (void)state;
-  protect_pos_t p = {0};
+  protect_pos_t p = check_new();
   sim_t s = {0};
   s.step = true;
   const protect_pos_view_t v = view(0.0f);
@@ -138,13 +137,13 @@ static void a_current_step_passes(void **state) {
 /* The first check opens the window: the 9th over-count is the 10th check. */
 static void half_a_turn_off_trips(void **state) {
   (void)state;
-  protect_pos_t p = {0};
+  protect_pos_t p = check_new();
   sim_t s = {0};
   s.delta = 3.14159265f; /* the source's angle off by pi */
   const protect_pos_view_t v = view(0.0f);
   assert_int_equal(checks_to_trip(&p, &s, &v, 100), 10);
   assert_true(p.res > 3.0f);
-  p = (protect_pos_t){0}; /* and through the current steps */
+  p = check_new(); /* and through the current steps */
   s = (sim_t){0};
   s.delta = 3.14159265f;
   s.step = true;
@@ -155,12 +154,12 @@ static void half_a_turn_off_trips(void **state) {
  * 100 * 32 / 16384 rad); the error's window mean dv sinc(phi / 2). */
 static void just_inside_the_tolerance(void **state) {
   (void)state;
-  protect_pos_t p = {0};
+  protect_pos_t p = check_new();
   sim_t s = {0};
   s.dv_d = 5.9f;
   const protect_pos_view_t v = view(0.0f);
   assert_int_equal(checks_to_trip(&p, &s, &v, 100), 0);
-  p = (protect_pos_t){0};
+  p = check_new();
   s = (sim_t){0};
   s.dv_d = 6.1f;
   assert_int_equal(checks_to_trip(&p, &s, &v, 100), 10);
@@ -168,7 +167,7 @@ static void just_inside_the_tolerance(void **state) {
 
 static void leaky_count_restart_and_due(void **state) {
   (void)state;
-  protect_pos_t p = {0};
+  protect_pos_t p = check_new();
   sim_t bad = {0}, good = {0};
   bad.dv_d = 10.0f;
   const protect_pos_view_t v = view(0.0f);
@@ -198,13 +197,13 @@ static void leaky_count_restart_and_due(void **state) {
  * (2500 * 0.11 + 1) + 2.4 = 85.2 V; half a turn off: 2 * 275 V. */
 static void above_half_a_turn_per_window(void **state) {
   (void)state;
-  protect_pos_t p = {0};
+  protect_pos_t p = check_new();
   sim_t s = {0};
   protect_pos_view_t v = view(0.0f);
   v.omega_e = 2500.0f;
   assert_int_equal(checks_to_trip(&p, &s, &v, 100), 0);
   assert_true(p.res < 0.1f);
-  p = (protect_pos_t){0};
+  p = check_new();
   s = (sim_t){0};
   s.delta = 3.14159265f;
   assert_int_equal(checks_to_trip(&p, &s, &v, 100), 10);

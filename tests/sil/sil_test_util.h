@@ -57,7 +57,7 @@ static inline void trace_observer(void *user, const sil_step_t *st) {
   tr->theta_err[k] = remainder(tm->theta_e - p->theta_e, 2.0 * 3.14159265358979323846);
   tr->lc_cause[k] = tm->lc_cause;
   tr->duty_max[k] = fmax(tm->duty[0], fmax(tm->duty[1], tm->duty[2]));
-  tr->pos_res[k] = st->drive->pos_emf_res;
+  tr->pos_res[k] = st->drive->pos_chk.res;
   tr->faults[k] = st->drive->faults;
   tr->state[k] = st->drive->state;
   tr->gates[k] = st->gates_on;

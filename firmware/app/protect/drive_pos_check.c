@@ -90,6 +90,18 @@ static float ab_abs(ab_t x) {
   return sqrtf(x.alpha * x.alpha + x.beta * x.beta);
 }
 
+void protect_pos_configure(protect_pos_t *p, const protect_pos_cfg_t *c) {
+  p->cfg = *c;
+  p->t_win = (float)c->periods * c->ts;
+  p->inv_t = p->t_win > 0.0f ? 1.0f / p->t_win : 0.0f;
+  p->tau_int = c->t_out - 0.5f * c->ts;
+  /* the count n that trips: the least n with n t_win >= POS_TRIP_S */
+  p->n_trip = p->t_win > 0.0f ? (int32_t)ceilf(POS_TRIP_S / p->t_win) : 1;
+  if (p->n_trip < 1) {
+    p->n_trip = 1;
+  }
+}
+
 uint32_t protect_pos_step(protect_pos_t *p, const protect_pos_view_t *v) {
   if (!v->active) {
     p->n = 0;
@@ -99,25 +111,25 @@ uint32_t protect_pos_step(protect_pos_t *p, const protect_pos_view_t *v) {
   if (!v->due) {
     return 0u;
   }
+  const protect_pos_cfg_t *c = &p->cfg;
   const float w = v->omega_e;
-  const float ts = v->ts;
+  const float ts = c->ts;
   const dq_t i = v->i_dq;
   /* the form: the integral one up to POS_TURN_MAX per window */
-  const bool integral = fabsf(w) * (float)v->periods * ts <= POS_TURN_MAX;
+  const bool integral = fabsf(w) * p->t_win <= POS_TURN_MAX;
   /* the angle: the window's end (integral form: the model's flux and
    * current turned there) or the last voltage's centre (derivative form) */
-  const float tau = integral ? v->t_out - 0.5f * ts : v->t_out;
+  const float tau = integral ? p->tau_int : c->t_out;
   sincos_t sc;
   /* mut: pos_check_emf_sign */
   fd_sincosf(v->theta_e + w * tau, &sc.s, &sc.c);
-  const dq_t psi = machine_flux(v->machine, i);
+  const dq_t psi = machine_flux(c->machine, i);
   const float i_abs = sqrtf(i.d * i.d + i.q * i.q);
   /* the window: the sums before the last voltage (it opens the next), on
    * a start taken in the same form; its changes are read before the end
    * becomes the next window's start */
   const bool window = p->psi_ok && p->ab_ok == integral;
-  const float t_win = (float)v->periods * ts;
-  const float inv_t = 1.0f / t_win;
+  const float inv_t = p->inv_t;
   const dq_t dpsi_dq = {psi.d - p->psi.d, psi.q - p->psi.q};
   p->psi = psi;
   p->psi_ok = true;
@@ -125,8 +137,8 @@ uint32_t protect_pos_step(protect_pos_t *p, const protect_pos_view_t *v) {
   float rd, rq, emf, ir;
   if (integral) {
     /* the flux's two parts, the magnet's and the currents', turned */
-    const ab_t pm_ab = frames_park_inv(v->psi0, sc);
-    const ab_t pi_ab = frames_park_inv((dq_t){psi.d - v->psi0.d, psi.q - v->psi0.q}, sc);
+    const ab_t pm_ab = frames_park_inv(c->psi0, sc);
+    const ab_t pi_ab = frames_park_inv((dq_t){psi.d - c->psi0.d, psi.q - c->psi0.q}, sc);
     const ab_t i_ab = frames_park_inv(i, sc);
     const ab_t sum = {p->v_sum.alpha - v->v_ab.alpha, p->v_sum.beta - v->v_ab.beta};
     const ab_t dpm = {pm_ab.alpha - p->psi_pm_ab.alpha, pm_ab.beta - p->psi_pm_ab.beta};
@@ -142,10 +154,10 @@ uint32_t protect_pos_step(protect_pos_t *p, const protect_pos_view_t *v) {
       return 0u;
     }
     /* stator frame: (rd, rq) = (alpha, beta) */
-    rd = (sum.alpha * ts - (dpm.alpha + dpi.alpha)) * inv_t - 0.5f * v->rs * i2.alpha;
-    rq = (sum.beta * ts - (dpm.beta + dpi.beta)) * inv_t - 0.5f * v->rs * i2.beta;
+    rd = (sum.alpha * ts - (dpm.alpha + dpi.alpha)) * inv_t - 0.5f * c->rs * i2.alpha;
+    rq = (sum.beta * ts - (dpm.beta + dpi.beta)) * inv_t - 0.5f * c->rs * i2.beta;
     emf = (ab_abs(dpm) + ab_abs(dpi)) * inv_t;
-    ir = 0.5f * v->rs * i_abs2;
+    ir = 0.5f * c->rs * i_abs2;
   } else {
     /* the derivative form, the source's rotor frame: the last voltage
      * around t_out after the sample */
@@ -155,16 +167,16 @@ uint32_t protect_pos_step(protect_pos_t *p, const protect_pos_view_t *v) {
     }
     const dq_t u = frames_park(v->v_ab, sc);
     const dq_t dpsi = {dpsi_dq.d * inv_t, dpsi_dq.q * inv_t};
-    rd = u.d - (v->rs * i.d + dpsi.d - w * psi.q);
-    rq = u.q - (v->rs * i.q + dpsi.q + w * psi.d);
-    const float pd = psi.d - v->psi0.d, pq = psi.q - v->psi0.q;
-    emf = fabsf(w) * (v->psi_pm + sqrtf(pd * pd + pq * pq));
-    ir = v->rs * i_abs;
+    rd = u.d - (c->rs * i.d + dpsi.d - w * psi.q);
+    rq = u.q - (c->rs * i.q + dpsi.q + w * psi.d);
+    const float pd = psi.d - c->psi0.d, pq = psi.q - c->psi0.q;
+    emf = fabsf(w) * (c->psi_pm + sqrtf(pd * pd + pq * pq));
+    ir = c->rs * i_abs;
   }
-  const float tol = v->emf_tol * (emf + ir) + POS_V_FLOOR * v->v_dc;
+  const float tol = c->emf_tol * (emf + ir) + POS_V_FLOOR * v->v_dc;
   p->res = sqrtf(rd * rd + rq * rq) / fd_maxf(tol, 1e-6f);
   if (!(rd * rd + rq * rq <= tol * tol)) { /* NaN counts as over */
-    if ((float)++p->n * (float)v->periods * ts >= POS_TRIP_S) {
+    if (++p->n >= p->n_trip) {
       /* mut: pos_check_never */
       return DRIVE_FAULT_POSITION;
     }

@@ -693,6 +693,11 @@ static void drive_speed_row(drive_t *drv, bool due) {
     const float w_ref = fd_clampf(drv->cmd.speed, -c->speed_max, c->speed_max);
     drv->speed_torque_new =
         speed_ctrl_update(&drv->speed, w_ref, w, drv->torque_min_avail, drv->torque_max_avail);
+    /* to the law in this ISR: handed a period later (a row of its own, to
+     * split the loop's and the law's work on a new torque between two
+     * ISRs) it broke fuzz_can's invariant |torque_ref| <= torque_max after
+     * a live torque_max write */
+    drv->speed_torque = drv->speed_torque_new;
     const protect_ra_view_t v = {w, drv->speed.w_ref_ramped, drv->speed_torque_new};
     const uint32_t ra = protect_ra_step(&drv->ra, &v);
     if (ra != 0u) {
@@ -708,18 +713,6 @@ static void drive_speed_row(drive_t *drv, bool due) {
   drv->tm.speed_ref = drv->speed_active ? drv->speed.w_ref_ramped : 0.0f;
 }
 
-/* The speed loop's torque to the law, in the ISR after the loop's: the
- * law's work on a new torque reference (FOC: the MTPA current,
- * machine_mtpa_current, about 450 instructions on a salient machine) and
- * the speed loop's (about 220) fall in two ISRs, not one (the worst case of
- * the ISR, issue 24 point 8). The loop's output reaches the machine a
- * period (62.5 us) later, within a speed-loop period of 1 ms (at a speed
- * bandwidth of 30 rad/s, 0.1 degrees of phase). */
-static void drive_torque_row(drive_t *drv, bool due) {
-  (void)due;
-  drv->speed_torque = drv->speed_torque_new;
-}
-
 /* The slow-rate schedule: what runs once per slow period (slow_div ISRs,
  * the speed loop's period), at which ISR of it, how often. The ISR walks
  * the table every period (drive_schedule: DRIVE_SLOW_ROWS rows, bounded);
@@ -732,16 +725,14 @@ static void drive_torque_row(drive_t *drv, bool due) {
  * rows of an ISR run in the table's order (phases that fall in one ISR,
  * slow_div < 3: MID, NEXT, START). The phases split the slow work so that
  * the worst-case ISR does not carry it all: the speed loop and its
- * run-away check, the current-sum check at the start, the speed loop's
- * torque to the law (and the law's work on it) and the overrun check in
- * the next ISR, the position check (one sine, one model evaluation) half a
- * slow period later (issue 24 point 8: the overrun check out of the speed
- * loop's ISR, the worst with FOC, and out of the position check's, the
- * worst with DFVC on an encoder). The current-sum check stays at the start: it samples one
- * period a slow period, and at another place in the slow period its trip
- * in sil/test_adc_faults (a channel stuck at 0 at 0.2 N m) came at
- * 25.5 ms, not 11 ms (the samples fall elsewhere on the currents' wave). A new slow check is one
- * row here and one part in protect/ (docs/architecture.md, "Adding a protection"). */
+ * run-away check, the current-sum check at the start (the loop's torque
+ * reaches the law in the same ISR), the overrun check in the next ISR, the position check (one
+ * sine, one model evaluation) half a slow period later (issue 24 point 8: the overrun check out of
+ * the speed loop's ISR, the worst with FOC, and out of the position check's, the worst with DFVC on
+ * an encoder). The current-sum check stays at the start: it samples one period a slow period, and
+ * at another place in the slow period its trip in sil/test_adc_faults (a channel stuck at 0 at 0.2
+ * N m) came at 25.5 ms, not 11 ms (the samples fall elsewhere on the currents' wave). A new slow
+ * check is one row here and one part in protect/ (docs/architecture.md, "Adding a protection"). */
 enum { DRIVE_PHASE_START, DRIVE_PHASE_NEXT, DRIVE_PHASE_MID };
 
 typedef struct {
@@ -754,7 +745,6 @@ typedef struct {
 
 static const drive_slow_row_t drive_slow_rows[] = {
     {"pos_check", DRIVE_PHASE_MID, DRIVE_POS_CHECK_DIV, drive_pos_check_row},
-    {"torque_ref", DRIVE_PHASE_NEXT, 1u, drive_torque_row},
     {"overrun", DRIVE_PHASE_NEXT, 1u, drive_overrun_row},
     {"current_sum", DRIVE_PHASE_START, 1u, drive_isum_row},
     {"speed_loop", DRIVE_PHASE_START, 1u, drive_speed_row},

@@ -691,14 +691,12 @@ static void drive_speed_row(drive_t *drv, bool due) {
     }
     /* the limit in force re-clamps the reference (a live speed_max write) */
     const float w_ref = fd_clampf(drv->cmd.speed, -c->speed_max, c->speed_max);
-    drv->speed_torque_new =
+    /* to the law in this ISR, with the limits in force (a torque handed a
+     * period later missed a live torque_max write: fuzz_can corpus
+     * live_torque_max_below_speed_torque) */
+    drv->speed_torque =
         speed_ctrl_update(&drv->speed, w_ref, w, drv->torque_min_avail, drv->torque_max_avail);
-    /* to the law in this ISR: handed a period later (a row of its own, to
-     * split the loop's and the law's work on a new torque between two
-     * ISRs) it broke fuzz_can's invariant |torque_ref| <= torque_max after
-     * a live torque_max write */
-    drv->speed_torque = drv->speed_torque_new;
-    const protect_ra_view_t v = {w, drv->speed.w_ref_ramped, drv->speed_torque_new};
+    const protect_ra_view_t v = {w, drv->speed.w_ref_ramped, drv->speed_torque};
     const uint32_t ra = protect_ra_step(&drv->ra, &v);
     if (ra != 0u) {
       drv->tm.lc_cause = ra;
@@ -708,7 +706,6 @@ static void drive_speed_row(drive_t *drv, bool due) {
     speed_ctrl_reset(&drv->speed, drv->omega_m, 0.0f);
     drv->speed_active = false;
     drv->speed_torque = 0.0f;
-    drv->speed_torque_new = 0.0f;
   }
   drv->tm.speed_ref = drv->speed_active ? drv->speed.w_ref_ramped : 0.0f;
 }
@@ -846,7 +843,6 @@ FD_COLD FD_NOINLINE static void drive_gates_start(drive_t *drv) {
   drv->pos.in = (pos_input_t){0.0f, 0.0f}; /* no torque before the run */
   drv->speed_active = false;
   drv->speed_torque = 0.0f;
-  drv->speed_torque_new = 0.0f;
   protect_lc_reset(&drv->lc);
   protect_ra_reset(&drv->ra);
   drv->tm.lc_cause = 0u;

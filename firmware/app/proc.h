@@ -68,23 +68,29 @@ enum {
   PROC_ST_RUNNING = 1,
   PROC_ST_DONE = 2,
   PROC_ST_FAILED = 3,
-  PROC_ST_ABORTED = 4 /* disabled or tripped by another cause while it ran */
+  PROC_ST_ABORTED = 4, /* disabled, stopped or tripped by another cause while it ran */
+  PROC_ST_REFUSED = 5  /* an identification the parameter set in force cannot run (its check) */
 };
 
 enum {
-  PROC_CAP_GATES = 1u << 0 /* modulates: the gates are on while it runs */
+  PROC_CAP_GATES = 1u << 0, /* modulates: the gates are on while it runs */
+  /* an identification procedure: the host may run it alone, with the drive
+   * disabled (drive_cmd_identify; the commissioning, docs/commissioning.md):
+   * the offsets first, then it, then the gates off again */
+  PROC_CAP_IDENT = 1u << 1
 };
 
 /* Results published like telemetry (drive_telemetry_t.proc): the last
  * procedure that ran, where it is, what it found. */
-#define PROC_RESULTS 3
+#define PROC_RESULTS 8
 typedef struct {
   uint8_t id;     /* proc_id_t (PROC_NONE: none yet) */
   uint8_t status; /* PROC_ST_* */
   uint8_t phase;  /* the procedure's own phase (the held start's: acquisition, pulses ...) */
   uint32_t n;     /* periods since it began */
   uint32_t fault; /* PROC_ST_FAILED: the fault bits it raised */
-  /* its results (0 until found): offset: the three offsets [A]; align:
+  /* its results (0 until found; each row's publish documents its own,
+   * docs/commissioning.md the identification's): offset: the three offsets [A]; align:
    * the angle of the current (the source's reference once done) [rad
    * electrical], the periods the rotor has been calm; hold: the angle along the
    * pulses, the north pole's angle [rad electrical], the evidence
@@ -191,6 +197,11 @@ const proc_row_t *proc_row(proc_id_t id);
 /* The start: the procedures the drive runs from an enable to the run, in
  * order (*n of them). */
 const proc_id_t *proc_start_sequence(unsigned *n);
+/* The identification run of `id` (drive_cmd_identify): the offsets, then
+ * the procedure; *n entries written to seq[2]. */
+void proc_ident_sequence(proc_id_t id, proc_id_t seq[2], unsigned *n);
+/* Whether the host may run `id` alone (PROC_CAP_IDENT): NULL, or why not. */
+const char *proc_ident_refusal(proc_id_t id, const proc_setup_t *su, const char **field);
 /* Whether the start runs `id` with this setup: wanted and able (check). */
 bool proc_applies(proc_id_t id, const proc_setup_t *su);
 /* Every procedure of the start that is wanted must be able: NULL, or the

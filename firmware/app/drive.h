@@ -132,13 +132,10 @@ typedef struct drive_s {
   float offset[3];
 
   /* the procedure in force (proc.h: offset calibration, alignment, held
-   * start), its place in the start sequence and its state: 84 B on the
-   * Cortex-M, what the offset calibration's and the alignment's fields took
-   * here before, so the periodic path's fields after them keep their
-   * offsets (and the PIL counts; a larger union moves them) */
+   * start, identification) and its place in its sequence; its state is
+   * last (proc_st) */
   const proc_row_t *proc; /* NULL: none (idle, run, fault) */
   uint32_t proc_k;        /* its index in proc_start_sequence() */
-  proc_state_t proc_st;
 
   /* position */
   const pos_source_row_t *pos_src;
@@ -232,6 +229,10 @@ typedef struct drive_s {
   float flux_scale;          /* flux amplitude on MTPA at i_max [Vs] */
   float psi_pm;              /* |flux linkage at zero current| of the model [Vs] */
   dq_t psi0;                 /* that flux linkage [Vs] */
+  /* the state of the procedure in force (proc.h), last: a procedure runs
+   * from flash outside the run (FD_COLD), and its state, however large an
+   * identification's, moves nothing the periodic path reads */
+  proc_state_t proc_st;
 } drive_t;
 
 /* The layout rules the ISR's instruction counts depend on (docs/pil.md),
@@ -255,6 +256,7 @@ _Static_assert(offsetof(drive_t, cfg) > offsetof(drive_t, win_k) &&
                    offsetof(drive_t, ctrl) > offsetof(drive_t, win_k) &&
                    offsetof(drive_t, pos_st) > offsetof(drive_t, win_k),
                "drive_t: the parts reached through a pointer after the per-period scalars");
+_Static_assert(sizeof(proc_state_t) <= 1024u, "proc_state_t: a procedure's state beyond 1 KiB");
 _Static_assert(offsetof(drive_t, clear_seen) > offsetof(drive_t, host) &&
                    offsetof(drive_t, psi0) > offsetof(drive_t, clear_seen),
                "drive_t: the slow-rate and command fields last");

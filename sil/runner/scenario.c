@@ -140,6 +140,7 @@ static int set_pwm_frequency(ctx_t *c, scenario_t *sc, const sk_val_t *v);
 static int mechanics_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
 static int sensors_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
 static int controller_params(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int controller_map(ctx_t *c, scenario_t *sc, const sk_val_t *v);
 static int estimates_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
 static int inject_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
 static int current_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v);
@@ -561,6 +562,28 @@ static int controller_params(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
       return -1;
     }
   }
+  return 0;
+}
+
+/* The drive's own flux map (controller.map: an identified one, the
+ * commissioning's), the plant keeping its own: both maps of one machine
+ * (the same pole pairs). */
+static int controller_map(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  const cJSON *it = v->it;
+  if (sc->plant.machine.map == NULL) {
+    return scn_fail(c, v->path, "needs a flux-map machine (machine.map or a map preset)");
+  }
+  char why[640];
+  const int pp = sc->plant.machine.pole_pairs;
+  const map_load_t *e = map_load(it->valuestring, c->origin, pp, why, sizeof why);
+  if (e == NULL) {
+    return scn_fail(c, v->path, "%s", why);
+  }
+  if (e->map.pole_pairs != (float)pp) {
+    return scn_fail(c, v->path, "%s has %g pole pairs, the machine %d", it->valuestring,
+                    (double)e->map.pole_pairs, pp);
+  }
+  sc->drive.machine_map = e->words;
   return 0;
 }
 

@@ -208,6 +208,8 @@
   X(K_CONTROLLER, .parent = K_ROOT, .key = "controller", .type = SK_OBJECT, .params = 1,           \
     .set = controller_params,                                                                      \
     .doc = "the drive's parameters (`docs/parameters.md`)")                \
+  X(K_C_MAP, .parent = K_CONTROLLER, .key = "map", .type = SK_STRING, .set = controller_map,       \
+    .dflt = "the machine's", .doc = "the drive's own flux map (a commissioned one), the plant keeping machine.map") \
   X(K_C_ESTIMATES, .parent = K_CONTROLLER, .key = "estimates", .type = SK_OBJECT,                  \
     .post = estimates_post, .doc = "detuning: the controller's machine as factors of the plant's") \
   X(K_C_E_RS, .parent = K_C_ESTIMATES, .key = "rs_scale", .type = SK_NUM, RANGE(0.1, 10.0),        \

@@ -473,6 +473,11 @@ static int machine_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
   if (pm->ld_sat > 0.0 && !(pm->i_sat > 0.0)) {
     return scn_fail(c, "machine.i_sat", "must be given (> 0 A) with machine.ld_sat > 0");
   }
+  /* the cogging torque (plant_mech.c): its order with its amplitude */
+  if (sc->plant.mech.cog_amp != 0.0 && sc->plant.mech.cog_order < 1) {
+    return scn_fail(c, "machine.cogging_order",
+                    "must be given (periods per mechanical turn, >= 1) with machine.cogging_amp");
+  }
   /* star_phi_iq: both terms' shift (a turned saliency axis: phi_a = phi_iq,
    * phi_b = 2 phi_iq of (3.97)), an alias of the pair */
   if (cJSON_GetObjectItemCaseSensitive(m, "star_phi_iq") != NULL) {

@@ -53,8 +53,8 @@ static inline double eff_duty(double d, double kd, double i_norm) {
 /* The period-average device drop of a leg with effective duty e at
  * current i (header comment); sg = sgn_s(i). */
 static inline double avg_drop(const double dv[4], double e, double i, double sg) {
-  const double vsw = dv[0] * sg + dv[1] * i, vd = dv[2] * sg + dv[3] * i;
   /* mut: avg_drop_device_swapped */
+  const double vsw = dv[0] * sg + dv[1] * i, vd = dv[2] * sg + dv[3] * i;
   return i > 0.0 ? e * vsw + (1.0 - e) * vd : e * vd + (1.0 - e) * vsw;
 }
 

@@ -222,6 +222,7 @@ static void sw_deriv(const plant_t *pl, const sw_cfg_t *cf, const double *x, dou
                        : (fl && cf->cond[j] == COND_LO) ? cf->rl[j]
                                                         : 0.0;
       v[j] = k * vdc;
+      /* mut: sw_drop_sign */
       if (drops) {
         v[j] -= leg_drop(pl, cf->type[j], cf->cond[j], i[j]);
       }

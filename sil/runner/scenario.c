@@ -786,9 +786,10 @@ static int resolve_substeps(ctx_t *c, scenario_t *sc) {
                                                          : "machine.lq";
       return scn_fail(c, key,
                       "the plant cannot integrate this machine at this PWM period: its electrical "
-                      "time constant L/R_s (%.3g s with L = %.3g H) needs %d integration steps per "
-                      "period, at most %d",
-                      lmin / p->machine.rs, lmin, need, PLANT_SUBSTEPS_MAX);
+                      "time constant L/R (%.3g s with L = %.3g H, R = R_s and the inverter's "
+                      "device resistance) needs %d integration steps per period, at most %d",
+                      lmin / (p->machine.rs + fmax(p->inverter.r_on_sw, p->inverter.r_diode)), lmin,
+                      need, PLANT_SUBSTEPS_MAX);
     }
     p->inverter.substeps = need;
   } else if (p->inverter.substeps < need) {

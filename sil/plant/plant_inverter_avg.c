@@ -92,10 +92,12 @@ typedef struct {
  * angle. The same expressions as plant_internal.h's inline mechanics and
  * DC link, with the parameters hoisted. `avgs`: integrate the period
  * averages (v_an, v_bn, i_dc, torque, i_dq: the log's; plant_set_averages)
- * as well; the star point's (X_VN, the sensors') always. */
+ * as well; the star point's (X_VN, the sensors') always. `real`: the
+ * device drops and the cogging torque (a copy of their own: the usual
+ * periods without them run the code they ran before, issue 25). */
 static AVG_ALWAYS_INLINE void avg_deriv(const avg_k_t *restrict k, int ideal, int imposed, int avgs,
-                                        double c, double s, const double *restrict x, double m,
-                                        double *restrict dx, const double *i_known) {
+                                        int real, double c, double s, const double *restrict x,
+                                        double m, double *restrict dx, const double *i_known) {
   double id, iq;
   if (i_known != NULL) { /* the state's currents, already computed (the plant's cache) */
     id = i_known[0];
@@ -111,7 +113,7 @@ static AVG_ALWAYS_INLINE void avg_deriv(const avg_k_t *restrict k, int ideal, in
   const double db = eff_duty(k->d[1], k->kd[1], ib * nb);
   const double dc = eff_duty(k->d[2], k->kd[2], ic * nb);
   double va0 = da * vdc, vb0 = db * vdc, vc0 = dc * vdc;
-  if (k->drops) {
+  if (real && k->drops) {
     va0 -= avg_drop(k->dv, da, ia, sat1(ia * nb));
     vb0 -= avg_drop(k->dv, db, ib, sat1(ib * nb));
     vc0 -= avg_drop(k->dv, dc, ic, sat1(ic * nb));
@@ -131,7 +133,7 @@ static AVG_ALWAYS_INLINE void avg_deriv(const avg_k_t *restrict k, int ideal, in
   } else {
     dx[X_TH] = x[X_W];
     const double tn = te - k->b * x[X_W] - m;
-    dx[X_W] = (k->cog[0] != 0.0 ? tn + plant_mech_cogging(k->cog, x[X_TH]) : tn) * k->inv_j;
+    dx[X_W] = (real && k->cog[0] != 0.0 ? tn + plant_mech_cogging(k->cog, x[X_TH]) : tn) * k->inv_j;
   }
   dx[X_VN] = vn - 0.5 * vdc;
   const double idc = avgs || !ideal ? da * ia + db * ib + dc * ic : 0.0;
@@ -150,12 +152,12 @@ static AVG_ALWAYS_INLINE void avg_deriv(const avg_k_t *restrict k, int ideal, in
   }
 }
 
-/* The RK4 steps of one period; `ideal`, `imposed` and `avgs` are constants
+/* The RK4 steps of one period; `ideal`, `imposed`, `avgs` and `real` are constants
  * at each call site (specialised copies). State entries whose derivative is
  * identically zero (v_C on an ideal link, w under imposed speed) are left
  * as they are: x + h * 0 = x, the same result without the work. */
 static AVG_ALWAYS_INLINE void avg_rk4(const plant_t *pl, const avg_k_t *restrict kc, int ideal,
-                                      int imposed, int avgs, angle_ref_t *restrict ar,
+                                      int imposed, int avgs, int real, angle_ref_t *restrict ar,
                                       double *restrict x, double *restrict cs_end) {
   /* a stage's state entry; v_C on an ideal link and w under imposed speed
    * are not read by the derivative (nor is their derivative): the entry
@@ -184,22 +186,22 @@ static AVG_ALWAYS_INLINE void avg_rk4(const plant_t *pl, const avg_k_t *restrict
       ar->c = c;
       ar->s = s;
     }
-    avg_deriv(k, ideal, imposed, avgs, ar->c, ar->s, x, m0, k1, j == 0 ? ar->i_known : NULL);
+    avg_deriv(k, ideal, imposed, avgs, real, ar->c, ar->s, x, m0, k1, j == 0 ? ar->i_known : NULL);
     for (int i = 0; i < X_VA; i++) { /* the integrals X_VA.. are not read */
       xs[i] = AVG_STAGE(i, x[i] + h2 * k1[i]);
     }
     stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
-    avg_deriv(k, ideal, imposed, avgs, c, s, xs, m1, k2, NULL);
+    avg_deriv(k, ideal, imposed, avgs, real, c, s, xs, m1, k2, NULL);
     for (int i = 0; i < X_VA; i++) {
       xs[i] = AVG_STAGE(i, x[i] + h2 * k2[i]);
     }
     stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
-    avg_deriv(k, ideal, imposed, avgs, c, s, xs, m1, k3, NULL);
+    avg_deriv(k, ideal, imposed, avgs, real, c, s, xs, m1, k3, NULL);
     for (int i = 0; i < X_VA; i++) {
       xs[i] = AVG_STAGE(i, x[i] + h * k3[i]);
     }
     stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
-    avg_deriv(k, ideal, imposed, avgs, c, s, xs, m2, k4, NULL);
+    avg_deriv(k, ideal, imposed, avgs, real, c, s, xs, m2, k4, NULL);
     for (int i = 0; i < X_N; i++) {
       if ((ideal && i == X_VC) || (imposed && i == X_W) || (!avgs && i != X_VN && i >= X_VA)) {
         continue;
@@ -267,13 +269,15 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
     ar.i_known = NULL;
   }
   const int avgs = pl->aux.avgs;
-  if (k.ideal && !k.imposed) { /* the usual case */
+  if (k.drops || k.cog[0] != 0.0) { /* device drops, cogging: a copy of their own */
+    avg_rk4(pl, &k, k.ideal, k.imposed, avgs, 1, &ar, x, cs_end);
+  } else if (k.ideal && !k.imposed) { /* the usual case */
     if (avgs) {
-      avg_rk4(pl, &k, 1, 0, 1, &ar, x, cs_end);
+      avg_rk4(pl, &k, 1, 0, 1, 0, &ar, x, cs_end);
     } else {
-      avg_rk4(pl, &k, 1, 0, 0, &ar, x, cs_end);
+      avg_rk4(pl, &k, 1, 0, 0, 0, &ar, x, cs_end);
     }
   } else {
-    avg_rk4(pl, &k, k.ideal, k.imposed, avgs, &ar, x, cs_end);
+    avg_rk4(pl, &k, k.ideal, k.imposed, avgs, 0, &ar, x, cs_end);
   }
 }

@@ -214,7 +214,6 @@ static void sw_deriv(const plant_t *pl, const sw_cfg_t *cf, const double *x, dou
     const double ial = id * c - iq * s, ibe = id * s + iq * c;
     const double i[3] = {ial, -0.5 * ial + PLANT_SQRT3_2 * ibe, -0.5 * ial - PLANT_SQRT3_2 * ibe};
     double v[3];
-    const int drops = pl->aux.drops && cf->node < 0;
     for (int j = 0; j < 3; j++) {
       const int fl = cf->type[j] == LEG_FLOAT;
       const double k = cf->type[j] == LEG_HI            ? 1.0
@@ -222,12 +221,14 @@ static void sw_deriv(const plant_t *pl, const sw_cfg_t *cf, const double *x, dou
                        : (fl && cf->cond[j] == COND_LO) ? cf->rl[j]
                                                         : 0.0;
       v[j] = k * vdc;
-      /* mut: sw_drop_sign */
-      if (drops) {
-        v[j] -= leg_drop(pl, cf->type[j], cf->cond[j], i[j]);
-      }
       /* mut: short_link_current_one_way */
       idc += k * i[j];
+    }
+    if (pl->aux.drops && cf->node < 0) { /* the device drops (header comment) */
+      for (int j = 0; j < 3; j++) {
+        /* mut: sw_drop_sign */
+        v[j] -= leg_drop(pl, cf->type[j], cf->cond[j], i[j]);
+      }
     }
     const double val = (2.0 * v[0] - v[1] - v[2]) * (1.0 / 3.0);
     const double vbe = (v[1] - v[2]) * PLANT_INV_SQRT3;

@@ -10,7 +10,10 @@
  *     forward interpolant at i = 0, +-1 mA, with the cross term), cogging torque;
  *   mechanics: J, viscous friction (mech.b plus the passive load's
  *     faults.viscous), Coulomb friction (faults.coulomb);
- *   inverter: dead time, the device drops (plant_inverter_t);
+ *   inverter: dead time, the device drops (plant_inverter_t) and the band
+ *     i_band [A] over which both models take the dead time's sign and the
+ *     thresholds in (the initialised plant's, plant_inverter.c): the
+ *     voltage-error curve of docs/machines.md;
  *   encoder: counts per turn, its mounting offset (inject.encoder_error at
  *     t = 0 [rad mech], and in electrical degrees), its direction (the
  *     plant's encoder counts with the rotor: +1);
@@ -109,6 +112,11 @@ char *truth_json(const scenario_t *sc) {
   cJSON_AddNumberToObject(iv, "r_on_sw", p->inverter.r_on_sw);
   cJSON_AddNumberToObject(iv, "v_f_diode", p->inverter.v_f_diode);
   cJSON_AddNumberToObject(iv, "r_diode", p->inverter.r_diode);
+  static plant_t pl; /* large (the noise tables): not on the stack */
+  const char *field = NULL;
+  if (plant_init(&pl, p, &field) == 0) {
+    cJSON_AddNumberToObject(iv, "i_band", 1.0 / pl.aux.inv_band);
+  }
 
   cJSON *en = cJSON_AddObjectToObject(o, "encoder");
   cJSON_AddNumberToObject(en, "cpr", p->sensors.encoder_cpr);

@@ -84,6 +84,12 @@ static void linear_machine_with_everything(void **state) {
   close_to(num(o, "inverter", "r_on_sw"), 0.04, 1e-12);
   close_to(num(o, "inverter", "v_f_diode"), 0.8, 1e-12);
   close_to(num(o, "inverter", "r_diode"), 0.02, 1e-12);
+  /* the band (plant_inverter.c): 2 ((td/Ts) v_dc + max threshold) h / L_min */
+  const double h = p->ts / p->inverter.substeps;
+  const double ld = p->machine.ld / (1.0 + p->machine.ld_sat);
+  const double lmin = ld < p->machine.lq ? ld : p->machine.lq;
+  close_to(num(o, "inverter", "i_band"), 2.0 * (5e-7 / p->ts * p->dclink.v_source + 1.1) * h / lmin,
+           1e-9);
   close_to(num(o, "encoder", "offset"), 0.01, 1e-12);
   close_to(num(o, "encoder", "offset_deg_e"), 0.01 * p->machine.pole_pairs * 57.29577951308232,
            1e-12);

@@ -39,6 +39,7 @@
 #include "signals_json.h"
 #include "sil_run.h"
 #include "summary.h"
+#include "truth.h"
 
 static volatile int stop_flag;
 
@@ -87,7 +88,7 @@ static int parse_long(const char *opt, const char *s, long lo, long hi, long *ou
 typedef struct {
   const char *scenario, *log_path, *summary_path, *record_path, *dump_path, *can;
   const char *keys_doc, *keys_doc_write, *params_path;
-  int bench, print_config, print_params, print_signals, realtime, keys, help;
+  int bench, print_config, print_params, print_signals, realtime, keys, help, print_truth;
   long decimate, preempt_n, seed, node, can_timeout, max_gap_us;
 } cli_t;
 
@@ -132,6 +133,9 @@ static const option_t options[] = {
      LONG(decimate, 1, 1000000)},
     {"--bench", NULL, "no log; print steps, wall time and the real-time factor", FLAG(bench)},
     {"--print-config", NULL, "print the resolved parameters (JSON) and exit", FLAG(print_config)},
+    {"--print-truth", NULL,
+     "print the plant's true values a commissioning identifies (JSON, truth.h) and exit",
+     FLAG(print_truth)},
     {"--print-params", NULL, "print the parameter table (JSON; no scenario needed) and exit",
      FLAG(print_params)},
     {"--print-signals", NULL,
@@ -255,6 +259,15 @@ int main(int argc, char **argv) {
   }
   if (cli.print_config) {
     char *js = config_json(&sc);
+    if (js == NULL) {
+      return 1;
+    }
+    printf("%s\n", js);
+    free(js);
+    return 0;
+  }
+  if (cli.print_truth) {
+    char *js = truth_json(&sc);
     if (js == NULL) {
       return 1;
     }

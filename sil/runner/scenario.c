@@ -478,6 +478,11 @@ static int machine_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
   if (pm->ld_sat > 0.0 && !(pm->i_sat > 0.0)) {
     return scn_fail(c, "machine.i_sat", "must be given (> 0 A) with machine.ld_sat > 0");
   }
+  /* the cogging torque (plant_mech.c): its order with its amplitude */
+  if (sc->plant.mech.cog_amp != 0.0 && sc->plant.mech.cog_order < 1) {
+    return scn_fail(c, "machine.cogging_order",
+                    "must be given (periods per mechanical turn, >= 1) with machine.cogging_amp");
+  }
   /* star_phi_iq: both terms' shift (a turned saliency axis: phi_a = phi_iq,
    * phi_b = 2 phi_iq of (3.97)), an alias of the pair */
   if (cJSON_GetObjectItemCaseSensitive(m, "star_phi_iq") != NULL) {
@@ -808,9 +813,10 @@ static int resolve_substeps(ctx_t *c, scenario_t *sc) {
                                                          : "machine.lq";
       return scn_fail(c, key,
                       "the plant cannot integrate this machine at this PWM period: its electrical "
-                      "time constant L/R_s (%.3g s with L = %.3g H) needs %d integration steps per "
-                      "period, at most %d",
-                      lmin / p->machine.rs, lmin, need, PLANT_SUBSTEPS_MAX);
+                      "time constant L/R (%.3g s with L = %.3g H, R = R_s and the inverter's "
+                      "device resistance) needs %d integration steps per period, at most %d",
+                      lmin / (p->machine.rs + fmax(p->inverter.r_on_sw, p->inverter.r_diode)), lmin,
+                      need, PLANT_SUBSTEPS_MAX);
     }
     p->inverter.substeps = need;
   } else if (p->inverter.substeps < need) {

@@ -137,7 +137,9 @@ static void push_frame(const hal_can_frame_t *f) {
   if (r < 0) {
     return;
   }
-  static const uint8_t dlc[] = {4u, 4u, 4u, 8u, 4u, 8u}; /* docs/can.md */
+  /* by reply_req (docs/can.md); HOST_HB (6) is never answered, CMD_PROC is 7 */
+  static const uint8_t dlc[] = {4u, 4u, 4u, 8u, 4u, 8u, 1u, 1u};
+  _Static_assert(CAN_MSG_CMD_PROC == 7, "reply_req of CMD_PROC");
   if (st.head - st.tail >= REQ_QUEUE) {
     violated("more requests outstanding than the harness tracks");
   }

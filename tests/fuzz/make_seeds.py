@@ -91,7 +91,7 @@ CAN = {
     "seed-proc": frame(PROC, [0]) + wait_ms(5) + frame(PROC, [255]) + wait_ms(2)
     + frame(PROC, [1]) + frame(PROC, [200]) + frame(PROC, [0]) + wait_ms(10)
     + state(1, mode=0) + wait_ms(10) + frame(PROC, [0]) + state(0) + wait_ms(5)
-    + frame(PROC, [0]) + bytes([6, 1]),
+    + bytes([7, 43, 5]) + frame(PROC, [0]) + bytes([6, 1]),  # offset_samples x 10: 160 ms
 }
 
 

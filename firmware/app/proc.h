@@ -52,7 +52,11 @@
 #define PROC_LIST(X)                                                                               \
   X(OFFSET, offset, "current sensor offsets with the gates off (offset_samples averaged)")         \
   X(ALIGN, align, "d current along theta = 0 for align_time; an encoder's: damped, until settled") \
-  X(HOLD, hold, "the held start (start_mode 1): angle at standstill, polarity from two d pulses")
+  X(HOLD, hold, "the held start (start_mode 1): angle at standstill, polarity from two d pulses")  \
+  X(RS, rs,                                                                                        \
+    "identification: R_s and the inverter's voltage error v_err(i) from DC levels, both signs")    \
+  X(LDQ, ldq,                                                                                      \
+    "identification: L_d, L_q at standstill, square-wave voltage injection along d, then q")
 
 #define PROC_ENUM(E, n, d) PROC_##E,
 typedef enum { PROC_LIST(PROC_ENUM) PROC_COUNT } proc_id_t;
@@ -162,10 +166,57 @@ typedef struct {
   bool plain;              /* the pattern without the DFC window (a pulse's clean sample) */
 } proc_hold_t;
 
+/* proc_rs.c: R_s and v_err(i) (issue 25 a). Levels of each sign, at most: */
+#define PROC_RS_LEVELS_MAX 12u
+typedef struct {
+  current_ctrl_t cc;                   /* the level's current loop (frame turned by theta) */
+  uint8_t n_levels;                    /* levels of each sign (id_rs_levels) */
+  uint8_t phase;                       /* proc_rs.c's phases */
+  int8_t last;                         /* the last level measured (-1: none) */
+  uint32_t n;                          /* periods into the phase */
+  uint32_t n_all;                      /* periods since it began */
+  float i_ref;                         /* the current reference, slew-limited [A] */
+  float theta;                         /* the current's axis [rad] */
+  float v_prev;                        /* the axis' voltage asked last period [V] */
+  float acc_v, acc_i;                  /* the level's sums */
+  uint32_t acc_n;                      /* ... of this many periods */
+  float i_peak;                        /* the largest measured current amplitude [A] */
+  float lv_i[2u * PROC_RS_LEVELS_MAX]; /* the levels' mean current, positive then negative [A] */
+  float lv_v[2u * PROC_RS_LEVELS_MAX]; /* ... and commanded voltage [V] */
+  float res[PROC_RESULTS];             /* the fit (proc_rs.c, rs_publish) */
+} proc_rs_t;
+
+/* proc_ldq.c: L_d, L_q at standstill (issue 25 b). */
+typedef struct {
+  current_ctrl_t cc; /* the bias current's loop (alignment, hold) */
+  uint8_t phase;     /* proc_ldq.c's phases */
+  uint8_t axis;      /* 0: d (the bias' axis), 1: q */
+  uint8_t tries;     /* amplitude adjustments of this axis */
+  uint32_t n;        /* periods into the phase */
+  uint32_t n_all;    /* periods since it began */
+  float i_ref;       /* the bias reference, slew-limited [A] */
+  float v_hold[2];   /* the bias' voltage (d, q) held under the injection [V] */
+  float v_h;         /* the injection's amplitude [V] */
+  float v_prev;      /* the injected voltage asked last period [V] */
+  float i_prev;      /* the injected axis' current last period [A] */
+  float acc_d;       /* the bias current's sum over an injection period [A] */
+  float psi;         /* the injected volt-seconds to the sample (ts sum u) [Vs] */
+  float s_pp, s_pu, s_p, s_uu, s_u, s_py, s_uy, s_y; /* the regression (3) (proc_ldq.c) */
+  uint32_t sn;
+  float i_lo, i_hi; /* the injected axis' current range [A] */
+  float i_peak;     /* the largest measured current amplitude [A] */
+  float l[2];       /* the inductances found (d, q) [H] */
+  float ripple[2];  /* their current ripple, peak to peak [A] */
+  float cross[2];   /* the other axis' ripple over this axis' [-] */
+  float o_lo, o_hi; /* the other axis' current range under the injection [A] */
+} proc_ldq_t;
+
 typedef union {
   proc_offset_t offset;
   proc_align_t align;
   proc_hold_t hold;
+  proc_rs_t rs;
+  proc_ldq_t ldq;
 } proc_state_t;
 
 typedef struct {

@@ -186,29 +186,29 @@ typedef struct {
   float res[PROC_RESULTS];             /* the fit (proc_rs.c, rs_publish) */
 } proc_rs_t;
 
-/* proc_ldq.c: L_d, L_q at standstill (issue 25 b). */
+/* proc_ldq.c: L_d, L_q at standstill (issue 25 b). A half wave of at most
+ * PROC_LDQ_M_MAX PWM periods (id_ldq_freq at least f_pwm / 32): */
+#define PROC_LDQ_M_MAX 16u
 typedef struct {
-  current_ctrl_t cc; /* the bias current's loop (alignment, hold) */
-  uint8_t phase;     /* proc_ldq.c's phases */
-  uint8_t axis;      /* 0: d (the bias' axis), 1: q */
-  uint8_t tries;     /* amplitude adjustments of this axis */
-  uint32_t n;        /* periods into the phase */
-  uint32_t n_all;    /* periods since it began */
-  float i_ref;       /* the bias reference, slew-limited [A] */
-  float v_hold[2];   /* the bias' voltage (d, q) held under the injection [V] */
-  float v_h;         /* the injection's amplitude [V] */
-  float v_prev;      /* the injected voltage asked last period [V] */
-  float i_prev;      /* the injected axis' current last period [A] */
-  float acc_d;       /* the bias current's sum over an injection period [A] */
-  float psi;         /* the injected volt-seconds to the sample (ts sum u) [Vs] */
-  float s_pp, s_pu, s_p, s_uu, s_u, s_py, s_uy, s_y; /* the regression (3) (proc_ldq.c) */
-  uint32_t sn;
-  float i_lo, i_hi; /* the injected axis' current range [A] */
-  float i_peak;     /* the largest measured current amplitude [A] */
-  float l[2];       /* the inductances found (d, q) [H] */
-  float ripple[2];  /* their current ripple, peak to peak [A] */
-  float cross[2];   /* the other axis' ripple over this axis' [-] */
-  float o_lo, o_hi; /* the other axis' current range under the injection [A] */
+  current_ctrl_t cc;            /* the bias current's loop (alignment, hold) */
+  uint8_t phase;                /* proc_ldq.c's phases */
+  uint8_t axis;                 /* 0: d (the bias' axis), 1: q */
+  uint8_t tries;                /* amplitude adjustments of this axis */
+  uint32_t n;                   /* periods into the phase */
+  uint32_t n_all;               /* periods since it began */
+  float i_ref;                  /* the bias reference, slew-limited [A] */
+  float v_hold[2];              /* the bias' voltage (d, q) held under the injection [V] */
+  float v_h;                    /* the injection's amplitude [V] */
+  float i_prev;                 /* the injected axis' current last period [A] */
+  float acc_d;                  /* the bias current's sum over an injection period [A] */
+  float w[2u * PROC_LDQ_M_MAX]; /* the current summed at each of the wave's periods (5) [A] */
+  uint32_t sn;                  /* ... over this many waves */
+  float i_lo, i_hi;             /* the injected axis' current range [A] */
+  float i_peak;                 /* the largest measured current amplitude [A] */
+  float l[2];                   /* the inductances found (d, q) [H] */
+  float ripple[2];              /* their current ripple, peak to peak [A] */
+  float cross[2];               /* the other axis' ripple over this axis' [-] */
+  float o_lo, o_hi;             /* the other axis' current range under the injection [A] */
 } proc_ldq_t;
 
 typedef union {

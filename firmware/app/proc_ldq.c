@@ -6,27 +6,26 @@
  * aligns a PM rotor's d axis there (a reluctance rotor's high-inductance
  * axis); its voltage is then held (v_hold, trimmed once an injection
  * period on the period's mean current) and a square wave of +-v_h, a half
- * period of M PWM periods (M = 1 / (2 f_h ts), id_ldq_freq), is added
- * along d, then along q. The axis' current follows L di/dt = u - R i~
- * (i~ its deviation from the bias; the bias' constant terms, R i_b and the
- * inverter's error, cancel against v_hold). With the volt-seconds asked
- * up to the sample, psi_k = ts sum_{j<k} u_j (the sample at k reflects the
- * voltage asked at k-1: the one-period delay), the sample is
- *   i_k = A psi_k + B u_{k-1} + C                                      (3)
- * least squares over whole periods of the wave: A = 1/L exactly without
- * R (the zero-order-hold response of an inductance is psi / L), and the
- * resistive lag lands in B (u is orthogonal to psi). For a sinusoid
- * i~ = u / (R + j w L) gives A = w^2 L / (R^2 + w^2 L^2), B = R / (R^2 +
- * w^2 L^2), so
- *   L = A / (A^2 + w^2 B^2),  w = pi / (M ts)                          (4)
- * (the wave's fundamental; on the model its residual is below 2 % at
- * R / (w L) = 0.16, tests/app/test_proc_ldq.c). The bias keeps every phase
- * current's sign through the ripple (d: i_b +- ripple / 2, q: the b, c
- * phases at -i_b / 2 +- 0.87 i_q): the inverter's voltage error stays on
- * its plateau (a constant, in C); below its knee it acts as a resistance
- * (in B). This is the pulse method L = v dt / di (VESC's and ODrive's
- * inductance measurements with square voltages) regressed over many
- * periods against noise, on a bias: on a saturated machine it gives the
+ * period of M PWM periods (M = 1 / (2 f_h ts), id_ldq_freq; 2 .. 16), is added
+ * along d, then along q. The axis' current deviation from the bias
+ * follows L di/dt = u - R i (the bias' constant terms, R i_b and the
+ * inverter's error, cancel against v_hold); its exact zero-order-hold
+ * response, with the sample at k reflecting the voltage asked at k-1 (the
+ * one-period delay), is
+ *   i_{k+1} = alpha i_k + beta u_k + c,
+ *   alpha = exp(-R ts / L), beta = (1 - alpha) / R                      (5)
+ * The samples are averaged at each of the wave's 2M positions over the
+ * waves measured (w_j: the noise down by the square root of their count,
+ * so the least squares of (5) on w_j, cyclic in j, is not biased by noise
+ * in its regressor), and
+ *   L = ts (1 - alpha) / (beta (-ln alpha))   (ts / beta when alpha -> 1) (6)
+ * exact for any R / (w L) and for the inverter's error below its knee,
+ * which acts as a resistance (it enters alpha and beta alike). The bias
+ * keeps every phase current's sign through the ripple (d: i_b +- ripple /
+ * 2, q: the b, c phases at -i_b / 2 +- 0.87 i_q), so the error stays on its
+ * plateau (in c). This is the pulse method L = v dt / di (VESC's and
+ * ODrive's inductance measurements with square voltages), on a bias and
+ * over many periods: on a saturated machine it gives the
  * incremental inductances at (i_b, 0), dpsi_d/di_d and dpsi_q/di_q.
  *
  * The amplitude: from the parameter set's inductance, a quarter of the
@@ -67,7 +66,7 @@ FD_COLD static float ldq_bias(const drive_config_t *c) {
 /* PWM periods of a half injection period (at least 1). */
 FD_COLD static uint32_t ldq_half(const drive_config_t *c) {
   const float m = 0.5f / (c->id_ldq_freq * c->ts);
-  return m < 1.0f ? 1u : (uint32_t)(m + 0.5f);
+  return m < 2.0f ? 2u : m > (float)PROC_LDQ_M_MAX ? PROC_LDQ_M_MAX : (uint32_t)(m + 0.5f);
 }
 
 FD_COLD static bool ldq_wanted(const proc_setup_t *su) {
@@ -81,17 +80,18 @@ FD_COLD static const char *ldq_check(const proc_setup_t *su, const char **field)
     *field = "id_ldq_current";
     return "the bias current must be positive";
   }
-  if (ldq_half(c) * 2u > 4096u) {
+  const float m = 0.5f / (c->id_ldq_freq * c->ts);
+  if (m < 1.5f || m > (float)PROC_LDQ_M_MAX + 0.5f) {
     *field = "id_ldq_freq";
-    return "an injection period of at most 4096 PWM periods";
+    return "a half wave of 2 .. PROC_LDQ_M_MAX PWM periods";
   }
   return NULL;
 }
 
 FD_COLD static void ldq_reset_sums(proc_ldq_t *q) {
-  q->psi = 0.0f;
-  q->v_prev = 0.0f;
-  q->s_pp = q->s_pu = q->s_p = q->s_uu = q->s_u = q->s_py = q->s_uy = q->s_y = 0.0f;
+  for (unsigned j = 0; j < 2u * PROC_LDQ_M_MAX; ++j) {
+    q->w[j] = 0.0f;
+  }
   q->sn = 0u;
   q->i_lo = q->o_lo = 1e30f;
   q->i_hi = q->o_hi = -1e30f;
@@ -110,7 +110,6 @@ FD_COLD static void ldq_init(proc_state_t *st, const proc_setup_t *su) {
   q->i_ref = 0.0f;
   q->v_hold[0] = q->v_hold[1] = 0.0f;
   q->v_h = 0.0f;
-  q->v_prev = 0.0f;
   q->i_peak = 0.0f;
   q->l[0] = q->l[1] = 0.0f;
   q->ripple[0] = q->ripple[1] = 0.0f;
@@ -125,26 +124,44 @@ FD_COLD static float ldq_v_first(const drive_config_t *c, uint8_t axis, float ib
   return 0.25f * PROC_LDQ_RIPPLE * ib * l / ((float)ldq_half(c) * c->ts);
 }
 
-/* The least squares of (3), i = A psi + B u + C, by Cramer's rule on its
- * normal equations (psi and u are centred by the constant): A, B. */
-FD_COLD static bool ldq_solve(const proc_ldq_t *q, float *a, float *b) {
-  const float n = (float)q->sn;
-  if (q->sn < 3u) {
-    return false;
+/* The least squares of (5) on the averaged wave w_j (2m positions,
+ * cyclic: w_{j+1} on w_j and u_j, centred by the constant c), then (6):
+ * L [H], 0 when it has no solution. */
+FD_COLD static float ldq_solve(const proc_ldq_t *q, uint32_t m, float v_h, float ts) {
+  const uint32_t n2 = 2u * m;
+  if (q->sn == 0u || !(v_h > 0.0f)) {
+    return 0.0f;
   }
-  /* centred sums: S_xy - S_x S_y / n */
-  const float pp = q->s_pp - q->s_p * q->s_p / n;
-  const float pu = q->s_pu - q->s_p * q->s_u / n;
-  const float uu = q->s_uu - q->s_u * q->s_u / n;
-  const float py = q->s_py - q->s_p * q->s_y / n;
-  const float uy = q->s_uy - q->s_u * q->s_y / n;
-  const float det = pp * uu - pu * pu;
+  float mw = 0.0f;
+  for (uint32_t j = 0; j < n2; ++j) {
+    mw += q->w[j];
+  }
+  mw /= (float)n2 * (float)q->sn;
+  /* centred: x = w_j - mean, y = w_{j+1} - mean, u_j = +-v_h (mean 0) */
+  float xx = 0.0f, xu = 0.0f, uu = 0.0f, xy = 0.0f, uy = 0.0f;
+  for (uint32_t j = 0; j < n2; ++j) {
+    const float x = q->w[j] / (float)q->sn - mw;
+    const float y = q->w[(j + 1u) % n2] / (float)q->sn - mw;
+    const float u = ((j < m) ? 1.0f : -1.0f) * v_h;
+    xx += x * x;
+    xu += x * u;
+    uu += u * u;
+    xy += x * y;
+    uy += u * y;
+  }
+  const float det = xx * uu - xu * xu;
   if (!(det > 0.0f)) {
-    return false;
+    return 0.0f;
   }
-  *a = (py * uu - uy * pu) / det;
-  *b = (uy * pp - py * pu) / det;
-  return isfinite(*a) && isfinite(*b);
+  const float alpha = (xy * uu - uy * xu) / det;
+  const float beta = (uy * xx - xy * xu) / det;
+  if (!(beta > 0.0f) || !(alpha > 0.0f) || !isfinite(alpha)) {
+    return 0.0f;
+  }
+  /* (6); ts / beta within 1e-3 when 1 - alpha < 2e-3 (the series 1 + x / 2) */
+  const float x = 1.0f - alpha;
+  const float g = x > 2e-3f ? x / -logf(alpha) : 1.0f - 0.5f * x;
+  return ts * g / beta;
 }
 
 FD_COLD static int ldq_step(proc_state_t *st, const proc_setup_t *su, const proc_in_t *in,
@@ -201,36 +218,24 @@ FD_COLD static int ldq_step(proc_state_t *st, const proc_setup_t *su, const proc
   /* the wave starts in the middle of its positive half: the ripple is
    * centred on the bias from the first period on */
   const uint32_t k = (q->n + m / 2u) % (2u * m);
+  const bool trial = q->phase == PH_D_TRY || q->phase == PH_Q_TRY;
   const float vh_max =
       fmaxf(in->v_max - sqrtf(q->v_hold[0] * q->v_hold[0] + q->v_hold[1] * q->v_hold[1]), 0.0f);
   q->v_h = fminf(q->v_h, vh_max);
   const float u = k < m ? q->v_h : -q->v_h;
-  /* (3): the sample against the volt-seconds asked to it and the last
-   * period's voltage (the sample reflects the voltage asked a period
-   * before) */
   /* mut: ldq_delay */
-  q->psi += c->ts * q->v_prev;
-  if (q->n > 0u) {
-    const float p = q->psi, v = q->v_prev;
-    q->s_pp += p * p;
-    q->s_pu += p * v;
-    q->s_p += p;
-    q->s_uu += v * v;
-    q->s_u += v;
-    q->s_py += p * i_x;
-    q->s_uy += v * i_x;
-    q->s_y += i_x;
-    ++q->sn;
+  if (!trial) { /* the sample at its position in the wave (5) */
+    q->w[k] += i_x;
   }
   q->i_lo = fminf(q->i_lo, i_x);
   q->i_hi = fmaxf(q->i_hi, i_x);
   q->o_lo = fminf(q->o_lo, i_o);
   q->o_hi = fmaxf(q->o_hi, i_o);
   q->acc_d += i_d;
-  q->v_prev = u;
   /* an injection period's end: the bias voltage trimmed on its mean
    * current (the apparent resistance v_hold / i_b, PROC_LDQ_TRIM of it) */
   if (k == 2u * m - 1u) {
+    q->sn += trial ? 0u : 1u;
     const float r_app = fabsf(q->v_hold[0]) / ib;
     q->v_hold[0] += PROC_LDQ_TRIM * r_app * (ib - q->acc_d / (float)(2u * m));
     q->acc_d = 0.0f;
@@ -242,7 +247,6 @@ FD_COLD static int ldq_step(proc_state_t *st, const proc_setup_t *su, const proc
   const float sc = vm > in->v_max ? in->v_max / vm : 1.0f;
   out->v_ab = (ab_t){sc * vd, sc * vq};
   ++q->n;
-  const bool trial = q->phase == PH_D_TRY || q->phase == PH_Q_TRY;
   const uint32_t n_meas = ((uint32_t)(c->id_ldq_time / c->ts) / (2u * m) + 1u) * 2u * m;
   const float want = PROC_LDQ_RIPPLE * ib;
   /* a trial ends early when the current leaves 1.5 times the ripple band
@@ -263,17 +267,14 @@ FD_COLD static int ldq_step(proc_state_t *st, const proc_setup_t *su, const proc
     return PROC_RUNNING;
   }
   if (!trial && q->n >= n_meas) {
-    /* (3) solved, then (4) */
-    float a, b;
-    const bool solved = ldq_solve(q, &a, &b);
-    const float w = FRAMES_PI / ((float)m * c->ts);
-    const float den = a * a + w * w * b * b;
-    if (!solved || !(a > 0.0f) || !(den > 0.0f) || !(q->v_h > 0.0f)) {
+    /* (5) solved, (6) */
+    const float l = ldq_solve(q, m, q->v_h, c->ts);
+    if (!(l > 0.0f) || !isfinite(l)) {
       /* no response (an open phase) or no voltage left for the injection */
       out->fault = DRIVE_FAULT_CONTROL;
       return PROC_FAILED;
     }
-    q->l[ax] = a / den;
+    q->l[ax] = l;
     q->ripple[ax] = q->i_hi - q->i_lo;
     q->cross[ax] = q->ripple[ax] > 0.0f ? (q->o_hi - q->o_lo) / q->ripple[ax] : 0.0f;
     ++q->phase;

@@ -124,6 +124,7 @@ static void inductances_within_5_percent(void **state) {
   static const float cases[][4] = {
       {0.05f, 1e-4f, 1.5e-4f, 1.0f}, {0.5f, 1e-3f, 2.5e-3f, 0.3f}, {3.0f, 2e-2f, 3e-2f, 3.0f},
       {2.0f, 0.057f, 0.057f, 1.0f},  {0.2f, 5e-4f, 1.5e-3f, 2.0f}, {1.0f, 4e-3f, 4e-3f, 0.05f},
+      {3.0f, 1e-3f, 2e-3f, 1.0f},    {1.0f, 2e-4f, 3e-4f, 1.0f},
   };
   for (unsigned c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
     const float r = cases[c][0], ld = cases[c][1], lq = cases[c][2];

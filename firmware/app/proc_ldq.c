@@ -10,17 +10,21 @@
  * along d, then along q. The axis' current deviation from the bias
  * follows L di/dt = u - R i (the bias' constant terms, R i_b and the
  * inverter's error, cancel against v_hold); its exact zero-order-hold
- * response, with the sample at k reflecting the voltage asked at k-1 (the
- * one-period delay), is
- *   i_{k+1} = alpha i_k + beta u_k + c,
- *   alpha = exp(-R ts / L), beta = (1 - alpha) / R                      (5)
+ * response, with the voltage asked at k acting over one PWM period that
+ * ends one or two samples later (the timer's preload: the SIL's ISR k
+ * acts over [t_{k+1}, t_{k+2}); a board's sampling point may split it), is
+ *   i_{k+1} = alpha i_k + beta_1 u_k + beta_2 u_{k-1} + c,
+ *   alpha = exp(-R ts / L), beta_1 + beta_2 = beta = (1 - alpha) / R    (5)
+ * (the modified z-transform of the delayed zero-order hold: the split of
+ * beta depends on the delay, the sum does not).
  * The samples are averaged at each of the wave's 2M positions over the
  * waves measured (w_j: the noise down by the square root of their count,
  * so the least squares of (5) on w_j, cyclic in j, is not biased by noise
  * in its regressor), and
  *   L = ts (1 - alpha) / (beta (-ln alpha))   (ts / beta when alpha -> 1) (6)
- * exact for any R / (w L) and for the inverter's error below its knee,
- * which acts as a resistance (it enters alpha and beta alike). The bias
+ * exact for any R / (w L), any delay from one to two periods and the
+ * inverter's error below its knee, which acts as a resistance (it enters
+ * alpha and beta alike). The bias
  * keeps every phase current's sign through the ripple (d: i_b +- ripple /
  * 2, q: the b, c phases at -i_b / 2 +- 0.87 i_q), so the error stays on its
  * plateau (in c). This is the pulse method L = v dt / di (VESC's and
@@ -125,8 +129,8 @@ FD_COLD static float ldq_v_first(const drive_config_t *c, uint8_t axis, float ib
 }
 
 /* The least squares of (5) on the averaged wave w_j (2m positions,
- * cyclic: w_{j+1} on w_j and u_j, centred by the constant c), then (6):
- * L [H], 0 when it has no solution. */
+ * cyclic: w_{j+1} on w_j, u_j and u_{j-1}, centred by the constant c),
+ * then (6) with beta = beta_1 + beta_2: L [H], 0 when it has no solution. */
 FD_COLD static float ldq_solve(const proc_ldq_t *q, uint32_t m, float v_h, float ts) {
   const uint32_t n2 = 2u * m;
   if (q->sn == 0u || !(v_h > 0.0f)) {
@@ -137,31 +141,48 @@ FD_COLD static float ldq_solve(const proc_ldq_t *q, uint32_t m, float v_h, float
     mw += q->w[j];
   }
   mw /= (float)n2 * (float)q->sn;
-  /* centred: x = w_j - mean, y = w_{j+1} - mean, u_j = +-v_h (mean 0) */
-  float xx = 0.0f, xu = 0.0f, uu = 0.0f, xy = 0.0f, uy = 0.0f;
+  /* the normal equations G p = h of the regressors (x, u_j, u_{j-1}),
+   * scaled by v_h (u = +-1) for their conditioning */
+  float g[3][3] = {{0.0f}};
+  float h[3] = {0.0f, 0.0f, 0.0f};
   for (uint32_t j = 0; j < n2; ++j) {
-    const float x = q->w[j] / (float)q->sn - mw;
+    const float r[3] = {q->w[j] / (float)q->sn - mw, (j < m) ? 1.0f : -1.0f,
+                        (((j + n2 - 1u) % n2) < m) ? 1.0f : -1.0f};
     const float y = q->w[(j + 1u) % n2] / (float)q->sn - mw;
-    const float u = ((j < m) ? 1.0f : -1.0f) * v_h;
-    xx += x * x;
-    xu += x * u;
-    uu += u * u;
-    xy += x * y;
-    uy += u * y;
+    for (unsigned a = 0; a < 3u; ++a) {
+      for (unsigned b = 0; b < 3u; ++b) {
+        g[a][b] += r[a] * r[b];
+      }
+      h[a] += r[a] * y;
+    }
   }
-  const float det = xx * uu - xu * xu;
-  if (!(det > 0.0f)) {
+  /* Cramer's rule */
+  const float det = g[0][0] * (g[1][1] * g[2][2] - g[1][2] * g[2][1]) -
+                    g[0][1] * (g[1][0] * g[2][2] - g[1][2] * g[2][0]) +
+                    g[0][2] * (g[1][0] * g[2][1] - g[1][1] * g[2][0]);
+  if (!(fabsf(det) > 0.0f)) {
     return 0.0f;
   }
-  const float alpha = (xy * uu - uy * xu) / det;
-  const float beta = (uy * xx - xy * xu) / det;
+  const float alpha =
+      (h[0] * (g[1][1] * g[2][2] - g[1][2] * g[2][1]) -
+       g[0][1] * (h[1] * g[2][2] - g[1][2] * h[2]) + g[0][2] * (h[1] * g[2][1] - g[1][1] * h[2])) /
+      det;
+  const float b1 = (g[0][0] * (h[1] * g[2][2] - g[1][2] * h[2]) -
+                    h[0] * (g[1][0] * g[2][2] - g[1][2] * g[2][0]) +
+                    g[0][2] * (g[1][0] * h[2] - h[1] * g[2][0])) /
+                   det;
+  const float b2 =
+      (g[0][0] * (g[1][1] * h[2] - h[1] * g[2][1]) - g[0][1] * (g[1][0] * h[2] - h[1] * g[2][0]) +
+       h[0] * (g[1][0] * g[2][1] - g[1][1] * g[2][0])) /
+      det;
+  const float beta = (b1 + b2) / v_h;
   if (!(beta > 0.0f) || !(alpha > 0.0f) || !isfinite(alpha)) {
     return 0.0f;
   }
   /* (6); ts / beta within 1e-3 when 1 - alpha < 2e-3 (the series 1 + x / 2) */
   const float x = 1.0f - alpha;
-  const float g = x > 2e-3f ? x / -logf(alpha) : 1.0f - 0.5f * x;
-  return ts * g / beta;
+  const float gl = x > 2e-3f ? x / -logf(alpha) : 1.0f - 0.5f * x;
+  return ts * gl / beta;
 }
 
 FD_COLD static int ldq_step(proc_state_t *st, const proc_setup_t *su, const proc_in_t *in,

@@ -1,11 +1,10 @@
 /*
  * The ldq identification (proc_ldq.c) without the SIL: on a small
  * standstill R-L model with L_d != L_q (the rotor resting at theta = 0),
- * one period's delay, an inverter voltage error per phase (a knee, a
- * plateau), current noise and quantisation, L_d and L_q within 5 % of the
- * model's (the truth: the model's parameters) over a spread of R, L and
- * saliency, and with the parameter set's inductances far off (the
- * amplitude adapts); the current within 1.5 times the bias; the trip.
+ * one or two periods' delay (the SIL's timer preload), an inverter voltage error per phase (a knee,
+ * a plateau), current noise and quantisation, L_d and L_q within 5 % of the model's (the truth: the
+ * model's parameters) over a spread of R, L and saliency, and with the parameter set's inductances
+ * far off (the amplitude adapts); the current within 1.5 times the bias; the trip.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -39,6 +38,8 @@ typedef struct {
   float i_a, i_b; /* alpha, beta current [A] */
   uint32_t seed;
   float i_peak; /* the largest true current amplitude [A] */
+  int delay2;   /* the voltage acts a period later (the SIL's timer preload) */
+  ab_t pend;    /* then: the voltage asked last period */
 } model_t;
 
 static float model_noise(model_t *m) {
@@ -113,7 +114,9 @@ static int run(model_t *m, proc_telemetry_t *tm, uint32_t max, unsigned *points)
     }
     const float vm = sqrtf(out.v_ab.alpha * out.v_ab.alpha + out.v_ab.beta * out.v_ab.beta);
     assert_true(vm <= 24.0f * 1.0001f);
-    model_step(m, out.apply ? out.v_ab : (ab_t){0.0f, 0.0f}, fx.cfg.ts);
+    const ab_t v = out.apply ? out.v_ab : (ab_t){0.0f, 0.0f};
+    model_step(m, m->delay2 ? m->pend : v, fx.cfg.ts);
+    m->pend = v;
   }
   return res;
 }
@@ -131,7 +134,8 @@ static void inductances_within_5_percent(void **state) {
     fixture(r, ld);
     fx.cfg.ld = ld * cases[c][3];
     fx.cfg.lq = ld * cases[c][3];
-    model_t m = {r, ld, lq, 0.4f, 0.3f, 0.02f, 0.01f, 0.0f, 0.0f, 99u + c, 0.0f};
+    model_t m = {r,    ld,   lq,      0.4f, 0.3f,          0.02f,       0.01f,
+                 0.0f, 0.0f, 99u + c, 0.0f, (int)(c % 2u), {0.0f, 0.0f}};
     proc_telemetry_t tm;
     unsigned points;
     assert_int_equal(run(&m, &tm, 400000u, &points), PROC_DONE);

@@ -166,6 +166,20 @@ typedef struct {
   bool plain;              /* the pattern without the DFC window (a pulse's clean sample) */
 } proc_hold_t;
 
+/* The ldq identification's alignment (proc_ldq.c): the current's
+ * angle at period n of it: pi/2 for n_first periods (a rotor anywhere but
+ * at -pi/2 turns there), then turned to 0 over n_turn (a rotor left at
+ * -pi/2 is 90 degrees off the current then, and follows too), then 0. A
+ * rotor that starts at pi, where a current along 0 holds it unstably (the
+ * rs procedure leaves it there), is aligned all the same. */
+static inline float proc_ident_align_angle(uint32_t n, uint32_t n_first, uint32_t n_turn) {
+  if (n < n_first) {
+    return 0.5f * FRAMES_PI;
+  }
+  const uint32_t k = n - n_first;
+  return k < n_turn ? 0.5f * FRAMES_PI * (1.0f - (float)k / (float)n_turn) : 0.0f;
+}
+
 /* proc_rs.c: R_s and v_err(i) (issue 25 a). Levels of each sign, at most: */
 #define PROC_RS_LEVELS_MAX 12u
 typedef struct {

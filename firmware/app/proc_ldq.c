@@ -2,9 +2,11 @@
  * proc_ldq.c - L_d and L_q at standstill, zero average torque (issue 25,
  * procedure b; docs/commissioning.md, "ldq").
  *
- * A d bias current i_b along theta = 0 (the current loop, current_ctrl.h)
- * aligns a PM rotor's d axis there (a reluctance rotor's high-inductance
- * axis); its voltage is then held (v_hold, trimmed once an injection
+ * A d bias current i_b (the current loop, current_ctrl.h) along pi/2 for
+ * id_rs_align / 2, turned to 0 in PROC_LDQ_TURN and held there for
+ * id_rs_align (proc_ident_align_angle) aligns a PM rotor's d axis at
+ * theta = 0 from anywhere (a reluctance rotor's high-inductance axis);
+ * its voltage is then held (v_hold, trimmed once an injection
  * period on the period's mean current) and a square wave of +-v_h, a half
  * period of M PWM periods (M = 1 / (2 f_h ts), id_ldq_freq; 2 .. 16), is added
  * along d, then along q. The axis' current deviation from the bias
@@ -43,7 +45,8 @@
  * i_max / 2; a measured current above 2 i_b fails it (overcurrent). The q
  * injection's torque averages zero over each period: the rotor wiggles by
  * 1.5 p lambda_m (i_q ripple / 2) / (J (2 pi f_h)^2) (mechanical) about the
- * alignment, which itself turns it by at most half an electrical turn.
+ * alignment, which itself turns it by at most 1.5 pi electrical: the bound
+ * is one electrical turn, 2 pi / p mechanical.
  */
 #include "proc.h"
 
@@ -58,6 +61,7 @@
 #define PROC_LDQ_TRY    4u     /* injection periods of an amplitude trial */
 #define PROC_LDQ_TRIES  8u     /* amplitude trials at most */
 #define PROC_LDQ_RAMP   0.005f /* the bias is ramped over this [s] */
+#define PROC_LDQ_TURN   0.2f   /* the alignment's turn from pi/2 to 0 [s] */
 #define PROC_LDQ_TRIM   0.25f  /* the bias voltage's trim a period, of the apparent resistance */
 
 enum { PH_ALIGN = 0, PH_D_TRY = 1, PH_D = 2, PH_Q_TRY = 3, PH_Q = 4, PH_DONE = 5 };
@@ -208,16 +212,24 @@ FD_COLD static int ldq_step(proc_state_t *st, const proc_setup_t *su, const proc
   }
   const uint32_t m = ldq_half(c);
   if (q->phase == PH_ALIGN) {
-    const uint32_t n_align = (uint32_t)(c->id_rs_align / c->ts) + 1u;
-    const float slew = ib * c->ts / PROC_LDQ_RAMP;
+    const uint32_t n_hold = (uint32_t)(c->id_rs_align / c->ts) + 1u;
+    const uint32_t n_turn = (uint32_t)(PROC_LDQ_TURN / c->ts) + 1u;
+    const uint32_t n_align = n_hold / 2u + n_turn + n_hold;
+    /* the bias from 0 over the first part (id_rs_align / 2): a rotor far
+     * from the current's axis breaks away at a small current and swings
+     * little (proc_rs.c) */
+    const float slew = ib * c->ts / fmaxf(0.5f * c->id_rs_align, PROC_LDQ_RAMP);
     q->i_ref += fd_clampf(ib - q->i_ref, -slew, slew);
-    const dq_t v =
-        current_ctrl_update(&q->cc, (dq_t){q->i_ref, 0.0f}, (dq_t){i_d, i_q}, 0.0f, in->v_max);
-    out->v_ab = (ab_t){v.d, v.q};
-    /* the bias' voltage: the loop's mean over the last quarter */
+    /* the loop in the frame of the alignment's angle (proc.h) */
+    const sincos_t sc = frames_sincos(proc_ident_align_angle(q->n, n_hold / 2u, n_turn));
+    const dq_t i_f = {sc.c * i_d + sc.s * i_q, -sc.s * i_d + sc.c * i_q};
+    const dq_t v = current_ctrl_update(&q->cc, (dq_t){q->i_ref, 0.0f}, i_f, 0.0f, in->v_max);
+    out->v_ab = (ab_t){sc.c * v.d - sc.s * v.q, sc.s * v.d + sc.c * v.q};
+    /* the bias' voltage (alpha, beta = d, q at 0): the loop's mean over
+     * the last quarter (within the hold at 0) */
     if (q->n >= n_align - n_align / 4u) {
-      q->v_hold[0] += v.d;
-      q->v_hold[1] += v.q;
+      q->v_hold[0] += out->v_ab.alpha;
+      q->v_hold[1] += out->v_ab.beta;
       q->acc_d += 1.0f;
     }
     if (++q->n >= n_align) {

@@ -75,7 +75,11 @@ static void rows_agree_with_the_list(void **state) {
     assert_non_null(r->publish);
     /* a procedure shows as a start state: gates off or on by its caps */
     const bool gates = (r->caps & PROC_CAP_GATES) != 0u;
-    assert_int_equal(r->state, gates ? DRIVE_STATE_ALIGN : DRIVE_STATE_OFFSET_CAL);
+    /* (an identification that modulates: the ident state) */
+    const bool ident = gates && (r->caps & PROC_CAP_IDENT) != 0u;
+    assert_int_equal(r->state, ident   ? DRIVE_STATE_IDENT
+                               : gates ? DRIVE_STATE_ALIGN
+                                       : DRIVE_STATE_OFFSET_CAL);
   }
   assert_null(proc_row(PROC_COUNT));
   assert_null(proc_row((proc_id_t)1000));

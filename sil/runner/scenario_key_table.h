@@ -237,6 +237,13 @@
     SK_PROFILE_DOC("q current reference [A] (current mode)"))                                      \
   X(K_R_FLUX, .parent = K_REFERENCES, .key = "flux", AT(PROFILE, ref.flux),                        \
     SK_PROFILE_DOC("flux reference [Vs], 0 = automatic"))                                          \
+  /* ---- commission ---- */                                                                       \
+  X(K_COMMISSION, .parent = K_ROOT, .key = "commission", .type = SK_OBJECTS,                        \
+    .max = SIL_COMMISSION_MAX, .stride = sizeof(int), .set = commission_pre, .post = commission_post, \
+    .doc = "identification procedures run in turn, drive disabled, before the enable (docs/commissioning.md)") \
+  X(K_CM_PROC, .parent = K_COMMISSION, .key = "proc", .type = SK_ENUM, .name_of = sil_proc_name,   \
+    .req = "an identification procedure", .set = commission_proc, AT(INT, commission.proc[0]),     \
+    .doc = "the procedure (proc.h: a row with PROC_CAP_IDENT)")                                   \
   /* ---- inject ---- */                                                                           \
   X(K_INJECT, .parent = K_ROOT, .key = "inject", .type = SK_OBJECT, .post = inject_post,           \
     .doc = "injected failures")                                                                    \

@@ -13,9 +13,11 @@
  * and averages to zero: the rotor, free, only rocks. The flux is the
  * integral of the stator voltage equation at standstill,
  *
- *   psi_dq(t) - psi_dq(0) = int_0^t (v_dq - R_s i_dq) dt          (1)
+ *   psi_dq(t) - psi_dq(0) = int_0^t (v_dq - R_s i_dq - j omega psi_dq) dt  (1)
  *
- * (Pescetto 2018 eq. (1)-(2); omega ~ 0), over each half cycle: from zero
+ * (Pescetto 2018 eq. (1)-(2); the omega term, the frame following the
+ * rocking rotor, from the position source's turn each period), over each
+ * half cycle: from zero
  * current to the point (i_d, s I) (s = +1, -1), dwell there, back to zero,
  * dwell. The flux change over the whole half cycle is zero (the same
  * current at both ends: the loop closes), so what (1) leaves at the end is
@@ -57,7 +59,10 @@
  * 4 FMAP_CYCLES dwells each). Results (publish): [0] psi_d [Vs], [1] psi_q
  * [Vs], [2] i_d, [3] i_q [A] (the measured point), [4] i_d, [5] i_q the
  * reference [A], [6] the resistance correction r of (2) on q [Ohm], [7]
- * points done.
+ * the phase of the point these are (1 + k nd + j; 0: none done yet), so
+ * that a reader that samples the telemetry slower than the ISR (the main
+ * loop, the host over CAN) pairs them right: each point's results stay
+ * for the whole next point.
  */
 #include "proc.h"
 
@@ -71,6 +76,7 @@
 #define FMAP_AVG    4u    /* the average over the last 1/FMAP_AVG of a dwell */
 #define FMAP_TRIP   1.25f /* the current bound's margin on I_g */
 #define FMAP_POINTS 254u  /* at most: the phase is a uint8 (0: none done yet) */
+#define FMAP_SHOW   64u   /* periods a point's results show before the next phase */
 
 enum { SEG_POINT = 0, SEG_ZERO = 1, SEG_SHOW = 2 };
 
@@ -152,10 +158,17 @@ FD_COLD static float fmap_closed(float phi1, float q1, float phi2, float q2, flo
   return phi1 - *r * q1;
 }
 
+/* the sign of i_q in half cycle h: + - - + + - - + ... (Gray code), so
+ * that the second cycle turns the rotor back by what the first turned it
+ * (+ then - leaves it displaced by the speed gained, - then + undoes it) */
+FD_COLD static float fmap_sign(uint8_t h) {
+  return ((h ^ (h >> 1u)) & 1u) == 0u ? 1.0f : -1.0f;
+}
+
 /* one half cycle done: its changes (2) into the point's sums (3) */
 FD_COLD static void fmap_half(proc_fmap_t *f, const drive_config_t *c) {
   const float k = 1.0f / (float)(fmap_dwell(c) / FMAP_AVG);
-  const float s = (f->half & 1u) == 0u ? 1.0f : -1.0f; /* i_q = s I */
+  const float s = fmap_sign(f->half); /* i_q = s I */
   float r_d, r_q;
   const float dd = fmap_closed(f->phi1.d * k, f->q1.d * k, f->phi2.d * k, f->q2.d * k, &r_d);
   const float dq = fmap_closed(f->phi1.q * k, f->q1.q * k, f->phi2.q * k, f->q2.q * k, &r_q);
@@ -174,8 +187,12 @@ FD_COLD static int fmap_step(proc_state_t *st, const proc_setup_t *su, const pro
   const uint16_t n_dw = fmap_dwell(c);
   const uint16_t n_avg = (uint16_t)(n_dw / FMAP_AVG);
   f->n++;
+  float dth = 0.0f; /* the frame's turn this period [rad electrical] */
   if (in->pos->valid) {
-    f->theta = in->pos->theta; /* the d axis; the frame follows the rocking rotor */
+    /* the d axis; the frame follows the rocking rotor */
+    dth = frames_wrap_pi(in->pos->theta - f->theta);
+    dth = f->n > 1u ? dth : 0.0f;
+    f->theta = in->pos->theta;
   }
   const sincos_t sc = frames_sincos(f->theta);
   const dq_t i = frames_park(in->i_ab, sc);
@@ -188,22 +205,31 @@ FD_COLD static int fmap_step(proc_state_t *st, const proc_setup_t *su, const pro
    * trapezoid */
   const dq_t im = {0.5f * (i.d + f->i_prev.d), 0.5f * (i.q + f->i_prev.q)};
   f->i_prev = i;
-  f->phi.d += (f->v_prev.d - c->rs * im.d) * c->ts;
-  f->phi.q += (f->v_prev.q - c->rs * im.q) * c->ts;
+  /* the rotor frame turning with the rocking rotor: d psi_dq / dt = v - R i
+   * - j omega psi_dq (the dq voltage equation; omega dt = the frame's
+   * turn), psi = (lambda_m, 0) + phi over the half */
+  const float psd = c->lambda_m + f->phi.d, psq = f->phi.q;
+  /* mut: fmap_frame_turn */
+  f->phi.d += (f->v_prev.d - c->rs * im.d) * c->ts + dth * psq;
+  f->phi.q += (f->v_prev.q - c->rs * im.q) * c->ts - dth * psd;
   f->q.d += im.d * c->ts;
   f->q.q += im.q * c->ts;
   if (f->seg == SEG_SHOW) {
-    /* the point's results shown for a period: on to the next */
-    f->point = fmap_next(c, (uint16_t)(f->point + 1u));
-    if (f->point >= (unsigned)c->id_fmap_nd * c->id_fmap_nq) {
-      *out = (proc_out_t){{0.0f, 0.0f}, false, false, 0u};
-      return PROC_DONE;
+    /* the point's results shown for FMAP_SHOW periods (a reader at the
+     * main loop's rate sees them under the point's phase; the current held
+     * at zero): on to the next */
+    if (++f->m >= FMAP_SHOW) {
+      f->point = fmap_next(c, (uint16_t)(f->point + 1u));
+      if (f->point >= (unsigned)c->id_fmap_nd * c->id_fmap_nq) {
+        *out = (proc_out_t){{0.0f, 0.0f}, false, false, 0u};
+        return PROC_DONE;
+      }
+      f->phase = (uint8_t)(f->point + 1u);
+      f->seg = SEG_POINT;
+      f->m = 0u;
+      f->half = 0u;
+      f->phi = f->q = (dq_t){0.0f, 0.0f};
     }
-    f->phase = (uint8_t)(f->point + 1u);
-    f->seg = SEG_POINT;
-    f->m = 0u;
-    f->half = 0u;
-    f->phi = f->q = (dq_t){0.0f, 0.0f};
   } else if (++f->m > n_dw - n_avg) {
     /* the last quarter of the dwell: the averages */
     if (f->seg == SEG_POINT) {
@@ -233,11 +259,12 @@ FD_COLD static int fmap_step(proc_state_t *st, const proc_setup_t *su, const pro
           f->res[3] = f->acc[3] * kh;
           f->res[4] = ref.d;
           f->res[5] = ref.q;
-          f->res[7] += 1.0f;
+          f->res[7] = (float)(f->point + 1u); /* whose results: its phase */
           for (int x = 0; x < 4; ++x) {
             f->acc[x] = 0.0f;
           }
           f->seg = SEG_SHOW;
+          f->m = 0u;
         }
       }
     }
@@ -245,7 +272,7 @@ FD_COLD static int fmap_step(proc_state_t *st, const proc_setup_t *su, const pro
   dq_t ref = {0.0f, 0.0f};
   if (f->seg == SEG_POINT) {
     ref = fmap_ref(c, f->point);
-    ref.q = (f->half & 1u) == 0u ? ref.q : -ref.q;
+    ref.q *= fmap_sign(f->half);
   }
   const dq_t v = current_ctrl_update(&f->cc, ref, i, 0.0f, in->v_max);
   f->v_prev = v;

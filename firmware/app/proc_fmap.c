@@ -22,17 +22,20 @@
  * dwell. The flux change over the whole half cycle is zero (the same
  * current at both ends: the loop closes), so what (1) leaves at the end is
  * the integral of the error of the voltage (the inverter's error, R_s's
- * error): taking it as a resistance, r = e_2 / Q_2 (Q = int i dt, per
- * axis), the change to the point is
+ * error): taking it along the current's direction, r = e_2 / Q_2 (Q = int
+ * i / |i| dt per axis, a smooth sign: a dead time's or a device threshold's
+ * error follows the current's sign, not its size), the change to the point
+ * is
  *
  *   dpsi = psi(t_1) - r Q(t_1)                                      (2)
  *
  * (the loop-closure correction: Pescetto 2018 sec. III, where the drift of
- * the integrated flux over each cycle is removed; here in proportion to the
- * current's integral, which a dead-time or device-drop error at the point's
- * current follows). With psi_q(i_d, 0) = 0 and psi_d(0, 0) = lambda_m (the
- * PM flux: procedure f's result, the parameter lambda_m; 0 for SyR, which
- * standstill cannot see: the flux at zero current),
+ * the integrated flux over each cycle is removed; not on an axis the
+ * current hardly points along, Q_2 below a tenth of a dwell). The current
+ * loop's integrators are cleared as the current goes back to zero, so that
+ * no tail of current (and of the inverter's error on it) is left. With psi_q(i_d, 0) = 0 and
+ * psi_d(0, 0) = lambda_m (the PM flux: procedure f's result, the parameter lambda_m; 0 for SyR,
+ * which standstill cannot see: the flux at zero current),
  *
  *   psi_d(i_d, I) = lambda_m + (dpsi_d(+) + dpsi_d(-)) / 2
  *   psi_q(i_d, I) = (dpsi_q(+) - dpsi_q(-)) / 2                     (3)
@@ -76,6 +79,7 @@
 #define FMAP_AVG    4u    /* the average over the last 1/FMAP_AVG of a dwell */
 #define FMAP_TRIP   1.25f /* the current bound's margin on I_g */
 #define FMAP_POINTS 254u  /* at most: the phase is a uint8 (0: none done yet) */
+#define FMAP_BAND   0.05f /* the smooth sign's band of the error's weight, x i_max */
 #define FMAP_SHOW   64u   /* periods a point's results show before the next phase */
 
 enum { SEG_POINT = 0, SEG_ZERO = 1, SEG_SHOW = 2 };
@@ -151,10 +155,12 @@ FD_COLD static void fmap_init(proc_state_t *st, const proc_setup_t *su) {
 }
 
 /* the loop-closure correction (2) on one axis: the change to the point */
-FD_COLD static float fmap_closed(float phi1, float q1, float phi2, float q2, float *r) {
-  /* a current integral too small to carry an error (a zero bias): none */
+FD_COLD static float fmap_closed(float phi1, float q1, float phi2, float q2, float q_min,
+                                 float *r) {
+  /* an axis the current hardly points along (a zero bias) carries too
+   * little of the error to find it: none */
   /* mut: fmap_closure */
-  *r = fabsf(q2) > 1e-9f ? phi2 / q2 : 0.0f;
+  *r = fabsf(q2) > q_min ? phi2 / q2 : 0.0f;
   return phi1 - *r * q1;
 }
 
@@ -170,8 +176,10 @@ FD_COLD static void fmap_half(proc_fmap_t *f, const drive_config_t *c) {
   const float k = 1.0f / (float)(fmap_dwell(c) / FMAP_AVG);
   const float s = fmap_sign(f->half); /* i_q = s I */
   float r_d, r_q;
-  const float dd = fmap_closed(f->phi1.d * k, f->q1.d * k, f->phi2.d * k, f->q2.d * k, &r_d);
-  const float dq = fmap_closed(f->phi1.q * k, f->q1.q * k, f->phi2.q * k, f->q2.q * k, &r_q);
+  /* the error's weight over a tenth of a dwell at the least */
+  const float q_min = 0.1f * (float)fmap_dwell(c) * c->ts;
+  const float dd = fmap_closed(f->phi1.d * k, f->q1.d * k, f->phi2.d * k, f->q2.d * k, q_min, &r_d);
+  const float dq = fmap_closed(f->phi1.q * k, f->q1.q * k, f->phi2.q * k, f->q2.q * k, q_min, &r_q);
   f->acc[0] += dd;
   /* mut: fmap_q_sign */
   f->acc[1] += s * dq;
@@ -212,8 +220,12 @@ FD_COLD static int fmap_step(proc_state_t *st, const proc_setup_t *su, const pro
   /* mut: fmap_frame_turn */
   f->phi.d += (f->v_prev.d - c->rs * im.d) * c->ts + dth * psq;
   f->phi.q += (f->v_prev.q - c->rs * im.q) * c->ts - dth * psd;
-  f->q.d += im.d * c->ts;
-  f->q.q += im.q * c->ts;
+  /* the weight of the voltage error (2): the current's direction, i / |i|
+   * (a smooth sign over FMAP_BAND i_max): a dead time's or a device's
+   * threshold error follows the current's sign, not its size */
+  const float ia = fmaxf(sqrtf(im.d * im.d + im.q * im.q), FMAP_BAND * c->i_max);
+  f->q.d += im.d / ia * c->ts;
+  f->q.q += im.q / ia * c->ts;
   if (f->seg == SEG_SHOW) {
     /* the point's results shown for FMAP_SHOW periods (a reader at the
      * main loop's rate sees them under the point's phase; the current held
@@ -243,6 +255,11 @@ FD_COLD static int fmap_step(proc_state_t *st, const proc_setup_t *su, const pro
     if (f->m >= n_dw) {
       f->m = 0u;
       if (f->seg == SEG_POINT) {
+        /* back to zero with the loop's integrators cleared: what they hold
+         * (R i and the inverter's error at the point) would otherwise keep
+         * a current's tail for L / R, and the inverter's error on it (a
+         * dead time's: its sign, not its size) would spoil (2) */
+        current_ctrl_reset(&f->cc);
         f->seg = SEG_ZERO;
       } else {
         fmap_half(f, c);

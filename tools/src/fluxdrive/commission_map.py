@@ -54,9 +54,12 @@ class Point:
     iq_ref: float
 
 
-def points_of(record: dict) -> list[Point]:
+def points_of(record: dict, lambda_m: float = 0.0) -> list[Point]:
     """The procedure's points from a summary's commission record (fmap):
-    those whose result[7] names their phase, once each."""
+    those whose result[7] names their phase, once each. lambda_m: the PM
+    flux to add to psi_d (standstill cannot see the flux at zero current:
+    procedure f's result, when the drive's parameter lambda_m was not set
+    to it while the procedure ran)."""
     out: dict[int, Point] = {}
     rows = list(record.get("points", [])) + [[0] + list(record.get("result", []))]
     for row in rows:
@@ -66,7 +69,7 @@ def points_of(record: dict) -> list[Point]:
         ph = int(round(r[7]))
         if ph <= 0 or not all(np.isfinite(r)):
             continue
-        out[ph] = Point(ph, r[0], r[1], r[2], r[3], r[4], r[5])
+        out[ph] = Point(ph, r[0] + lambda_m, r[1], r[2], r[3], r[4], r[5])
     return [out[k] for k in sorted(out)]
 
 
@@ -231,6 +234,9 @@ def main(argv=None) -> int:
     ap.add_argument("summary")
     ap.add_argument("--scenario", required=True)
     ap.add_argument("--out", default=None, help="folder: the blob, the plot, errors.json")
+    ap.add_argument("--lambda-m", type=float, default=None,
+                    help="PM flux to add to psi_d [Vs] (procedure f's result; default: the "
+                         "plant map's flux at zero current, the truth, for a SIL run)")
     a = ap.parse_args(argv)
     summ = json.loads(Path(a.summary).read_text())
     scen = json.loads(Path(a.scenario).read_text())
@@ -238,7 +244,8 @@ def main(argv=None) -> int:
     ctl = scen.get("controller", {})
     nd, nq = int(ctl.get("id_fmap_nd", 9)), int(ctl.get("id_fmap_nq", 5))
     truth = truth_of(scen, Path(a.scenario).parent)
-    pts = points_of(rec)
+    lam = truth.pm_flux() if a.lambda_m is None else a.lambda_m
+    pts = points_of(rec, lam)
     ident, measured = assemble(pts, nd, nq, truth.pole_pairs)
     i_max = float(ctl.get("i_max", 3.5355339))
     e = errors(ident, measured, pts, truth, min(i_max, float(ctl.get("id_fmap_current", 3.5))))

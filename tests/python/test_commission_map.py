@@ -1,6 +1,7 @@
 """Issue 25 procedure c: the flux maps at standstill (firmware/app/proc_fmap.c)
 run in the SIL on the flux-map presets, rotor free, average inverter with
-its 1 us dead time, current and voltage noise, a 4096-count encoder; the
+its 1 us dead time and device drops (switch 0.8 V + 50 mOhm, diode 1.0 V +
+30 mOhm), current and voltage noise, a 4096-count encoder; the
 points assembled on the host (fluxdrive.commission_map) and compared with
 the plant's map. Limits from the issue: the maps within 3 % rms and 6 %
 worst over the identified range (|psi - psi_true| over the largest
@@ -39,7 +40,8 @@ def scenario(preset: str) -> dict:
         "name": f"fmap on {preset}",
         "duration": 6.0,
         "machine": {"preset": preset},
-        "inverter": {"model": "average", "dead_time": 1e-6},
+        "inverter": {"model": "average", "dead_time": 1e-6, "v_th_sw": 0.8, "r_on_sw": 0.05,
+                     "v_f_diode": 1.0, "r_diode": 0.03},
         "mechanics": {"mode": "free"},
         "sensors": {"v_full_scale": 1000, "i_noise": 0.002, "v_noise": 0.1, "encoder_cpr": 4096},
         "controller": {"law": "foc", "mode": "torque", "i_max": i_max, "i_trip": 1.5 * i_max,

@@ -173,7 +173,9 @@ FD_COLD static float fmap_sign(uint8_t h) {
 
 /* one half cycle done: its changes (2) into the point's sums (3) */
 FD_COLD static void fmap_half(proc_fmap_t *f, const drive_config_t *c) {
-  const float k = 1.0f / (float)(fmap_dwell(c) / FMAP_AVG);
+  /* the periods averaged: the step's n_avg, a whole number */
+  const unsigned n_avg = (unsigned)fmap_dwell(c) / FMAP_AVG;
+  const float k = 1.0f / (float)n_avg;
   const float s = fmap_sign(f->half); /* i_q = s I */
   float r_d, r_q;
   /* the error's weight over a tenth of a dwell at the least */

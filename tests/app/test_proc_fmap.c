@@ -15,7 +15,6 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include <cmocka.h>
@@ -137,9 +136,8 @@ static run_t run(float r_plant, float v_err, float i_trip_at) {
   for (int p = 0; p < r.points; ++p) {
     const dq_t t = model_flux(&mdl, (dq_t){pts[p][2], pts[p][3]});
     const float e = fmaxf(fabsf(pts[p][0] - t.d), fabsf(pts[p][1] - t.q)) / psi_max;
-    if (getenv("FMAP_DEBUG"))
-      print_message("%d %f %f: %f %f | %f %f\n", p, (double)pts[p][2], (double)pts[p][3],
-                    (double)pts[p][0], (double)t.d, (double)pts[p][1], (double)t.q);
+    print_message("%d %f %f: %f %f | %f %f\n", p, (double)pts[p][2], (double)pts[p][3],
+                  (double)pts[p][0], (double)t.d, (double)pts[p][1], (double)t.q);
     e2 += e * e;
     r.err_max = fmaxf(r.err_max, e);
   }

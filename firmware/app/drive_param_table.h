@@ -140,6 +140,13 @@
     "alignment before run: d current along the assumed axis for this long (0: no alignment, else >= ts)")               \
   X(45, align_current,  F32,  "A",      1.0f,        0.0f,    1e4f,     IDLE, "controller.align_current",  \
     "d current of the alignment")                                                                           \
+  /* identification with an encoder (issue 25 d-g; proc_poles.c, proc_enc.c, proc_flux.c, proc_mech.c) */ \
+  X(200, id_i_test,     F32,  "A",      0.0f,        0.0f,    1e4f,     IDLE, "controller.id_i_test",      \
+    "identification: test current amplitude (poles, enc: the turned vector; flux: the d current; mech: the q current of the torque steps); clamped to i_max; 0: 0.3 i_max") \
+  X(201, id_speed,      F32,  "rad/s",  0.0f,        0.0f,    1e5f,     IDLE, "controller.id_speed",       \
+    "identification: speed of the PM flux measurement (flux), mechanical; 0: 0.2 speed_max; at most id_speed_max") \
+  X(202, id_speed_max,  F32,  "rad/s",  0.0f,        0.0f,    1e5f,     IDLE, "controller.id_speed_max",   \
+    "identification: speed bound of the spinning procedures (flux, mech), mechanical: mech accelerates to 0.8 of it, either trips overspeed above 1.2 of it; 0: 0.3 speed_max") \
   X(61, start_mode,     U16,  "",       0.0f,        0.0f,    1.0f,     IDLE, "controller.start_mode",     \
     "start of a position source: 0 align (d current along theta = 0 for align_time, the rotor turns), 1 hold (star point: angle at standstill, polarity from d-axis saturation pulses, no free rotor)") \
   X(46, pos_err_max,    F32,  "rad",    0.5f,        0.01f,   3.2f,     LIVE, "controller.pos_err_max",    \

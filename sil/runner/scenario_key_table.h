@@ -208,6 +208,8 @@
   X(K_CONTROLLER, .parent = K_ROOT, .key = "controller", .type = SK_OBJECT, .params = 1,           \
     .set = controller_params,                                                                      \
     .doc = "the drive's parameters (`docs/parameters.md`)")                \
+  X(K_C_MAP, .parent = K_CONTROLLER, .key = "map", .type = SK_STRING, .set = controller_map,       \
+    .dflt = "the machine's", .doc = "the drive's own flux map (a commissioned one), the plant keeping machine.map") \
   X(K_C_ESTIMATES, .parent = K_CONTROLLER, .key = "estimates", .type = SK_OBJECT,                  \
     .post = estimates_post, .doc = "detuning: the controller's machine as factors of the plant's") \
   X(K_C_E_RS, .parent = K_C_ESTIMATES, .key = "rs_scale", .type = SK_NUM, RANGE(0.1, 10.0),        \
@@ -237,6 +239,13 @@
     SK_PROFILE_DOC("q current reference [A] (current mode)"))                                      \
   X(K_R_FLUX, .parent = K_REFERENCES, .key = "flux", AT(PROFILE, ref.flux),                        \
     SK_PROFILE_DOC("flux reference [Vs], 0 = automatic"))                                          \
+  /* ---- commission ---- */                                                                       \
+  X(K_COMMISSION, .parent = K_ROOT, .key = "commission", .type = SK_OBJECTS,                        \
+    .max = SIL_COMMISSION_MAX, .stride = sizeof(int), .set = commission_pre, .post = commission_post, \
+    .doc = "identification procedures run in turn, drive disabled, before the enable (docs/commissioning.md)") \
+  X(K_CM_PROC, .parent = K_COMMISSION, .key = "proc", .type = SK_ENUM, .name_of = sil_proc_name,   \
+    .req = "an identification procedure", .set = commission_proc, AT(INT, commission.proc[0]),     \
+    .doc = "the procedure (proc.h: a row with PROC_CAP_IDENT)")                                   \
   /* ---- inject ---- */                                                                           \
   X(K_INJECT, .parent = K_ROOT, .key = "inject", .type = SK_OBJECT, .post = inject_post,           \
     .doc = "injected failures")                                                                    \

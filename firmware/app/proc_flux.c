@@ -79,7 +79,7 @@ FD_COLD static float flux_lambda(const machine_t *m, const float mean[4], float 
     return 0.0f;
   }
   const float ud = mean[2] / i, uq = mean[3] / i;
-  /* mut: flux_cross_projection */
+  /* mut: flux_inductance_term */
   const float vn = -uq * mean[0] + ud * mean[1];
   return (vn / w - i * (m->lq * uq * uq + m->ld * ud * ud)) / ud;
 }

@@ -122,8 +122,8 @@ FD_COLD static void mech_block(proc_mech_t *m, const drive_config_t *c, float th
     }
     if (++m->win_n >= PROC_MECH_NW) {
       const mech_scale_t s = mech_scale(c);
+      /* mut: mech_coulomb_column */
       const float a[3] = {(x[1] - m->w0) / s.w_s, m->win[0] / s.t_w, m->win[1] / (s.w_s * s.t_w)};
-      /* mut: mech_row_torque */
       ident_mech_add(m->ls, a, m->win[2] / (s.t_s * s.t_w));
       m->rows++;
       m->win[0] = m->win[1] = m->win[2] = 0.0f;

@@ -100,6 +100,9 @@ def _check(out: dict, tr: dict, friction: bool = False) -> list[str]:
     c = {x["proc"]: x for x in out["commission"]}
     bad = []
     for p in PROCS:
+        if p not in c:
+            bad.append(f"{p}: not run (a procedure before it failed)")
+            continue
         if c[p]["status"] != "done":
             bad.append(f"{p}: {c[p]['status']} {c[p]['fault']}")
         bound = 1.3 * I_TEST * tr["i_max"] + 0.05 * tr["i_max"]

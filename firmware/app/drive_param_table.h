@@ -148,6 +148,13 @@
     "flux maps: grid points along i_q (0 .. range; i_q bipolar)")                                          \
   X(211, id_fmap_dwell, F32,  "s",      0.003f,      1e-4f,   1.0f,     IDLE, "controller.id_fmap_dwell",  \
     "flux maps: dwell at each current level (the point, zero)")                                           \
+  /* identification with an encoder (issue 25 d-g; proc_poles.c, proc_enc.c, proc_flux.c, proc_mech.c) */ \
+  X(212, id_i_test,     F32,  "A",      0.0f,        0.0f,    1e4f,     IDLE, "controller.id_i_test",      \
+    "identification: test current amplitude (poles, enc: the turned vector; flux: the d current; mech: the q current of the torque steps); clamped to i_max; 0: 0.3 i_max") \
+  X(213, id_speed,      F32,  "rad/s",  0.0f,        0.0f,    1e5f,     IDLE, "controller.id_speed",       \
+    "identification: speed of the PM flux measurement (flux), mechanical; 0: 0.2 speed_max; at most id_speed_max") \
+  X(214, id_speed_max,  F32,  "rad/s",  0.0f,        0.0f,    1e5f,     IDLE, "controller.id_speed_max",   \
+    "identification: speed bound of the spinning procedures (flux, mech), mechanical: mech accelerates to 0.8 of it, either trips overspeed above 1.2 of it; 0: 0.3 speed_max") \
   X(61, start_mode,     U16,  "",       0.0f,        0.0f,    1.0f,     IDLE, "controller.start_mode",     \
     "start of a position source: 0 align (d current along theta = 0 for align_time, the rotor turns), 1 hold (star point: angle at standstill, polarity from d-axis saturation pulses, no free rotor)") \
   X(46, pos_err_max,    F32,  "rad",    0.5f,        0.01f,   3.2f,     LIVE, "controller.pos_err_max",    \

@@ -57,7 +57,13 @@
     "identification: R_s and the inverter's voltage error v_err(i) from DC levels, both signs")    \
   X(LDQ, ldq,                                                                                      \
     "identification: L_d, L_q at standstill, square-wave voltage injection along d, then q")  \
-  X(FMAP, fmap, "flux maps at standstill: bipolar i_q on an i_d bias per grid point (issue 25 c)")
+  X(FMAP, fmap, "flux maps at standstill: bipolar i_q on an i_d bias per grid point (issue 25 c)")  \
+  X(POLES, poles,                                                                                  \
+    "identification: pole pairs and polarity, a current vector turned slowly (encoder)")           \
+  X(ENC, enc, "identification: encoder offset and direction, the rotor held at angles both ways")  \
+  X(FLUX, flux, "identification: PM flux lambda_m at id_speed both ways (encoder, current loop)")  \
+  X(MECH, mech,                                                                                    \
+    "identification: inertia J, Coulomb and viscous friction from torque steps (encoder)")
 
 #define PROC_ENUM(E, n, d) PROC_##E,
 typedef enum { PROC_LIST(PROC_ENUM) PROC_COUNT } proc_id_t;
@@ -244,6 +250,82 @@ typedef struct {
   float acc[4];            /* the point's sums over its halves: psi_d, psi_q, i_d, i_q */
   float res[PROC_RESULTS]; /* the last point done (publish) */
 } proc_fmap_t;
+/* The encoder identifications' shared view of the encoder (proc_poles.c):
+ * the mechanical angle unwrapped from their start [rad]. */
+typedef struct {
+  float prev;  /* the last reading [rad mechanical, 0 .. 2 pi) */
+  float theta; /* unwrapped from the start [rad mechanical] */
+  bool started;
+} proc_enc_unwrap_t;
+
+/* proc_poles.c: a current vector of amplitude i turned slowly (I-f). */
+typedef struct {
+  current_ctrl_t cc;   /* the current loop in the alpha-beta frame */
+  proc_enc_unwrap_t u; /* the encoder */
+  uint32_t n, n_all;   /* periods into the phase, since it began */
+  uint8_t phase;       /* proc_poles.c: PH_* */
+  float theta_v;       /* the vector's angle [rad electrical] */
+  float acc;           /* sum of the unwrapped angle over the hold's window */
+  uint32_t acc_n;
+  float th0, th1; /* the rotor's rest angle before and after the turns [rad mechanical] */
+  float pp;       /* pole pairs measured (not rounded), signed by the direction */
+} proc_poles_t;
+
+/* proc_enc.c: the rotor held at angles both ways. */
+typedef struct {
+  current_ctrl_t cc;
+  proc_enc_unwrap_t u;
+  uint32_t n, n_all;
+  uint8_t point;      /* the hold point: 0 .. 2 PROC_ENC_POINTS - 1 (forward, then back) */
+  float theta_v;      /* the vector's angle asked (before the damping) [rad electrical] */
+  float th_start;     /* the unwrapped angle at the forward pass's first point [rad mechanical] */
+  float move;         /* the unwrapped movement of the forward pass [rad mechanical] */
+  float s[2][2];      /* sum of (cos, sin) of (encoder - vector) per direction */
+  float e[2];         /* the offset found per direction [rad electrical] */
+  float acc_c, acc_s; /* the point's sums */
+  uint32_t acc_n;
+  float dir; /* +1, -1: the encoder counts with the vector's angle or against it */
+} proc_enc_t;
+
+/* proc_flux.c: the rotor spun by the current loop on the encoder. */
+typedef struct {
+  current_ctrl_t cc;
+  proc_enc_unwrap_t u;
+  uint32_t n, n_all;
+  uint8_t phase;
+  float w_ref;  /* the speed reference [rad/s mechanical] */
+  float th0;    /* the unwrapped angle at the window's start [rad mechanical] */
+  float sum[4]; /* over the window: v_d, v_q, i_d, i_q */
+  uint32_t sum_n;
+  float lam[2], w[2]; /* lambda_m and the speed [rad/s electrical] per direction */
+  uint8_t limited;    /* the voltage limit was reached in a window */
+  dq_t v_prev;        /* the voltage asked last period [V], rotor frame */
+} proc_flux_t;
+
+/* proc_mech.c: torque steps on the encoder; the least squares in core
+ * (estimation/ident_mech.h). The signals are filtered by a moving mean of
+ * PROC_MECH_NB blocks of PROC_MECH_D periods (the encoder's speed over it). */
+#define PROC_MECH_D  32u /* periods per block */
+#define PROC_MECH_NB 16u /* blocks in the moving mean */
+typedef struct {
+  current_ctrl_t cc;
+  proc_enc_unwrap_t u;
+  uint32_t n, n_all;
+  uint8_t phase;
+  uint16_t rows;            /* the least squares' rows so far */
+  uint32_t bk;              /* blocks so far */
+  float r_th[PROC_MECH_NB]; /* the angle at the last blocks' ends [rad mechanical] */
+  float r_t[PROC_MECH_NB];  /* the torque's integral over each block [N m s] */
+  float r_s[PROC_MECH_NB];  /* sgn(w)'s integral over each block [s] */
+  float b_t, b_th0;         /* this block's torque integral, its start angle */
+  float x_prev[3];          /* the filtered speed, sgn(w), torque at the last block */
+  float w0;                 /* the filtered speed at the window's start [rad/s] */
+  float win[3];             /* over the window: int sgn(w), int w, int T (filtered) */
+  uint32_t win_n;           /* blocks in the window */
+  float ls[10];             /* the normal equations (ident_mech.h) */
+  float res[4];             /* J, T_c, B, the fit's residual */
+  float w;                  /* the speed [rad/s mechanical] (the PLL's) */
+} proc_mech_t;
 
 typedef union {
   proc_offset_t offset;
@@ -252,6 +334,10 @@ typedef union {
   proc_rs_t rs;
   proc_ldq_t ldq;
   proc_fmap_t fmap;
+  proc_poles_t poles;
+  proc_enc_t enc;
+  proc_flux_t flux;
+  proc_mech_t mech;
 } proc_state_t;
 
 typedef struct {
@@ -297,5 +383,17 @@ const char *proc_start_refusal(const proc_setup_t *su, const char **field);
 
 /* proc_align.c: the alignment's timing for cfg (also the tests'). */
 void proc_align_timing(const drive_config_t *cfg, proc_align_timing_t *t);
+
+/* proc_poles.c: the encoder identifications' test current (id_i_test, 0:
+ * 0.3 i_max, at most i_max) [A], their speed bound (id_speed_max, 0: 0.3
+ * speed_max) and measuring speed (id_speed, 0: 0.2 speed_max, at most the
+ * bound) [rad/s mechanical]; the encoder unwrapped (returns the angle). */
+float proc_id_current(const drive_config_t *cfg);
+float proc_id_speed_max(const drive_config_t *cfg);
+float proc_id_speed(const drive_config_t *cfg);
+void proc_enc_unwrap_reset(proc_enc_unwrap_t *u);
+float proc_enc_unwrap(proc_enc_unwrap_t *u, float enc_angle);
+/* Refused without an encoder (the encoder identifications' check). */
+const char *proc_id_encoder_check(const proc_setup_t *su, const char **field);
 
 #endif /* FLUXDRIVE_PROC_H */

@@ -52,7 +52,9 @@
 #define PROC_LIST(X)                                                                               \
   X(OFFSET, offset, "current sensor offsets with the gates off (offset_samples averaged)")         \
   X(ALIGN, align, "d current along theta = 0 for align_time; an encoder's: damped, until settled") \
-  X(HOLD, hold, "the held start (start_mode 1): angle at standstill, polarity from two d pulses")
+  X(HOLD, hold, "the held start (start_mode 1): angle at standstill, polarity from two d pulses")  \
+  X(STAR, star,                                                                                    \
+    "identification: the star point's a, b (3.7), the rotor turned half an electrical turn")
 
 #define PROC_ENUM(E, n, d) PROC_##E,
 typedef enum { PROC_LIST(PROC_ENUM) PROC_COUNT } proc_id_t;
@@ -94,7 +96,12 @@ typedef struct {
    * the angle of the current (the source's reference once done) [rad
    * electrical], the periods the rotor has been calm; hold: the angle along the
    * pulses, the north pole's angle [rad electrical], the evidence
-   * (d0 - d1) / mean */
+   * (d0 - d1) / mean; star: a, b, p = b / a (3.7) (after the first sweep's
+   * fit that sweep's, at the end the mean of both), the rotor's angle
+   * where the last fitted sweep ended [rad electrical], the fit's rms
+   * residual / |a| (the larger of the sweeps'), the sweeps' difference in
+   * a and in b over |a|, the first sweep's lag of the rotor behind the
+   * current vector [rad electrical] (docs/commissioning.md) */
   float result[PROC_RESULTS];
 } proc_telemetry_t;
 
@@ -162,10 +169,34 @@ typedef struct {
   bool plain;              /* the pattern without the DFC window (a pulse's clean sample) */
 } proc_hold_t;
 
+/* The star point's a, b (proc_star.c): the signals of a sweep in
+ * PROC_STAR_BINS bins of the current vector's angle, then their fit. */
+#define PROC_STAR_BINS 32u
+typedef struct {
+  float y[PROC_STAR_BINS][2]; /* each bin's mean -Gamma_alpha + j Gamma_beta (/ v_dc) */
+  float g_acc[3];             /* the bin in force: each test vector's signals summed */
+  uint16_t g_n[3];            /* and counted */
+  uint8_t phase;              /* proc_star.c: PH_* */
+  uint8_t bin;                /* the bin in force (sweep) or fitted (fit) */
+  uint8_t pass;               /* the fit's pass (0: the start) */
+  bool done;
+  uint32_t n;      /* periods into the phase */
+  uint32_t n_all;  /* periods since it began */
+  float integ[2];  /* the current error's integral [V] */
+  float a, b;      /* the fit in progress */
+  float lag[2];    /* e^{-j2 delta}: the rotor's lag behind the vector */
+  float h[3];      /* the reduced normal matrix (00, 01, 11) */
+  float acc[4];    /* the pass's sums (the start's A, B; the gradient and the lag) */
+  float res2;      /* the pass's squared residuals */
+  float theta_end; /* the rotor's angle where the sweep ended [rad electrical] */
+  float sw[2][4];  /* each sweep's a, b, lag [rad electrical], rms residual / |a| */
+} proc_star_t;
+
 typedef union {
   proc_offset_t offset;
   proc_align_t align;
   proc_hold_t hold;
+  proc_star_t star;
 } proc_state_t;
 
 typedef struct {

@@ -180,16 +180,16 @@ typedef struct {
   uint8_t bin;                /* the bin in force (sweep) or fitted (fit) */
   uint8_t pass;               /* the fit's pass (0: the start) */
   bool done;
-  uint32_t n;      /* periods into the phase */
-  uint32_t n_all;  /* periods since it began */
-  float integ[2];  /* the current error's integral [V] */
-  float a, b;      /* the fit in progress */
-  float lag[2];    /* e^{-j2 delta}: the rotor's lag behind the vector */
-  float h[3];      /* the reduced normal matrix (00, 01, 11) */
-  float acc[4];    /* the pass's sums (the start's A, B; the gradient and the lag) */
-  float res2;      /* the pass's squared residuals */
-  float theta_end; /* the rotor's angle where the sweep ended [rad electrical] */
-  float sw[2][4];  /* each sweep's a, b, lag [rad electrical], rms residual / |a| */
+  uint32_t n;        /* periods into the phase */
+  uint32_t n_all;    /* periods since it began */
+  current_ctrl_t cc; /* the current vector's loop (the stator frame) */
+  float a, b;        /* the fit in progress */
+  float lag[2];      /* e^{-j2 delta}: the rotor's lag behind the vector */
+  float h[3];        /* the reduced normal matrix (00, 01, 11) */
+  float acc[4];      /* the pass's sums (the start's A, B; the gradient and the lag) */
+  float res2;        /* the pass's squared residuals */
+  float theta_end;   /* the rotor's angle where the sweep ended [rad electrical] */
+  float sw[2][4];    /* each sweep's a, b, lag [rad electrical], rms residual / |a| */
 } proc_star_t;
 
 typedef union {

@@ -188,6 +188,8 @@ typedef struct {
   float h[3];        /* the reduced normal matrix (00, 01, 11) */
   float acc[4];      /* the pass's sums (the start's A, B; the gradient and the lag) */
   float res2;        /* the pass's squared residuals */
+  float swing;       /* the alignment's rotor movement (the source's speed integrated) [rad] */
+  float dir;         /* the sweeps' direction: +1 (0 -> pi) or -1 (0 -> -pi) */
   float theta_end;   /* the rotor's angle where the sweep ended [rad electrical] */
   float sw[2][4];    /* each sweep's a, b, lag [rad electrical], rms residual / |a| */
 } proc_star_t;

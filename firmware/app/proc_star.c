@@ -19,13 +19,16 @@
  *
  * Sequence (phases): 0 alignment: the current vector id_star_current i_max
  * along theta = 0, ramped up over a quarter of id_star_time and held for a
- * quarter; 1 sweep: the vector turns from 0 to pi (electrical) at constant
- * rate in id_star_time, the signals averaged in PROC_STAR_BINS bins of the
- * vector's angle; 2 fit of that sweep (the vector held); 3 sweep back
- * from pi to 0; 4 fit of it; done: a, b the mean of the two sweeps' fits,
- * their difference published as the check. The rotor moves about half an
- * electrical turn plus the alignment's (at most half a turn): at most one
- * electrical turn, 2 pi / pole_pairs mechanical.
+ * quarter; 1 sweep: the vector turns from 0 to +-pi (electrical) at
+ * constant rate in id_star_time, the signals averaged in PROC_STAR_BINS
+ * bins of the vector's angle; 2 fit of that sweep (the vector held); 3
+ * sweep back to 0; 4 fit of it; done: a, b the mean of the two sweeps'
+ * fits, their difference published as the check. The sweeps turn back the
+ * way the alignment moved the rotor (the sign of the source's speed
+ * integrated over the alignment), so the rotor stays within half an
+ * electrical turn of where it started, plus the damped overshoot and
+ * the lag: the bound stated is 1.25 pi electrical (1.25 pi / pole_pairs
+ * mechanical; docs/commissioning.md).
  *
  * The current and the damping. The core's current loop (current_ctrl.h,
  * current_bw) in the stator frame, as the alignment's (proc_align.c).
@@ -102,9 +105,14 @@ FD_COLD static uint32_t star_periods(const drive_config_t *c, float t) {
   return (uint32_t)(t / c->ts) + 1u;
 }
 
-/* The bins' centres phi_k = (k + 1/2) pi / K as e^{j2phi_k}. */
-FD_COLD static sincos_t star_bin_dir(unsigned k) {
-  return frames_sincos(2.0f * FRAMES_PI * ((float)k + 0.5f) / (float)PROC_STAR_BINS);
+/* The bins' centres phi_k = dir (k + 1/2) pi / K [rad electrical]. */
+FD_COLD static float star_bin_phi(const proc_star_t *t, unsigned k) {
+  return t->dir * FRAMES_PI * ((float)k + 0.5f) / (float)PROC_STAR_BINS;
+}
+
+/* e^{j2phi_k}. */
+FD_COLD static sincos_t star_bin_dir(const proc_star_t *t, unsigned k) {
+  return frames_sincos(2.0f * star_bin_phi(t, k));
 }
 
 FD_COLD static const char *star_check(const proc_setup_t *su, const char **field) {
@@ -171,7 +179,7 @@ FD_COLD static void star_take(proc_star_t *t, const hal_sample_t *s) {
 /* The fit's start (pass 0), one bin: the projections on e^{j2phi} and
  * -e^{-j4phi}. */
 FD_COLD static void star_fit_start(proc_star_t *t, unsigned k) {
-  const sincos_t e2 = star_bin_dir(k);
+  const sincos_t e2 = star_bin_dir(t, k);
   const float e4c = e2.c * e2.c - e2.s * e2.s;
   const float e4s = 2.0f * e2.c * e2.s;
   const float yr = t->y[k][0];
@@ -210,7 +218,7 @@ FD_COLD static bool star_fit_start_end(proc_star_t *t) {
  * the bin's share of the reduced normal equations of (a, b):
  * dr/da = -s, dr/db = conj(s)^2, dr/dx = -j (a s + 2 b conj(s)^2). */
 FD_COLD static void star_fit_pass(proc_star_t *t, unsigned k) {
-  const sincos_t e2 = star_bin_dir(k);
+  const sincos_t e2 = star_bin_dir(t, k);
   /* the start: e^{j2phi} e^{-j2delta} */
   float sr = e2.c * t->lag[0] - e2.s * t->lag[1];
   float si = e2.c * t->lag[1] + e2.s * t->lag[0];
@@ -260,7 +268,7 @@ FD_COLD static void star_fit_pass(proc_star_t *t, unsigned k) {
   if (k == (t->phase == PH_FIT ? PROC_STAR_BINS - 1u : 0u)) {
     /* the rotor where the sweep ended: theta = phi_k - delta_k */
     const float dl = -0.5f * fd_atan2f(si * e2.c - sr * e2.s, sr * e2.c + si * e2.s);
-    t->theta_end = FRAMES_PI * ((float)k + 0.5f) / (float)PROC_STAR_BINS - dl;
+    t->theta_end = star_bin_phi(t, k) - dl;
   }
 }
 
@@ -342,10 +350,16 @@ FD_COLD static int star_step(proc_state_t *st, const proc_setup_t *su, const pro
   }
   float amp = i_test;
   float phi = 0.0f;
+  /* the position source's speed [rad/s electrical] (the damping, below) */
+  const float w = fd_isfinite(in->pos->omega) ? in->pos->omega : 0.0f;
   switch (t->phase) {
   case PH_ALIGN:
     amp = n < n_align / 2u ? i_test * (float)n / (float)(n_align / 2u) : i_test;
+    t->swing += w * c->ts;
     if (n + 1u >= n_align) {
+      /* the sweep turns back the way the rotor came: it stays within half
+       * a turn of where it started */
+      t->dir = t->swing > 0.0f ? -1.0f : 1.0f;
       t->phase = PH_SWEEP;
       t->n = 0u;
     }
@@ -353,7 +367,7 @@ FD_COLD static int star_step(proc_state_t *st, const proc_setup_t *su, const pro
   case PH_SWEEP:
   case PH_BACK: {
     const float f = (float)n / (float)n_sweep;
-    phi = FRAMES_PI * (t->phase == PH_SWEEP ? f : 1.0f - f);
+    phi = t->dir * FRAMES_PI * (t->phase == PH_SWEEP ? f : 1.0f - f);
     unsigned k = (unsigned)(f * (float)PROC_STAR_BINS);
     k = t->phase == PH_SWEEP ? k : PROC_STAR_BINS - 1u - k;
     if (k != t->bin) {
@@ -380,7 +394,7 @@ FD_COLD static int star_step(proc_state_t *st, const proc_setup_t *su, const pro
   case PH_FIT:
   case PH_FIT_BACK:
   default: {
-    phi = t->phase == PH_FIT ? FRAMES_PI : 0.0f;
+    phi = t->phase == PH_FIT ? t->dir * FRAMES_PI : 0.0f;
     const int r = star_fit_step(t);
     if (r == PROC_FAILED) {
       out->fault = DRIVE_FAULT_POSITION;
@@ -408,7 +422,6 @@ FD_COLD static int star_step(proc_state_t *st, const proc_setup_t *su, const pro
    * source's speed), as the encoder's alignment (proc_align.c) */
   const float wn2 = 1.5f * c->pole_pairs * c->pole_pairs * c->lambda_m * i_test / c->inertia;
   const float kd = wn2 > 0.0f ? 2.0f * PROC_STAR_ZETA / sqrtf(wn2) : 0.0f;
-  const float w = fd_isfinite(in->pos->omega) ? in->pos->omega : 0.0f;
   phi -= fd_clampf(kd * w, -0.25f * FRAMES_PI, 0.25f * FRAMES_PI);
   /* the current: the core's current loop in the stator frame (dq at
    * theta = 0), as the alignment's (proc_align.c) */

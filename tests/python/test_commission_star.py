@@ -13,7 +13,7 @@ the plant's a and b of (3.7) from its L_d, L_q, star_m0, star_m2
     L0 = (L_d + L_q)/2 + M0,  L2 = (L_d - L_q) - 2 M2.
 
 Checked on the three star-point presets (`fabbri2022_t51`,
-`fabbri2022_ebike`, `fabbri2022_fig33` at star_p -0.4, -0.2, +0.15 (its
+`fabbri2022_ebike`, `fabbri2022_fig33` at star_p -0.35, -0.2, +0.15 (its
 default) and +0.3) and on random star-point machines of
 `fluxdrive machines draw --kind star` (seeds 1..5 in CI; more with
 FLUXDRIVE_STAR_SEEDS="6 7 8"):
@@ -64,7 +64,7 @@ PRESETS = {
     "fabbri2022_ebike": (103e-6, 149e-6, 6e-6, -21.42e-6),
 }
 FIG33 = (442.2e-6, 20.7e-6, 103.3e-6)  # L0, M0, L2 kept (docs/dfc.md)
-FIG33_P = [-0.4, -0.2, 0.15, 0.3]
+FIG33_P = [-0.35, -0.2, 0.15, 0.3]
 
 
 def plant_ab(ld: float, lq: float, m0: float, m2: float) -> tuple[float, float]:
@@ -167,7 +167,7 @@ def results(tmp_path_factory) -> list[tuple]:
         theta0 = 2.0 * math.pi * ((0.37 * (k + 1)) % 1.0)  # rad mech: spread over the turn
         sc = scenario(m, sec, noise, theta0, k + 1)
         if label.startswith("fabbri2022_fig33"):
-            # its signal reaches 0.3 v_dc at p -0.4 (a = 0.30): the 13 V star
+            # its signal reaches 0.27 v_dc at p -0.35 (a = 0.27): the 13 V star
             # channel clips it (docs/dfc.md, "EKF: the range of p": 40 V there)
             sc["sensors"]["star_full_scale"] = 40.0
         summary, lg = run(sc, out, f"star_{k}", log=True)
@@ -234,7 +234,7 @@ def test_star_current_and_movement_bounded(results):
         assert c["i_peak"] <= i_max, (label, c["i_peak"], i_max)
         assert c["i_peak"] > 0.5 * i_test, (label, c["i_peak"])  # it did turn the rotor
         p = pole_pairs_of(label, pp)
-        assert c["move"] * p <= 2.0 * math.pi, (label, c["move"] * p)
+        assert c["move"] * p <= 1.25 * math.pi, (label, c["move"] * p)
         assert c["move"] * p >= 0.5 * math.pi, (label, c["move"] * p)  # it turned
 
 

@@ -73,9 +73,13 @@ static void rows_agree_with_the_list(void **state) {
     assert_non_null(r->init);
     assert_non_null(r->step);
     assert_non_null(r->publish);
-    /* a procedure shows as a start state: gates off or on by its caps */
+    /* a procedure shows as a start state: gates off or on by its caps; an
+     * identification's gated rows as ident */
     const bool gates = (r->caps & PROC_CAP_GATES) != 0u;
-    assert_int_equal(r->state, gates ? DRIVE_STATE_ALIGN : DRIVE_STATE_OFFSET_CAL);
+    const bool ident = (r->caps & PROC_CAP_IDENT) != 0u && gates;
+    assert_int_equal(r->state, ident   ? DRIVE_STATE_IDENT
+                               : gates ? DRIVE_STATE_ALIGN
+                                       : DRIVE_STATE_OFFSET_CAL);
   }
   assert_null(proc_row(PROC_COUNT));
   assert_null(proc_row((proc_id_t)1000));

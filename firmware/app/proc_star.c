@@ -35,7 +35,8 @@
  * The free rotor swings about the vector at w_n = p sqrt(1.5 lambda_m i /
  * J) with almost no damping (friction only; the back-EMF's currents the
  * loop cancels): on fabbri2022_t51 +-0.4 rad electrical through the whole
- * sweep, which smears the bins unevenly. As the encoder's alignment does,
+ * sweep even under a fed-forward voltage (a first version, which kept
+ * some of the back-EMF's damping), which smears the bins unevenly. As the encoder's alignment does,
  * the vector's angle is led by -k_d omega_e, k_d = 2 zeta / w_n (zeta
  * PROC_STAR_ZETA, from the parameter set's pole_pairs, lambda_m, inertia),
  * here with the position source's speed (its PLL's or filter's on the
@@ -55,7 +56,8 @@
  * (variable projection): per bin, x_k by PROC_STAR_INNER Gauss-Newton
  * steps from the vector's angle less the lag, then the 2x2 normal
  * equations of (a, b) with x_k eliminated (Schur complement). One bin per
- * period: the fit costs a few hundred instructions an ISR.
+ * period: the fit costs a few hundred instructions an ISR (an estimate:
+ * not measured in PIL).
  *
  * The bins' averages. A bin averages the signals over the angles the
  * rotor passes in it, pi / PROC_STAR_BINS electrical: for a uniform turn
@@ -118,13 +120,9 @@ FD_COLD static sincos_t star_bin_dir(const proc_star_t *t, unsigned k) {
 FD_COLD static const char *star_check(const proc_setup_t *su, const char **field) {
   if (!su->gated) {
     *field = "pos_source";
-    return "the star point's a, b need a star-point position source (the DFC window's samples: "
-           "dfc, "
-           "dfc_inv, ivd, dfc+kf, ivd+kf, ekf, ivd+kf+rls) and a board with star-point samples";
-  }
-  if (!(su->cfg->rs > 0.0f)) {
-    *field = "rs";
-    return "the star point's a, b turn the rotor by a voltage fed forward from rs: rs > 0";
+    return "the star point's a, b need a star-point position source (the DFC window's "
+           "samples: dfc, dfc_inv, ivd, dfc+kf, ivd+kf, ekf, ivd+kf+rls) on a board with "
+           "star-point samples";
   }
   return NULL;
 }

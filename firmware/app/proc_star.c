@@ -338,6 +338,7 @@ FD_COLD static int star_step(proc_state_t *st, const proc_setup_t *su, const pro
   const float i_test = star_current(c);
   const uint32_t n_sweep = star_periods(c, c->id_star_time);
   const uint32_t n_align = n_sweep / 2u;
+  const uint32_t n_ramp = n_align / 2u; /* the current's ramp: half the alignment */
   *out = (proc_out_t){{0.0f, 0.0f}, true, false, 0u};
   t->n_all++;
   const uint32_t n = t->n++;
@@ -352,7 +353,7 @@ FD_COLD static int star_step(proc_state_t *st, const proc_setup_t *su, const pro
   const float w = fd_isfinite(in->pos->omega) ? in->pos->omega : 0.0f;
   switch (t->phase) {
   case PH_ALIGN:
-    amp = n < n_align / 2u ? i_test * (float)n / (float)(n_align / 2u) : i_test;
+    amp = n < n_ramp ? i_test * (float)n / (float)n_ramp : i_test;
     t->swing += w * c->ts;
     if (n + 1u >= n_align) {
       /* the sweep turns back the way the rotor came: it stays within half

@@ -84,6 +84,11 @@
 #include "math/frames.h"
 
 #define PROC_STAR_ZETA 0.7f /* the damping ratio of the rotor about the vector */
+/* the sweep's rate at most w_n / PROC_STAR_SLOW (drawn star seeds 7 and 12,
+ * w_n 17 and 12 rad/s: at 0.4 s a sweep the rotor could not follow and the
+ * fit's residual failed them), its time at most PROC_STAR_T_MAX [s] */
+#define PROC_STAR_SLOW  8.0f
+#define PROC_STAR_T_MAX 10.0f
 /* a measured current beyond the test current by this part of the way to
  * i_max fails (the window's pulses leave a ripple repeating every three
  * periods in the sample: 0.25 i_max on drawn star seed 5, L 0.19 mH) */
@@ -103,8 +108,19 @@ FD_COLD static float star_current(const drive_config_t *c) {
   return fd_clampf(c->id_star_current, 0.0f, 1.0f) * c->i_max;
 }
 
-FD_COLD static uint32_t star_periods(const drive_config_t *c, float t) {
-  return (uint32_t)(t / c->ts) + 1u;
+/* The rotor's natural frequency about the vector, w_n^2 = 1.5 p^2
+ * lambda_m i / J [rad^2/s^2] (the PM torque 1.5 p lambda_m i sin(delta),
+ * as proc_align_timing), from the parameter set. */
+FD_COLD static float star_wn2(const drive_config_t *c) {
+  return 1.5f * c->pole_pairs * c->pole_pairs * c->lambda_m * star_current(c) / c->inertia;
+}
+
+/* A sweep's periods: id_star_time, longer where the rotor is slow to
+ * follow (the sweep's rate pi / T at most w_n / PROC_STAR_SLOW). */
+FD_COLD static uint32_t star_sweep_periods(const drive_config_t *c) {
+  const float wn2 = star_wn2(c);
+  const float t_min = wn2 > 0.0f ? PROC_STAR_SLOW * FRAMES_PI / sqrtf(wn2) : 0.0f;
+  return (uint32_t)(fd_minf(fd_maxf(c->id_star_time, t_min), PROC_STAR_T_MAX) / c->ts) + 1u;
 }
 
 /* The bins' centres phi_k = dir (k + 1/2) pi / K [rad electrical]. */
@@ -336,7 +352,7 @@ FD_COLD static int star_step(proc_state_t *st, const proc_setup_t *su, const pro
   proc_star_t *t = &st->star;
   const drive_config_t *c = su->cfg;
   const float i_test = star_current(c);
-  const uint32_t n_sweep = star_periods(c, c->id_star_time);
+  const uint32_t n_sweep = star_sweep_periods(c);
   const uint32_t n_align = n_sweep / 2u;
   const uint32_t n_ramp = n_align / 2u; /* the current's ramp: half the alignment */
   *out = (proc_out_t){{0.0f, 0.0f}, true, false, 0u};
@@ -419,7 +435,7 @@ FD_COLD static int star_step(proc_state_t *st, const proc_setup_t *su, const pro
   }
   /* the damping: the vector's angle led by -k_d omega_e (the position
    * source's speed), as the encoder's alignment (proc_align.c) */
-  const float wn2 = 1.5f * c->pole_pairs * c->pole_pairs * c->lambda_m * i_test / c->inertia;
+  const float wn2 = star_wn2(c);
   const float kd = wn2 > 0.0f ? 2.0f * PROC_STAR_ZETA / sqrtf(wn2) : 0.0f;
   phi -= fd_clampf(kd * w, -0.25f * FRAMES_PI, 0.25f * FRAMES_PI);
   /* the current: the core's current loop in the stator frame (dq at

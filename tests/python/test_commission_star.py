@@ -126,9 +126,25 @@ def pole_pairs_of(label: str, pp: int) -> int:
     return pp if pp > 0 else 23  # the e-bike preset: 23 pole pairs (Table 5.4)
 
 
+def sweep_time(c: dict) -> float:
+    """A sweep's time as proc_star.c takes it from the parameter set c
+    (star_sweep_periods): id_star_time, at least 8 pi / w_n, at most 10 s."""
+    wn2 = (1.5 * c["pole_pairs"] ** 2 * c["lambda_m"] * c["id_star_current"] * c["i_max"]
+           / c["inertia"])
+    t_min = 8.0 * math.pi / math.sqrt(wn2) if wn2 > 0 else 0.0
+    return min(max(c["id_star_time"], t_min), 10.0)
+
+
 def run(sc: dict, out: Path, name: str, log: bool = False) -> tuple[dict, object]:
-    """The SIL on sc: its summary and (log) its full-rate log."""
+    """The SIL on sc (its duration set to the procedure's: the offsets, the
+    alignment, two sweeps and their fits): its summary and (log) its
+    full-rate log."""
     path = out / f"{name}.json"
+    path.write_text(json.dumps(sc, indent=1))
+    cfg = subprocess.run([str(REAL_SIL), str(path), "--print-config"], capture_output=True,
+                         text=True, timeout=60)
+    assert cfg.returncode == 0, (name, cfg.stderr)
+    sc["duration"] = round(2.5 * sweep_time(json.loads(cfg.stdout)["controller"]) + 0.15, 3)
     path.write_text(json.dumps(sc, indent=1))
     cmd = [str(REAL_SIL), str(path), "--summary", str(out / f"{name}.out.json")]
     if log:

@@ -97,7 +97,7 @@
 #define PROC_STAR_PASSES 6u /* Gauss-Newton passes of (a, b) after the start */
 /* a sweep whose fit leaves an rms residual above this part of |a| fails:
  * the rotor did not follow the vector (a load, a stuck rotor) or the
- * signals are not (3.6)'s (a clipped star channel); 0.06 at most on the
+ * signals are not (3.6)'s (a clipped star channel); 0.041 at most on the
  * presets and drawn machines (tests/python/test_commission_star.py), 3.3
  * with a current too small to turn drawn star seed 5 */
 #define PROC_STAR_RES_MAX 0.2f

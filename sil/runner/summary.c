@@ -203,6 +203,16 @@ char *params_json(void) {
       cJSON_AddItemToArray(a, cJSON_CreateString(lists[l].name(v)));
     }
   }
+  /* the procedures (proc.h PROC_LIST): CMD_PROC's and TM_PROC's value
+   * tables, the commissioning's identification procedures */
+  cJSON *pr = cJSON_AddArrayToObject(o, "procs");
+  for (unsigned k = 0; k < (unsigned)PROC_COUNT; ++k) {
+    const proc_row_t *r = proc_row((proc_id_t)k);
+    cJSON *p = cJSON_CreateObject();
+    cJSON_AddStringToObject(p, "name", r->name);
+    cJSON_AddBoolToObject(p, "ident", (r->caps & PROC_CAP_IDENT) != 0u);
+    cJSON_AddItemToArray(pr, p);
+  }
   cJSON *f = cJSON_AddArrayToObject(o, "faults");
   for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {
     cJSON_AddItemToArray(f, cJSON_CreateString(drive_fault_name(1u << b)));

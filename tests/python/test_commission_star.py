@@ -52,6 +52,15 @@ from fluxdrive import machines as mach
 pytestmark = pytest.mark.skipif(not REAL_SIL.exists(), reason="fluxdrive-sil not built")
 
 BAND = 0.05  # issue 25: a and b within 5 %
+# the inverter's device drops (issue 25 point 2): their resistances (a 24 V
+# MOSFET bridge). Their thresholds are left out: with v_f_diode 0.7 V (or
+# v_th_sw 0.7 V) the plant's star-point signal itself departs from (3.6)
+# (fabbri2022_t51: its b +49 % (-39 %) off the ideal devices' signal, the
+# fit's residual 1.9 %), an open question of the plant's drops at the test
+# vector's edge (docs/commissioning.md); FLUXDRIVE_STAR_DROPS=full adds them
+DROPS = {"v_th_sw": 0.0, "r_on_sw": 0.02, "v_f_diode": 0.0, "r_diode": 0.01}
+if os.environ.get("FLUXDRIVE_STAR_DROPS") == "full":
+    DROPS.update({"v_f_diode": 0.7})
 # the plant's signal this far off (3.7) or more: the drawn machine is checked
 # against its signal's a, b only (see signal_ab)
 FLOOR = 0.025
@@ -112,7 +121,8 @@ def scenario(m: dict, sec: dict, noise: float, theta0: float, seed: int,
     sc["machine"] = m
     sc["duration"] = 1.1
     sc["sensors"] = {**sc["sensors"], "star_noise": noise, "i_noise": 0.005, "seed": seed}
-    sc["inverter"] = {**sc.get("inverter", {}), "model": "switching", "dead_time": 5e-7}
+    sc["inverter"] = {**sc.get("inverter", {}), "model": "switching", "dead_time": 5e-7,
+                      **DROPS}
     sc["mechanics"] = {**sc.get("mechanics", {}), "mode": "free", "theta0": theta0}
     sc["controller"] = {**sc["controller"], "law": "foc", "mode": "torque", "pos_source": source,
                         "align_time": 0.1}

@@ -53,6 +53,10 @@
   X(OFFSET, offset, "current sensor offsets with the gates off (offset_samples averaged)")         \
   X(ALIGN, align, "d current along theta = 0 for align_time; an encoder's: damped, until settled") \
   X(HOLD, hold, "the held start (start_mode 1): angle at standstill, polarity from two d pulses")  \
+  X(RS, rs,                                                                                        \
+    "identification: R_s and the inverter's voltage error v_err(i) from DC levels, both signs")    \
+  X(LDQ, ldq,                                                                                      \
+    "identification: L_d, L_q at standstill, square-wave voltage injection along d, then q")       \
   X(STAR, star,                                                                                    \
     "identification: the star point's a, b (3.7), the rotor turned half an electrical turn")
 
@@ -169,6 +173,64 @@ typedef struct {
   bool plain;              /* the pattern without the DFC window (a pulse's clean sample) */
 } proc_hold_t;
 
+/* The ldq identification's alignment (proc_ldq.c): the current's
+ * angle at period n of it: pi/2 for n_first periods (a rotor anywhere but
+ * at -pi/2 turns there), then turned to 0 over n_turn (a rotor left at
+ * -pi/2 is 90 degrees off the current then, and follows too), then 0. A
+ * rotor that starts at pi, where a current along 0 holds it unstably (the
+ * rs procedure leaves it there), is aligned all the same. */
+static inline float proc_ident_align_angle(uint32_t n, uint32_t n_first, uint32_t n_turn) {
+  if (n < n_first) {
+    return 0.5f * FRAMES_PI;
+  }
+  const uint32_t k = n - n_first;
+  return k < n_turn ? 0.5f * FRAMES_PI * (1.0f - (float)k / (float)n_turn) : 0.0f;
+}
+
+/* proc_rs.c: R_s and v_err(i) (issue 25 a). Levels of each sign, at most: */
+#define PROC_RS_LEVELS_MAX 12u
+typedef struct {
+  current_ctrl_t cc;                   /* the level's current loop (frame turned by theta) */
+  uint8_t n_levels;                    /* levels of each sign (id_rs_levels) */
+  uint8_t phase;                       /* proc_rs.c's phases */
+  int8_t last;                         /* the last level measured (-1: none) */
+  uint32_t n;                          /* periods into the phase */
+  uint32_t n_all;                      /* periods since it began */
+  float i_ref;                         /* the current reference, slew-limited [A] */
+  float theta;                         /* the current's axis [rad] */
+  float v_prev;                        /* the axis' voltage asked last period [V] */
+  float acc_v, acc_i;                  /* the level's sums */
+  uint32_t acc_n;                      /* ... of this many periods */
+  float i_peak;                        /* the largest measured current amplitude [A] */
+  float lv_i[2u * PROC_RS_LEVELS_MAX]; /* the levels' mean current, positive then negative [A] */
+  float lv_v[2u * PROC_RS_LEVELS_MAX]; /* ... and commanded voltage [V] */
+  float res[PROC_RESULTS];             /* the fit (proc_rs.c, rs_publish) */
+} proc_rs_t;
+
+/* proc_ldq.c: L_d, L_q at standstill (issue 25 b). A half wave of at most
+ * PROC_LDQ_M_MAX PWM periods (id_ldq_freq at least f_pwm / 32): */
+#define PROC_LDQ_M_MAX 16u
+typedef struct {
+  current_ctrl_t cc;            /* the bias current's loop (alignment, hold) */
+  uint8_t phase;                /* proc_ldq.c's phases */
+  uint8_t axis;                 /* 0: d (the bias' axis), 1: q */
+  uint8_t tries;                /* amplitude adjustments of this axis */
+  uint32_t n;                   /* periods into the phase */
+  uint32_t n_all;               /* periods since it began */
+  float i_ref;                  /* the bias reference, slew-limited [A] */
+  float v_hold[2];              /* the bias' voltage (d, q) held under the injection [V] */
+  float v_h;                    /* the injection's amplitude [V] */
+  float i_prev;                 /* the injected axis' current last period [A] */
+  float acc_d;                  /* the bias current's sum over an injection period [A] */
+  float w[2u * PROC_LDQ_M_MAX]; /* the current summed at each of the wave's periods (5) [A] */
+  uint32_t sn;                  /* ... over this many waves */
+  float i_lo, i_hi;             /* the injected axis' current range [A] */
+  float i_peak;                 /* the largest measured current amplitude [A] */
+  float l[2];                   /* the inductances found (d, q) [H] */
+  float ripple[2];              /* their current ripple, peak to peak [A] */
+  float cross[2];               /* the other axis' ripple over this axis' [-] */
+  float o_lo, o_hi;             /* the other axis' current range under the injection [A] */
+} proc_ldq_t;
 /* The star point's a, b (proc_star.c): the signals of a sweep in
  * PROC_STAR_BINS bins of the current vector's angle, then their fit. */
 #define PROC_STAR_BINS 32u
@@ -198,6 +260,8 @@ typedef union {
   proc_offset_t offset;
   proc_align_t align;
   proc_hold_t hold;
+  proc_rs_t rs;
+  proc_ldq_t ldq;
   proc_star_t star;
 } proc_state_t;
 

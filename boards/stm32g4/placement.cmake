@@ -30,7 +30,7 @@ set(FD_PLACEMENT_g474 all)
 set(FD_FLASH_SOURCES_g474
   can_proto.c can_codec.c drive_config.c drive_params.c drive_host.c drive_enums.c
   drive_safe.c drive_pos_check.c drive_phase_check.c
-  proc.c proc_offset.c proc_align.c proc_hold.c proc_rs.c proc_ldq.c proc_star.c
+  proc.c proc_offset.c proc_align.c proc_hold.c proc_rs.c proc_ldq.c proc_fmap.c proc_star.c
   drive_signals.c pos_dfc_signals.c
   flux_map_blob.c)
 

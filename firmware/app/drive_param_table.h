@@ -140,6 +140,14 @@
     "alignment before run: d current along the assumed axis for this long (0: no alignment, else >= ts)")               \
   X(45, align_current,  F32,  "A",      1.0f,        0.0f,    1e4f,     IDLE, "controller.align_current",  \
     "d current of the alignment")                                                                           \
+  X(208, id_fmap_current, F32, "A",     3.5f,        0.0f,    1e4f,     IDLE, "controller.id_fmap_current", \
+    "flux maps (procedure fmap): the grid's current range, |i| <= this (clamped to i_max)")               \
+  X(209, id_fmap_nd,    U16,  "",       9.0f,        2.0f,    64.0f,    IDLE, "controller.id_fmap_nd",     \
+    "flux maps: grid points along i_d (-range .. range); id_fmap_nd x id_fmap_nq <= 254")                   \
+  X(210, id_fmap_nq,    U16,  "",       5.0f,        2.0f,    64.0f,    IDLE, "controller.id_fmap_nq",     \
+    "flux maps: grid points along i_q (0 .. range; i_q bipolar)")                                          \
+  X(211, id_fmap_dwell, F32,  "s",      0.003f,      1e-4f,   1.0f,     IDLE, "controller.id_fmap_dwell",  \
+    "flux maps: dwell at each current level (the point, zero)")                                           \
   X(61, start_mode,     U16,  "",       0.0f,        0.0f,    1.0f,     IDLE, "controller.start_mode",     \
     "start of a position source: 0 align (d current along theta = 0 for align_time, the rotor turns), 1 hold (star point: angle at standstill, polarity from d-axis saturation pulses, no free rotor)") \
   X(46, pos_err_max,    F32,  "rad",    0.5f,        0.01f,   3.2f,     LIVE, "controller.pos_err_max",    \

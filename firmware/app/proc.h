@@ -57,6 +57,7 @@
     "identification: R_s and the inverter's voltage error v_err(i) from DC levels, both signs")    \
   X(LDQ, ldq,                                                                                      \
     "identification: L_d, L_q at standstill, square-wave voltage injection along d, then q")       \
+  X(FMAP, fmap, "flux maps at standstill: bipolar i_q on an i_d bias per grid point (issue 25 c)") \
   X(STAR, star,                                                                                    \
     "identification: the star point's a, b (3.7), the rotor turned half an electrical turn")
 
@@ -100,8 +101,8 @@ typedef struct {
    * the angle of the current (the source's reference once done) [rad
    * electrical], the periods the rotor has been calm; hold: the angle along the
    * pulses, the north pole's angle [rad electrical], the evidence
-   * (d0 - d1) / mean; star: a, b, p = b / a (3.7) (after the first sweep's
-   * fit that sweep's, at the end the mean of both), the rotor's angle
+   * (d0 - d1) / mean; fmap: the last grid point done (proc_fmap.c); star: a, b, p = b / a (3.7)
+   * (after the first sweep's fit that sweep's, at the end the mean of both), the rotor's angle
    * where the last fitted sweep ended [rad electrical], the fit's rms
    * residual / |a| (the larger of the sweeps'), the sweeps' difference in
    * a and in b over |a|, the first sweep's lag of the rotor behind the
@@ -231,6 +232,25 @@ typedef struct {
   float cross[2];               /* the other axis' ripple over this axis' [-] */
   float o_lo, o_hi;             /* the other axis' current range under the injection [A] */
 } proc_ldq_t;
+/* The flux maps' state (proc_fmap.c): the point, its half cycle and
+ * segment, the integrals of (1) and their averages (2), the sums (3). */
+typedef struct {
+  current_ctrl_t cc;       /* the dq current loop on the source's angle */
+  uint32_t n;              /* periods since it began */
+  uint16_t point;          /* grid index of the point in force (k nd + j) */
+  uint16_t m;              /* periods into the segment */
+  uint8_t half;            /* half cycle of the point: even i_q = +I, odd -I */
+  uint8_t seg;             /* at the point, back at zero, its results shown */
+  uint8_t phase;           /* published: 1 + the point in force */
+  float theta;             /* the d axis [rad electrical] */
+  dq_t v_prev;             /* the voltage asked last period [V] */
+  dq_t i_prev;             /* the current last period [A] */
+  dq_t phi, q;             /* int (v - R i) dt [Vs], int i dt [As] over the half */
+  dq_t phi1, q1, i1;       /* their sums over the point's last quarter dwell */
+  dq_t phi2, q2;           /* ... and over the zero's */
+  float acc[4];            /* the point's sums over its halves: psi_d, psi_q, i_d, i_q */
+  float res[PROC_RESULTS]; /* the last point done (publish) */
+} proc_fmap_t;
 /* The star point's a, b (proc_star.c): the signals of a sweep in
  * PROC_STAR_BINS bins of the current vector's angle, then their fit. */
 #define PROC_STAR_BINS 32u
@@ -262,6 +282,7 @@ typedef union {
   proc_hold_t hold;
   proc_rs_t rs;
   proc_ldq_t ldq;
+  proc_fmap_t fmap;
   proc_star_t star;
 } proc_state_t;
 

@@ -32,6 +32,7 @@ set(FD_FLASH_SOURCES_g474
   drive_safe.c drive_pos_check.c drive_phase_check.c
   proc.c proc_offset.c proc_align.c proc_hold.c proc_rs.c proc_ldq.c proc_fmap.c drive_signals.c pos_dfc_signals.c
   proc_poles.c proc_enc.c proc_flux.c proc_mech.c ident_mech.c
+  proc_star.c
   flux_map_blob.c)
 
 # B-G431B-ESC1 (10 KiB CCM SRAM): the drive's ISR body and the law step

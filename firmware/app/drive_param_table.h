@@ -229,6 +229,11 @@
     "ldq identification: the square-wave injection's frequency (rounded to whole PWM periods)")          \
   X(207, id_ldq_time,   F32,  "s",      0.2f,        0.01f,   10.0f,    IDLE, "controller.id_ldq_time",    \
     "ldq identification: each axis' injection measured for this long")                                     \
+  /* identification: the star point's a and b at standstill (proc_star.c, docs/commissioning.md) */     \
+  X(240, id_star_current, F32, "",     0.2f,        0.01f,   1.0f,     IDLE, "controller.id_star_current", \
+    "star-point a, b identification: the current vector that turns the rotor, per unit of i_max")          \
+  X(241, id_star_time,  F32,  "s",      0.4f,        0.05f,   10.0f,    IDLE, "controller.id_star_time",   \
+    "star-point a, b identification: each half-turn sweep's time (the alignment before it: half of it)")   \
   /* timing and calibration */                                                                              \
   X(40, ts,             F32,  "s",      6.25e-5f,    1e-6f,   1e-2f,    RO,   "inverter.pwm_frequency",    \
     "PWM and ISR period")                                                                                   \

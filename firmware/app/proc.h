@@ -56,14 +56,16 @@
   X(RS, rs,                                                                                        \
     "identification: R_s and the inverter's voltage error v_err(i) from DC levels, both signs")    \
   X(LDQ, ldq,                                                                                      \
-    "identification: L_d, L_q at standstill, square-wave voltage injection along d, then q")  \
-  X(FMAP, fmap, "flux maps at standstill: bipolar i_q on an i_d bias per grid point (issue 25 c)")  \
+    "identification: L_d, L_q at standstill, square-wave voltage injection along d, then q")       \
+  X(FMAP, fmap, "flux maps at standstill: bipolar i_q on an i_d bias per grid point (issue 25 c)") \
   X(POLES, poles,                                                                                  \
     "identification: pole pairs and polarity, a current vector turned slowly (encoder)")           \
   X(ENC, enc, "identification: encoder offset and direction, the rotor held at angles both ways")  \
   X(FLUX, flux, "identification: PM flux lambda_m at id_speed both ways (encoder, current loop)")  \
   X(MECH, mech,                                                                                    \
-    "identification: inertia J, Coulomb and viscous friction from torque steps (encoder)")
+    "identification: inertia J, Coulomb and viscous friction from torque steps (encoder)")         \
+  X(STAR, star,                                                                                    \
+    "identification: the star point's a, b (3.7), the rotor turned half an electrical turn")
 
 #define PROC_ENUM(E, n, d) PROC_##E,
 typedef enum { PROC_LIST(PROC_ENUM) PROC_COUNT } proc_id_t;
@@ -105,7 +107,12 @@ typedef struct {
    * the angle of the current (the source's reference once done) [rad
    * electrical], the periods the rotor has been calm; hold: the angle along the
    * pulses, the north pole's angle [rad electrical], the evidence
-   * (d0 - d1) / mean; fmap: the last grid point done (proc_fmap.c) */
+   * (d0 - d1) / mean; fmap: the last grid point done (proc_fmap.c); star: a, b, p = b / a (3.7)
+   * (after the first sweep's fit that sweep's, at the end the mean of both), the rotor's angle
+   * where the last fitted sweep ended [rad electrical], the fit's rms
+   * residual / |a| (the larger of the sweeps'), the sweeps' difference in
+   * a and in b over |a|, the first sweep's lag of the rotor behind the
+   * current vector [rad electrical] (docs/commissioning.md) */
   float result[PROC_RESULTS];
 } proc_telemetry_t;
 
@@ -326,6 +333,30 @@ typedef struct {
   float res[4];             /* J, T_c, B, the fit's residual */
   float w;                  /* the speed [rad/s mechanical] (the PLL's) */
 } proc_mech_t;
+/* The star point's a, b (proc_star.c): the signals of a sweep in
+ * PROC_STAR_BINS bins of the current vector's angle, then their fit. */
+#define PROC_STAR_BINS 32u
+typedef struct {
+  float y[PROC_STAR_BINS][2]; /* each bin's mean -Gamma_alpha + j Gamma_beta (/ v_dc) */
+  float g_acc[3];             /* the bin in force: each test vector's signals summed */
+  uint16_t g_n[3];            /* and counted */
+  uint8_t phase;              /* proc_star.c: PH_* */
+  uint8_t bin;                /* the bin in force (sweep) or fitted (fit) */
+  uint8_t pass;               /* the fit's pass (0: the start) */
+  bool done;
+  uint32_t n;        /* periods into the phase */
+  uint32_t n_all;    /* periods since it began */
+  current_ctrl_t cc; /* the current vector's loop (the stator frame) */
+  float a, b;        /* the fit in progress */
+  float lag[2];      /* e^{-j2 delta}: the rotor's lag behind the vector */
+  float h[3];        /* the reduced normal matrix (00, 01, 11) */
+  float acc[4];      /* the pass's sums (the start's A, B; the gradient and the lag) */
+  float res2;        /* the pass's squared residuals */
+  float swing;       /* the alignment's rotor movement (the source's speed integrated) [rad] */
+  float dir;         /* the sweeps' direction: +1 (0 -> pi) or -1 (0 -> -pi) */
+  float theta_end;   /* the rotor's angle where the sweep ended [rad electrical] */
+  float sw[2][4];    /* each sweep's a, b, lag [rad electrical], rms residual / |a| */
+} proc_star_t;
 
 typedef union {
   proc_offset_t offset;
@@ -338,6 +369,7 @@ typedef union {
   proc_enc_t enc;
   proc_flux_t flux;
   proc_mech_t mech;
+  proc_star_t star;
 } proc_state_t;
 
 typedef struct {

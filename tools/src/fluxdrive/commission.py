@@ -67,6 +67,11 @@ RESULTS: dict[str, list[Result]] = {
     # proc_offset.c: the three current-sensor offsets [A] (measured again
     # at every enable: no parameter holds them)
     "offset": [Result(0, "offset_a", "A"), Result(1, "offset_b", "A"), Result(2, "offset_c", "A")],
+    # proc_star.c: the star point's a, b of (3.7) (normalised to v_dc), p =
+    # b/a, the fit's rms residual over |a| (truth: --print-truth's star.a,
+    # star.b)
+    "star": [Result(0, "star.a", "", "dfc_a"), Result(1, "star.b", "", "dfc_b"),
+             Result(2, "star_p", ""), Result(4, "star_residual", "")],
 }
 
 

@@ -82,7 +82,8 @@ bool sil_commission_main(sil_commission_t *cm, const sil_commission_list_t *list
   *s = (sil_commission_step_t){
       .proc = list->proc[cm->k], .status = PROC_ST_RUNNING, .t0 = t, .t1 = -1.0};
   cm->n = cm->k + 1;
-  cm->theta0 = theta_m;
+  cm->theta_prev = theta_m;
+  cm->theta_run = 0.0;
   cm->phase = 0u;
   memset(cm->last, 0, sizeof cm->last);
   const char *why = drive_cmd_identify(drv, (proc_id_t)s->proc, NULL);
@@ -106,8 +107,11 @@ void sil_commission_observe(sil_commission_t *cm, const double i_abc[3], double 
     const double a = fabs(i_abc[j]);
     s->i_peak = a > s->i_peak ? a : s->i_peak;
   }
-  /* the movement on the shortest way round (theta_m wraps at 2 pi) */
-  double d = fmod(theta_m - cm->theta0, 2.0 * CM_PI);
+  /* the movement unwrapped: each period's step on the shortest way round
+   * (theta_m wraps at 2 pi; a period turns the rotor far less than pi) */
+  double d = theta_m - cm->theta_prev;
   d = d > CM_PI ? d - 2.0 * CM_PI : (d < -CM_PI ? d + 2.0 * CM_PI : d);
-  s->move = fabs(d) > s->move ? fabs(d) : s->move;
+  cm->theta_prev = theta_m;
+  cm->theta_run += d;
+  s->move = fabs(cm->theta_run) > s->move ? fabs(cm->theta_run) : s->move;
 }

@@ -38,7 +38,8 @@ typedef struct {
   float result[PROC_RESULTS];
   double t0, t1; /* posted, ended [s] (t1 < 0: not ended) */
   double i_peak; /* the true largest phase current while it ran [A] */
-  double move;   /* the true largest rotor movement from its start [rad mech] */
+  double move;   /* the true largest rotor movement from its start, unwrapped (a spin
+                    counts every turn) [rad mech] */
 } sil_commission_step_t;
 
 /* The run's record and the main loop's progress through the list. */
@@ -50,7 +51,8 @@ typedef struct {
   bool done;                /* the list has ended (or was empty) */
   uint8_t phase;            /* the step's phase last seen */
   float last[PROC_RESULTS]; /* and its results then */
-  double theta0;            /* the rotor's true angle at the step's start [rad mech] */
+  double theta_prev;        /* the rotor's true angle last period [rad mech, wrapped] */
+  double theta_run;         /* its movement since the step's start, unwrapped [rad mech] */
   sil_commission_step_t step[SIL_COMMISSION_MAX];
   int n_points;
   bool points_full; /* points were dropped (SIL_COMMISSION_POINTS) */

@@ -29,14 +29,16 @@
 
 /* d_eff for a leg with duty d and kd = td/Ts when 0 < d < 1, else kd = 0
  * (no switching, no dead time: d_eff = d - 0 = d; only a NaN current, i.e.
- * an already diverged state, gives NaN there). The clamps are branches:
- * well predicted (a current crosses its band a few times per electrical
- * period), they keep the comparisons off the stage-to-stage dependency
- * chain, which bounds the speed of the integrator. */
+ * an already diverged state, gives NaN there). Each clamp is written as
+ * `bound OP v ? bound : v`, the operand order of SSE's MAXSD/MINSD (the
+ * second operand when unordered: NaN passes through, as before), so that
+ * the compiler emits the two instructions instead of compares and
+ * branches: the same values for every input, signed zeros included. */
 static inline double eff_duty(double d, double kd, double i_norm) {
-  const double sg = i_norm > 1.0 ? 1.0 : (i_norm < -1.0 ? -1.0 : i_norm);
-  const double e = d - kd * sg;
-  return e < 0.0 ? 0.0 : (e > 1.0 ? 1.0 : e);
+  const double lo = -1.0 > i_norm ? -1.0 : i_norm;
+  const double sg = 1.0 < lo ? 1.0 : lo;
+  const double e0 = 0.0 > d - kd * sg ? 0.0 : d - kd * sg;
+  return 1.0 < e0 ? 1.0 : e0;
 }
 
 /* Rotor angle reference: the stage angles differ from the reference angle

@@ -209,7 +209,8 @@ void plant_sample(plant_t *pl, plant_adc_t *out) {
   if (s->encoder_cpr > 0) {
     const double step = a->enc_step;
     double cnt = plant_floor(pl->theta_m / step);
-    cnt = cnt >= s->encoder_cpr ? 0.0 : (cnt < 0.0 ? 0.0 : cnt);
+    const double c0 = 0.0 > cnt ? 0.0 : cnt; /* MAXSD (NaN passes) */
+    cnt = cnt >= s->encoder_cpr ? 0.0 : c0;
     out->enc_angle = cnt * step;
   } else {
     out->enc_angle = pl->theta_m;

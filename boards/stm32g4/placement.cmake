@@ -30,7 +30,7 @@ set(FD_PLACEMENT_g474 all)
 set(FD_FLASH_SOURCES_g474
   can_proto.c can_codec.c drive_config.c drive_params.c drive_host.c drive_enums.c
   drive_safe.c drive_pos_check.c drive_phase_check.c
-  proc.c proc_offset.c proc_align.c proc_hold.c drive_signals.c pos_dfc_signals.c
+  proc.c proc_offset.c proc_align.c proc_hold.c proc_rs.c proc_ldq.c drive_signals.c pos_dfc_signals.c
   flux_map_blob.c)
 
 # B-G431B-ESC1 (10 KiB CCM SRAM): the drive's ISR body and the law step

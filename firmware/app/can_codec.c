@@ -25,6 +25,7 @@ static const can_sig_desc_t sigs[CAN_SIG_COUNT] = {
   {"param_id",          8,  8, false, false, 1.0f,    0.0f, 0.0f,      255.0f, 0, 255},
   {"param_value",      32, 32, true,  true,  1.0f,    0.0f, -F32_MAX,  F32_MAX, 0, 0},
   {"host_hb_count",     0,  8, false, false, 1.0f,    0.0f, 0.0f,      255.0f, 0, 255},
+  {"cmd_proc",          0,  8, false, false, 1.0f,    0.0f, 0.0f,      255.0f, 0, 255},
   {"reply_req",         0,  8, false, false, 1.0f,    0.0f, 0.0f,      255.0f, 0, 255},
   {"reply_result",      8,  8, false, false, 1.0f,    0.0f, 0.0f,      255.0f, 0, 255},
   {"reply_signal",     16,  8, false, false, 1.0f,    0.0f, 0.0f,      255.0f, 0, 255},
@@ -60,6 +61,11 @@ static const can_sig_desc_t sigs[CAN_SIG_COUNT] = {
   {"load_torque_est",   0, 32, true,  false, 1e-4f,   0.0f, -214748.3648f, 214748.3647f, -2147483648, 2147483647},
   {"pos_err",          32, 16, false, false, 1e-4f,   0.0f, 0.0f,      6.5535f, 0, 65535},
   {"rls_ok",           48,  1, false, false, 1.0f,    0.0f, 0.0f,      1.0f, 0, 1},
+  {"proc_id",           0,  8, false, false, 1.0f,    0.0f, 0.0f,      255.0f, 0, 255},
+  {"proc_status",       8,  8, false, false, 1.0f,    0.0f, 0.0f,      255.0f, 0, 255},
+  {"proc_phase",       16,  8, false, false, 1.0f,    0.0f, 0.0f,      255.0f, 0, 255},
+  {"proc_index",       24,  8, false, false, 1.0f,    0.0f, 0.0f,      255.0f, 0, 255},
+  {"proc_result",      32, 32, true,  true,  1.0f,    0.0f, -F32_MAX,  F32_MAX, 0, 0},
   {"hb_count",          0,  8, false, false, 1.0f,    0.0f, 0.0f,      255.0f, 0, 255},
   {"hb_state",          8,  8, false, false, 1.0f,    0.0f, 0.0f,      255.0f, 0, 255},
 };
@@ -73,6 +79,7 @@ static const can_msg_desc_t msgs[CAN_MSG_COUNT] = {
   {"CMD_FLUX",    0x140, 4, true,  CAN_SIG_CMD_FLUX,      1},
   {"PARAM_REQ",   0x150, 8, true,  CAN_SIG_PARAM_OP,      3},
   {"HOST_HB",     0x160, 1, true,  CAN_SIG_HOST_HB_COUNT, 1},
+  {"CMD_PROC",    0x170, 1, true,  CAN_SIG_CMD_PROC,      1},
   {"REPLY",       0x180, 8, false, CAN_SIG_REPLY_REQ,     5},
   {"STATUS",      0x200, 8, false, CAN_SIG_STATE,         8},
   {"TM_SPEED",    0x300, 8, false, CAN_SIG_SPEED_RPM,     2},
@@ -82,6 +89,7 @@ static const can_msg_desc_t msgs[CAN_MSG_COUNT] = {
   {"TM_FLUX",     0x340, 8, false, CAN_SIG_FLUX,          4},
   {"TM_CPU",      0x350, 8, false, CAN_SIG_ISR_CYCLES_MEAN, 4},
   {"TM_POSITION", 0x360, 7, false, CAN_SIG_LOAD_TORQUE_EST, 3},
+  {"TM_PROC",     0x370, 8, false, CAN_SIG_PROC_ID,       5},
   {"HEARTBEAT",   0x700, 2, false, CAN_SIG_HB_COUNT,      2},
 };
 /* clang-format on */

@@ -25,6 +25,7 @@ typedef enum {
   CAN_MSG_CMD_FLUX,
   CAN_MSG_PARAM_REQ,
   CAN_MSG_HOST_HB,
+  CAN_MSG_CMD_PROC,
   CAN_MSG_REPLY,
   CAN_MSG_STATUS,
   CAN_MSG_TM_SPEED,
@@ -34,6 +35,7 @@ typedef enum {
   CAN_MSG_TM_FLUX,
   CAN_MSG_TM_CPU,
   CAN_MSG_TM_POSITION,
+  CAN_MSG_TM_PROC,
   CAN_MSG_HEARTBEAT,
   CAN_MSG_COUNT
 } can_msg_t;
@@ -54,6 +56,7 @@ typedef enum {
   CAN_SIG_PARAM_ID,
   CAN_SIG_PARAM_VALUE,
   CAN_SIG_HOST_HB_COUNT,
+  CAN_SIG_CMD_PROC,
   CAN_SIG_REPLY_REQ,
   CAN_SIG_REPLY_RESULT,
   CAN_SIG_REPLY_SIGNAL,
@@ -89,6 +92,11 @@ typedef enum {
   CAN_SIG_LOAD_TORQUE_EST,
   CAN_SIG_POS_ERR,
   CAN_SIG_RLS_OK,
+  CAN_SIG_PROC_ID,
+  CAN_SIG_PROC_STATUS,
+  CAN_SIG_PROC_PHASE,
+  CAN_SIG_PROC_INDEX,
+  CAN_SIG_PROC_RESULT,
   CAN_SIG_HB_COUNT,
   CAN_SIG_HB_STATE,
   CAN_SIG_COUNT
@@ -110,6 +118,9 @@ typedef enum {
 /* CMD_STATE.enable / mode / law: this value leaves the setting as it is
  * (outside every range of laws and modes). */
 #define CAN_KEEP 255u
+/* CMD_PROC.cmd_proc: stop the identification running; TM_PROC.proc_id: no
+ * procedure since start-up (the procedures are proc.h's ids below it). */
+#define CAN_PROC_NONE 255u
 
 typedef struct {
   const char *name;

@@ -189,6 +189,9 @@ static float value_in_force(const drive_t *drv, can_msg_t m) {
     return c->id;
   case CAN_MSG_CMD_FLUX:
     return c->flux;
+  case CAN_MSG_CMD_PROC: /* the identification last asked for (255: a stop, or none) */
+    return c->ident_count != 0u && c->ident < (uint32_t)PROC_COUNT ? (float)c->ident
+                                                                   : (float)CAN_PROC_NONE;
   default:
     return 0.0f;
   }
@@ -240,6 +243,28 @@ static void handle_state(const can_proto_t *p, drive_t *drv, const uint8_t *d, r
   r->value = value_in_force(drv, CAN_MSG_CMD_STATE);
 }
 
+/* CMD_PROC: an identification procedure run alone, or 255 the stop
+ * (drive_cmd_identify). Refused: an id that is no procedure out_of_range,
+ * a procedure that is no identification unavailable (both naming
+ * cmd_proc), the drive enabled not_while_running (naming enable). Whether
+ * the parameter set in force can run it is the ISR's to say (TM_PROC
+ * status refused). */
+static void handle_proc(const can_proto_t *p, drive_t *drv, const uint8_t *d, reply_t *r) {
+  const uint32_t v = can_codec_get_raw(CAN_SIG_CMD_PROC, d);
+  if (v >= (uint32_t)PROC_COUNT && v != CAN_PROC_NONE) {
+    reply_error(r, CAN_RESULT_OUT_OF_RANGE, CAN_SIG_CMD_PROC);
+  } else if (!p->ramp) {
+    const char *field = NULL;
+    const proc_id_t id = v == CAN_PROC_NONE ? PROC_NONE : (proc_id_t)v;
+    if (drive_cmd_identify(drv, id, &field) != NULL) {
+      const bool enabled = field != NULL && strcmp(field, "enable") == 0;
+      reply_error(r, enabled ? CAN_RESULT_NOT_WHILE_RUNNING : CAN_RESULT_UNAVAILABLE,
+                  enabled ? CAN_SIG_ENABLE : CAN_SIG_CMD_PROC);
+    }
+  }
+  r->value = value_in_force(drv, CAN_MSG_CMD_PROC);
+}
+
 /* Applies a CMD_* frame (DLC and DBC ranges already checked). */
 static void handle_cmd(const can_proto_t *p, drive_t *drv, can_msg_t m, const uint8_t *d,
                        reply_t *r) {
@@ -247,6 +272,9 @@ static void handle_cmd(const can_proto_t *p, drive_t *drv, can_msg_t m, const ui
   switch (m) {
   case CAN_MSG_CMD_STATE:
     handle_state(p, drv, d, r);
+    return;
+  case CAN_MSG_CMD_PROC:
+    handle_proc(p, drv, d, r);
     return;
   case CAN_MSG_CMD_TORQUE: {
     float t = can_codec_get(CAN_SIG_CMD_TORQUE, d);
@@ -363,6 +391,14 @@ static void timeout_step(can_proto_t *p, drive_t *drv, uint32_t now) {
         now - p->last_rx_us < (uint32_t)p->cfg.timeout_ms * 1000u) {
       return;
     }
+    if (drive_commands(drv)->enable == 0u) {
+      /* enabled without an enable: an identification (drive_cmd_identify).
+       * No torque to ramp down and nobody watching it: the fault at once */
+      drive_request_fault(drv, DRIVE_FAULT_CMD_TIMEOUT);
+      p->stats.timeouts++;
+      p->last_rx_us = now; /* once: the next poll sees the fault */
+      return;
+    }
     p->ramp = true;
     p->ramp_t0_us = now;
     p->ramp_torque0 = drive_telemetry(drv)->torque_ref;
@@ -449,6 +485,20 @@ static void send_periodic(can_proto_t *p, can_period_t which, const drive_t *drv
   case CAN_PERIOD_TM_POSITION:
     telemetry_frame(&f, CAN_MSG_TM_POSITION, node, &src);
     break;
+  case CAN_PERIOD_TM_PROC: {
+    /* the procedure telemetry (proc.h), one result per frame, cycling */
+    const proc_telemetry_t *pt = &tm->proc;
+    const unsigned k = p->proc_index % (unsigned)PROC_RESULTS;
+    p->proc_index = (uint8_t)((k + 1u) % (unsigned)PROC_RESULTS);
+    frame_init(&f, CAN_MSG_TM_PROC, node);
+    const bool none = pt->status == PROC_ST_IDLE || pt->id >= (uint8_t)PROC_COUNT;
+    can_codec_set_raw(CAN_SIG_PROC_ID, f.data, none ? CAN_PROC_NONE : (uint32_t)pt->id);
+    can_codec_set_raw(CAN_SIG_PROC_STATUS, f.data, pt->status);
+    can_codec_set_raw(CAN_SIG_PROC_PHASE, f.data, pt->phase);
+    can_codec_set_raw(CAN_SIG_PROC_INDEX, f.data, k);
+    can_codec_set(CAN_SIG_PROC_RESULT, f.data, pt->result[k]);
+    break;
+  }
   case CAN_PERIOD_TM_CPU:
   default: {
     /* the board's measured ISR cycles (hal_isr_stats, DWT): the figure

@@ -29,7 +29,13 @@
  * DRIVE_FAULT_CMD_TIMEOUT) turns the gates off and latches the fault, and
  * the references are zeroed (speed, torque, currents; the previous mode is
  * restored) so that clear_fault + enable restarts from rest. During the
- * ramp, CMD_* frames are answered timed_out and not applied.
+ * ramp, CMD_* frames are answered timed_out and not applied. An
+ * identification (CMD_PROC: enabled without an enable) has no torque to
+ * ramp: its timeout latches the fault at once (gates off, state fault).
+ *
+ * CMD_PROC: runs an identification procedure alone (drive_cmd_identify),
+ * 255 stops it; TM_PROC: the procedure telemetry (proc.h), one of its
+ * PROC_RESULTS results per frame, the index cycling.
  */
 #ifndef FLUXDRIVE_CAN_PROTO_H
 #define FLUXDRIVE_CAN_PROTO_H
@@ -55,7 +61,8 @@
   X(TM_DQ, tm_dq, 10)                                                                              \
   X(TM_FLUX, tm_flux, 10)                                                                          \
   X(TM_CPU, tm_cpu, 100)                                                                           \
-  X(TM_POSITION, tm_position, 10)
+  X(TM_POSITION, tm_position, 10)                                                                  \
+  X(TM_PROC, tm_proc, 10)
 
 #define CAN_PERIOD_ENUM(E, n, ms) CAN_PERIOD_##E,
 typedef enum { CAN_PERIOD_LIST(CAN_PERIOD_ENUM) CAN_PERIOD_COUNT } can_period_t;
@@ -90,6 +97,7 @@ typedef struct {
   bool pending;           /* a reply waits for room in the TX queue */
   hal_can_frame_t pending_frame;
   uint8_t hb_count;
+  uint8_t proc_index; /* TM_PROC: the result the next frame carries (0..PROC_RESULTS - 1) */
   /* last STATUS content sent (a change sends one at once) */
   drive_state_t st_state;
   uint32_t st_faults;

@@ -24,7 +24,7 @@
 #include "math/frames.h"
 
 static bool gates_on_state(drive_state_t s) {
-  return s == DRIVE_STATE_RUN || s == DRIVE_STATE_ALIGN;
+  return s == DRIVE_STATE_RUN || s == DRIVE_STATE_ALIGN || s == DRIVE_STATE_IDENT;
 }
 
 /* The mode in force (drive_t.mode): current mode only with a law that has
@@ -442,6 +442,13 @@ static void take_commands(drive_t *drv) {
     drv->fault_total_seen = drv->cmd.fault_total;
     take_fault_requests(drv);
   }
+  /* an identification request: acted on in idle (a start) or during an
+   * identification run (a stop); anywhere else it is void (the main loop
+   * refused it with the drive enabled) */
+  if (drv->cmd.ident_count != drv->ident_seen) {
+    drv->ident_seen = drv->cmd.ident_count;
+    drv->ident_new = drv->state == DRIVE_STATE_IDLE || drv->ident;
+  }
 }
 
 /* ---------------------------------------------------------- protections */
@@ -854,19 +861,62 @@ FD_COLD FD_NOINLINE static void drive_gates_start(drive_t *drv) {
   hal_pwm_enable();
 }
 
+static void drive_proc_next(drive_t *drv, uint32_t k);
+
+/* An identification run ends (done, stopped, aborted): the gates off if
+ * they were on, idle. */
+FD_COLD FD_NOINLINE static void drive_ident_end(drive_t *drv) {
+  if (gates_on_state(drv->state)) {
+    drive_gates_off(drv);
+    protect_safe_leave_gates(&drv->safe);
+  }
+  drv->ident = false;
+  drv->ident_new = false;
+  drv->plain = false;
+  drv->state = DRIVE_STATE_IDLE;
+}
+
+/* An identification request taken in idle (drive_cmd_identify): the run
+ * of the offsets and the procedure, or its refusal (PROC_ST_REFUSED: the
+ * parameter set in force cannot run it; a stop request: nothing). */
+FD_COLD FD_NOINLINE static void drive_ident_start(drive_t *drv) {
+  drv->ident_new = false;
+  const proc_id_t id = (proc_id_t)drv->cmd.ident;
+  if (id >= PROC_NONE) {
+    return;
+  }
+  const proc_setup_t su = drive_proc_setup(drv);
+  const char *field;
+  if (proc_ident_refusal(id, &su, &field) != NULL) {
+    drv->tm.proc = (proc_telemetry_t){.id = (uint8_t)id, .status = PROC_ST_REFUSED};
+    return;
+  }
+  unsigned n;
+  proc_ident_sequence(id, drv->ident_seq, &n);
+  drv->ident_n = n;
+  drv->ident = true;
+  drv->pos_src->reset(&drv->pos_st);
+  drive_proc_next(drv, 0u);
+}
+
 /* The start from sequence index k on (proc_start_sequence): the next
  * procedure that applies begins, the gates coming on first if it
  * modulates; none left: the law runs (from a reset: a procedure's current
  * leaves the law's observers and integrators behind). */
 FD_COLD FD_NOINLINE static void drive_proc_next(drive_t *drv, uint32_t k) {
   const proc_setup_t su = drive_proc_setup(drv);
-  unsigned n;
-  const proc_id_t *seq = proc_start_sequence(&n);
-  while (k < n && !proc_applies(seq[k], &su)) {
+  unsigned n = drv->ident_n;
+  const proc_id_t *seq = drv->ident ? drv->ident_seq : proc_start_sequence(&n);
+  /* an identification runs its procedures as they are; the start those it wants */
+  while (k < n && !drv->ident && !proc_applies(seq[k], &su)) {
     ++k;
   }
   const proc_row_t *r = k < n ? proc_row(seq[k]) : NULL;
   const bool gates = gates_on_state(drv->state);
+  if (r == NULL && drv->ident) { /* the identification's end: the gates off, idle */
+    drive_ident_end(drv);
+    return;
+  }
   if (!gates && (r == NULL || (r->caps & PROC_CAP_GATES) != 0u)) {
     drive_gates_start(drv);
   }
@@ -883,7 +933,7 @@ FD_COLD FD_NOINLINE static void drive_proc_next(drive_t *drv, uint32_t k) {
   }
   r->init(&drv->proc_st, &su);
   proc_telemetry_t *t = &drv->tm.proc;
-  *t = (proc_telemetry_t){(uint8_t)r->id, PROC_ST_RUNNING, 0u, 0u, 0u, {0.0f, 0.0f, 0.0f}};
+  *t = (proc_telemetry_t){.id = (uint8_t)r->id, .status = PROC_ST_RUNNING};
   drv->state = (drive_state_t)r->state;
 }
 
@@ -1037,12 +1087,24 @@ void drive_isr(drive_t *drv) {
     if (enable && !drv->safe.asc) { /* the short first ends (protect/drive_safe.c) */
       drv->pos_src->reset(&drv->pos_st);
       drive_proc_next(drv, 0u); /* the start's first procedure: the offsets */
+    } else if (drv->ident_new) {
+      drv->ident_new = false;
+      if (!enable && !drv->safe.asc) {
+        drive_ident_start(drv);
+      }
     }
     break;
   case DRIVE_STATE_OFFSET_CAL:
-    if (!enable) {
+  case DRIVE_STATE_IDENT:
+    /* the start's offsets stop on a disable; an identification's run on an
+     * enable or another request (a stop) */
+    if (drv->ident ? (enable || drv->ident_new) : !enable) {
       drive_proc_abort(drv);
-      drv->state = DRIVE_STATE_IDLE;
+      if (drv->ident) {
+        drive_ident_end(drv);
+      } else {
+        drv->state = DRIVE_STATE_IDLE;
+      }
     } else {
       drive_proc_step(drv, i, &s);
     }
@@ -1067,6 +1129,8 @@ void drive_isr(drive_t *drv) {
     if (drv->proc != NULL) { /* tripped by another cause during a procedure */
       drive_proc_abort(drv);
     }
+    drv->ident = false; /* an identification ends with the fault */
+    drv->ident_new = false;
     break; /* all off or shorted: drive_safe */
   }
   if (!gates_on_state(drv->state)) {

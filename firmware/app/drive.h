@@ -110,6 +110,8 @@ typedef struct {
   uint32_t clear_enable_mark;              /* enable_count at the last clear */
   uint32_t fault_count[DRIVE_FAULT_COUNT]; /* drive_request_fault() per bit */
   uint32_t fault_total;                    /* drive_request_fault() calls, all bits */
+  uint32_t ident;       /* the identification asked for (proc_id_t; PROC_NONE: stop it) */
+  uint32_t ident_count; /* drive_cmd_identify() calls */
 } drive_cmd_t;
 
 typedef struct drive_s {
@@ -130,13 +132,10 @@ typedef struct drive_s {
   float offset[3];
 
   /* the procedure in force (proc.h: offset calibration, alignment, held
-   * start), its place in the start sequence and its state: 84 B on the
-   * Cortex-M, what the offset calibration's and the alignment's fields took
-   * here before, so the periodic path's fields after them keep their
-   * offsets (and the PIL counts; a larger union moves them) */
+   * start, identification) and its place in its sequence; its state is
+   * last (proc_st) */
   const proc_row_t *proc; /* NULL: none (idle, run, fault) */
   uint32_t proc_k;        /* its index in proc_start_sequence() */
-  proc_state_t proc_st;
 
   /* position */
   const pos_source_row_t *pos_src;
@@ -213,6 +212,12 @@ typedef struct drive_s {
   drive_law_t law_refused;   /* a law whose switch the ISR refused (DRIVE_LAW_COUNT: none) */
   uint32_t fault_total_seen; /* req.fault_total taken */
   uint32_t fault_seen[DRIVE_FAULT_COUNT];
+  uint32_t ident_seen;    /* cmd.ident_count taken */
+  bool ident_new;         /* an identification request taken, not yet acted on (idle or
+                             identifying: drive.c, "the identification") */
+  bool ident;             /* the procedures in force are an identification run's */
+  proc_id_t ident_seq[2]; /* that run: the offsets, then the procedure (proc_ident_sequence) */
+  uint32_t ident_n;       /* its length */
   /* the protections at the slow rate (drive.c's schedule table) or with
    * the gates off, each an owned part in protect/ */
   protect_isum_t isum;       /* the current-sum (current-sensor) check */
@@ -224,6 +229,10 @@ typedef struct drive_s {
   float flux_scale;          /* flux amplitude on MTPA at i_max [Vs] */
   float psi_pm;              /* |flux linkage at zero current| of the model [Vs] */
   dq_t psi0;                 /* that flux linkage [Vs] */
+  /* the state of the procedure in force (proc.h), last: a procedure runs
+   * from flash outside the run (FD_COLD), and its state, however large an
+   * identification's, moves nothing the periodic path reads */
+  proc_state_t proc_st;
 } drive_t;
 
 /* The layout rules the ISR's instruction counts depend on (docs/pil.md),
@@ -247,6 +256,7 @@ _Static_assert(offsetof(drive_t, cfg) > offsetof(drive_t, win_k) &&
                    offsetof(drive_t, ctrl) > offsetof(drive_t, win_k) &&
                    offsetof(drive_t, pos_st) > offsetof(drive_t, win_k),
                "drive_t: the parts reached through a pointer after the per-period scalars");
+_Static_assert(sizeof(proc_state_t) <= 1024u, "proc_state_t: a procedure's state beyond 1 KiB");
 _Static_assert(offsetof(drive_t, clear_seen) > offsetof(drive_t, host) &&
                    offsetof(drive_t, psi0) > offsetof(drive_t, clear_seen),
                "drive_t: the slow-rate and command fields last");
@@ -286,7 +296,8 @@ void drive_machine_copy(machine_t *dm, flux_map_t *dmap, const machine_t *m, con
  * (non-LIVE parameters are refused then). Inline: the ISR asks every
  * period. */
 static inline bool drive_state_enabled(drive_state_t s) {
-  return s == DRIVE_STATE_OFFSET_CAL || s == DRIVE_STATE_RUN || s == DRIVE_STATE_ALIGN;
+  return s == DRIVE_STATE_OFFSET_CAL || s == DRIVE_STATE_RUN || s == DRIVE_STATE_ALIGN ||
+         s == DRIVE_STATE_IDENT;
 }
 
 /* The enable in force as the main loop sees it (STATUS.cmd_enabled): an
@@ -321,6 +332,14 @@ void drive_cmd_torque(drive_t *drv, float torque);
 void drive_cmd_speed(drive_t *drv, float speed_m);
 void drive_cmd_current(drive_t *drv, float id, float iq);
 void drive_cmd_flux(drive_t *drv, float flux);
+/* Runs an identification procedure (a row with PROC_CAP_IDENT, proc.h)
+ * with the drive disabled: the offsets, then the procedure, then the gates
+ * off again, its progress and results in the telemetry (tm.proc). PROC_NONE
+ * stops the one running; so does an enable command, another request, a
+ * fault and every protection. NULL when posted, else why not (not an
+ * identification procedure, the drive enabled, the requested parameter
+ * set cannot run it: *field names the parameter). field may be NULL. */
+const char *drive_cmd_identify(drive_t *drv, proc_id_t id, const char **field);
 /* Asks the ISR to latch a fault (e.g. the CAN command timeout). */
 void drive_request_fault(drive_t *drv, uint32_t fault_bits);
 

@@ -30,7 +30,8 @@
   X(OFFSET_CAL, offset_cal, "gates off, averaging the current-sensor offsets")      \
   X(RUN, run, "gates on, control law active")                                       \
   X(FAULT, fault, "gates off, causes latched until cleared")                        \
-  X(ALIGN, align, "gates on, d current along the assumed axis (position sources)")
+  X(ALIGN, align, "gates on, d current along the assumed axis (position sources)")     \
+  X(IDENT, ident, "gates on, an identification procedure the host asked for (commissioning)")
 
 /* Fault causes, bit n = list position n: X(ENUM, name, doc). */
 #define DRIVE_FAULT_LIST(X)                                                                     \

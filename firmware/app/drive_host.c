@@ -189,6 +189,30 @@ void drive_cmd_flux(drive_t *drv, float flux) {
   cmd_end(drv);
 }
 
+const char *drive_cmd_identify(drive_t *drv, proc_id_t id, const char **field) {
+  const char *f_dummy = NULL;
+  const char **f = field != NULL ? field : &f_dummy;
+  *f = "proc";
+  if (id != PROC_NONE) {
+    const proc_row_t *r = proc_row(id);
+    if (r == NULL || (r->caps & PROC_CAP_IDENT) == 0u) {
+      return "not an identification procedure";
+    }
+    if (drv->req.cmd.enable != 0u) {
+      *f = "enable";
+      return "the drive is enabled: disable it first";
+    }
+  }
+  *f = NULL;
+  /* whether the parameter set in force can run it is the ISR's to say
+   * (PROC_ST_REFUSED): the set and the machine are its */
+  drive_cmd_t *c = cmd_begin(drv);
+  c->ident = (uint32_t)id;
+  c->ident_count++;
+  cmd_end(drv);
+  return NULL;
+}
+
 void drive_request_fault(drive_t *drv, uint32_t fault_bits) {
   drive_cmd_t *c = cmd_begin(drv);
   for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {

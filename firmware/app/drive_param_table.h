@@ -197,6 +197,23 @@
     "RLS: lower limit of P's diagonal (keeps the identification alive)")                                   \
   X(108, rls_w_min,     F32,  "rad/s",  50.0f,       0.0f,    1e5f,     LIVE, "controller.rls_w_min",      \
     "RLS: identify only above this electrical speed (a and b are not separable at standstill)")           \
+  /* identification (issue 25; docs/commissioning.md): rs (proc_rs.c), ldq (proc_ldq.c) */                 \
+  X(200, id_rs_current, F32,  "A",      0.0f,        0.0f,    1e4f,     IDLE, "controller.id_rs_current",  \
+    "rs identification: the current limit (top level 0.9 of it), clamped to i_max; 0: half of i_max")   \
+  X(201, id_rs_levels,  U16,  "",       8.0f,        3.0f,    12.0f,    IDLE, "controller.id_rs_levels",   \
+    "rs identification: current levels of each sign")                                                     \
+  X(202, id_rs_align,   F32,  "s",      0.3f,        0.0f,    10.0f,    IDLE, "controller.id_rs_align",    \
+    "rs identification: the alignment at the top level before each sign's levels (the rotor turns)")     \
+  X(203, id_rs_settle,  F32,  "s",      0.02f,       0.0f,    10.0f,    IDLE, "controller.id_rs_settle",   \
+    "rs identification: a level's settling before its average")                                           \
+  X(204, id_rs_avg,     F32,  "s",      0.04f,       1e-3f,   10.0f,    IDLE, "controller.id_rs_avg",      \
+    "rs identification: a level's average")                                                               \
+  X(205, id_ldq_current, F32, "A",      0.0f,        0.0f,    1e4f,     IDLE, "controller.id_ldq_current", \
+    "ldq identification: the d bias current (aligns the rotor, keeps the phase currents' signs); 0: a third of i_max; clamped to i_max / 2") \
+  X(206, id_ldq_freq,   F32,  "Hz",     1000.0f,      10.0f,   1e4f,     IDLE, "controller.id_ldq_freq",    \
+    "ldq identification: the square-wave injection's frequency (rounded to whole PWM periods)")          \
+  X(207, id_ldq_time,   F32,  "s",      0.2f,        0.01f,   10.0f,    IDLE, "controller.id_ldq_time",    \
+    "ldq identification: each axis' injection measured for this long")                                     \
   /* timing and calibration */                                                                              \
   X(40, ts,             F32,  "s",      6.25e-5f,    1e-6f,   1e-2f,    RO,   "inverter.pwm_frequency",    \
     "PWM and ISR period")                                                                                   \

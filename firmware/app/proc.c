@@ -46,3 +46,19 @@ FD_COLD const char *proc_start_refusal(const proc_setup_t *su, const char **fiel
   }
   return NULL;
 }
+
+FD_COLD void proc_ident_sequence(proc_id_t id, proc_id_t seq[2], unsigned *n) {
+  seq[0] = PROC_OFFSET;
+  seq[1] = id;
+  *n = id == PROC_OFFSET ? 1u : 2u;
+}
+
+FD_COLD const char *proc_ident_refusal(proc_id_t id, const proc_setup_t *su, const char **field) {
+  const proc_row_t *r = proc_row(id);
+  *field = "proc";
+  if (r == NULL || (r->caps & PROC_CAP_IDENT) == 0u) {
+    return "not an identification procedure";
+  }
+  *field = NULL;
+  return r->check != NULL ? r->check(su, field) : NULL;
+}

@@ -52,7 +52,11 @@
 #define PROC_LIST(X)                                                                               \
   X(OFFSET, offset, "current sensor offsets with the gates off (offset_samples averaged)")         \
   X(ALIGN, align, "d current along theta = 0 for align_time; an encoder's: damped, until settled") \
-  X(HOLD, hold, "the held start (start_mode 1): angle at standstill, polarity from two d pulses")
+  X(HOLD, hold, "the held start (start_mode 1): angle at standstill, polarity from two d pulses")  \
+  X(RS, rs,                                                                                        \
+    "identification: R_s and the inverter's voltage error v_err(i) from DC levels, both signs")    \
+  X(LDQ, ldq,                                                                                      \
+    "identification: L_d, L_q at standstill, square-wave voltage injection along d, then q")
 
 #define PROC_ENUM(E, n, d) PROC_##E,
 typedef enum { PROC_LIST(PROC_ENUM) PROC_COUNT } proc_id_t;
@@ -68,23 +72,29 @@ enum {
   PROC_ST_RUNNING = 1,
   PROC_ST_DONE = 2,
   PROC_ST_FAILED = 3,
-  PROC_ST_ABORTED = 4 /* disabled or tripped by another cause while it ran */
+  PROC_ST_ABORTED = 4, /* disabled, stopped or tripped by another cause while it ran */
+  PROC_ST_REFUSED = 5  /* an identification the parameter set in force cannot run (its check) */
 };
 
 enum {
-  PROC_CAP_GATES = 1u << 0 /* modulates: the gates are on while it runs */
+  PROC_CAP_GATES = 1u << 0, /* modulates: the gates are on while it runs */
+  /* an identification procedure: the host may run it alone, with the drive
+   * disabled (drive_cmd_identify; the commissioning, docs/commissioning.md):
+   * the offsets first, then it, then the gates off again */
+  PROC_CAP_IDENT = 1u << 1
 };
 
 /* Results published like telemetry (drive_telemetry_t.proc): the last
  * procedure that ran, where it is, what it found. */
-#define PROC_RESULTS 3
+#define PROC_RESULTS 8
 typedef struct {
   uint8_t id;     /* proc_id_t (PROC_NONE: none yet) */
   uint8_t status; /* PROC_ST_* */
   uint8_t phase;  /* the procedure's own phase (the held start's: acquisition, pulses ...) */
   uint32_t n;     /* periods since it began */
   uint32_t fault; /* PROC_ST_FAILED: the fault bits it raised */
-  /* its results (0 until found): offset: the three offsets [A]; align:
+  /* its results (0 until found; each row's publish documents its own,
+   * docs/commissioning.md the identification's): offset: the three offsets [A]; align:
    * the angle of the current (the source's reference once done) [rad
    * electrical], the periods the rotor has been calm; hold: the angle along the
    * pulses, the north pole's angle [rad electrical], the evidence
@@ -156,10 +166,71 @@ typedef struct {
   bool plain;              /* the pattern without the DFC window (a pulse's clean sample) */
 } proc_hold_t;
 
+/* The ldq identification's alignment (proc_ldq.c): the current's
+ * angle at period n of it: pi/2 for n_first periods (a rotor anywhere but
+ * at -pi/2 turns there), then turned to 0 over n_turn (a rotor left at
+ * -pi/2 is 90 degrees off the current then, and follows too), then 0. A
+ * rotor that starts at pi, where a current along 0 holds it unstably (the
+ * rs procedure leaves it there), is aligned all the same. */
+static inline float proc_ident_align_angle(uint32_t n, uint32_t n_first, uint32_t n_turn) {
+  if (n < n_first) {
+    return 0.5f * FRAMES_PI;
+  }
+  const uint32_t k = n - n_first;
+  return k < n_turn ? 0.5f * FRAMES_PI * (1.0f - (float)k / (float)n_turn) : 0.0f;
+}
+
+/* proc_rs.c: R_s and v_err(i) (issue 25 a). Levels of each sign, at most: */
+#define PROC_RS_LEVELS_MAX 12u
+typedef struct {
+  current_ctrl_t cc;                   /* the level's current loop (frame turned by theta) */
+  uint8_t n_levels;                    /* levels of each sign (id_rs_levels) */
+  uint8_t phase;                       /* proc_rs.c's phases */
+  int8_t last;                         /* the last level measured (-1: none) */
+  uint32_t n;                          /* periods into the phase */
+  uint32_t n_all;                      /* periods since it began */
+  float i_ref;                         /* the current reference, slew-limited [A] */
+  float theta;                         /* the current's axis [rad] */
+  float v_prev;                        /* the axis' voltage asked last period [V] */
+  float acc_v, acc_i;                  /* the level's sums */
+  uint32_t acc_n;                      /* ... of this many periods */
+  float i_peak;                        /* the largest measured current amplitude [A] */
+  float lv_i[2u * PROC_RS_LEVELS_MAX]; /* the levels' mean current, positive then negative [A] */
+  float lv_v[2u * PROC_RS_LEVELS_MAX]; /* ... and commanded voltage [V] */
+  float res[PROC_RESULTS];             /* the fit (proc_rs.c, rs_publish) */
+} proc_rs_t;
+
+/* proc_ldq.c: L_d, L_q at standstill (issue 25 b). A half wave of at most
+ * PROC_LDQ_M_MAX PWM periods (id_ldq_freq at least f_pwm / 32): */
+#define PROC_LDQ_M_MAX 16u
+typedef struct {
+  current_ctrl_t cc;            /* the bias current's loop (alignment, hold) */
+  uint8_t phase;                /* proc_ldq.c's phases */
+  uint8_t axis;                 /* 0: d (the bias' axis), 1: q */
+  uint8_t tries;                /* amplitude adjustments of this axis */
+  uint32_t n;                   /* periods into the phase */
+  uint32_t n_all;               /* periods since it began */
+  float i_ref;                  /* the bias reference, slew-limited [A] */
+  float v_hold[2];              /* the bias' voltage (d, q) held under the injection [V] */
+  float v_h;                    /* the injection's amplitude [V] */
+  float i_prev;                 /* the injected axis' current last period [A] */
+  float acc_d;                  /* the bias current's sum over an injection period [A] */
+  float w[2u * PROC_LDQ_M_MAX]; /* the current summed at each of the wave's periods (5) [A] */
+  uint32_t sn;                  /* ... over this many waves */
+  float i_lo, i_hi;             /* the injected axis' current range [A] */
+  float i_peak;                 /* the largest measured current amplitude [A] */
+  float l[2];                   /* the inductances found (d, q) [H] */
+  float ripple[2];              /* their current ripple, peak to peak [A] */
+  float cross[2];               /* the other axis' ripple over this axis' [-] */
+  float o_lo, o_hi;             /* the other axis' current range under the injection [A] */
+} proc_ldq_t;
+
 typedef union {
   proc_offset_t offset;
   proc_align_t align;
   proc_hold_t hold;
+  proc_rs_t rs;
+  proc_ldq_t ldq;
 } proc_state_t;
 
 typedef struct {
@@ -191,6 +262,11 @@ const proc_row_t *proc_row(proc_id_t id);
 /* The start: the procedures the drive runs from an enable to the run, in
  * order (*n of them). */
 const proc_id_t *proc_start_sequence(unsigned *n);
+/* The identification run of `id` (drive_cmd_identify): the offsets, then
+ * the procedure; *n entries written to seq[2]. */
+void proc_ident_sequence(proc_id_t id, proc_id_t seq[2], unsigned *n);
+/* Whether the host may run `id` alone (PROC_CAP_IDENT): NULL, or why not. */
+const char *proc_ident_refusal(proc_id_t id, const proc_setup_t *su, const char **field);
 /* Whether the start runs `id` with this setup: wanted and able (check). */
 bool proc_applies(proc_id_t id, const proc_setup_t *su);
 /* Every procedure of the start that is wanted must be able: NULL, or the

@@ -68,7 +68,12 @@ int plant_substeps_mech(const plant_params_t *p) {
   const double w_em = p->machine.pole_pairs * psi * sqrt(1.5 / (lmin * p->mech.j));
   const double n_em = ceil(p->ts * w_em / PLANT_HW_MAX);
   const double n_b = ceil(p->ts * b / (PLANT_HC_MAX * p->mech.j));
-  const double n = n_em > n_b ? n_em : n_b;
+  double n = n_em > n_b ? n_em : n_b;
+  if (p->mech.cog_amp != 0.0) { /* the cogging torque's stiffness A N (plant_mech.c) */
+    const double w_cog = sqrt(fabs(p->mech.cog_amp) * p->mech.cog_order / p->mech.j);
+    const double n_cog = ceil(p->ts * w_cog / PLANT_HW_MAX);
+    n = n_cog > n ? n_cog : n;
+  }
   if (!(n < 1e6)) { /* NaN, inf: beyond any limit */
     return 1000000;
   }
@@ -82,7 +87,9 @@ int plant_substeps_needed(const plant_params_t *p) {
   if (p->faults.rs_scale.n > 0) {
     profile_bounds(&p->faults.rs_scale, &lo, &hi);
   }
-  const double n = ceil(p->ts * p->machine.rs * hi / (PLANT_HR_MAX * lmin));
+  /* the device drops' resistance (plant_inverter_t) is in series with R_s */
+  const double r_dev = fmax(p->inverter.r_on_sw, p->inverter.r_diode);
+  const double n = ceil(p->ts * (p->machine.rs * hi + r_dev) / (PLANT_HR_MAX * lmin));
   if (!(n < 1e6)) { /* NaN, inf: beyond any limit */
     return 1000000;
   }

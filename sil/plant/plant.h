@@ -73,6 +73,14 @@ typedef struct {
   plant_inverter_model_t model;
   double dead_time; /* [s] */
   int substeps;     /* integration steps per PWM period (average model), >= 1 */
+  /* device voltage drops of every leg (both models; plant_inverter_sw.c):
+   * a conducting switch drops v_th_sw + r_on_sw |i|, a conducting diode
+   * v_f_diode + r_diode |i|, the thresholds taken in over the smooth-sign
+   * band of the currents (plant_inverter.c); all 0: ideal devices */
+  double v_th_sw;   /* [V] */
+  double r_on_sw;   /* [Ohm] */
+  double v_f_diode; /* [V] */
+  double r_diode;   /* [Ohm] */
 } plant_inverter_t;
 
 /* IDEAL: stiff source. RC: source behind r charging c, both ways.
@@ -103,6 +111,11 @@ typedef struct {
   profile_t speed;       /* imposed mechanical speed [rad/s] (IMPOSED mode) */
   double theta0;         /* initial mechanical angle [rad] */
   double omega0;         /* initial mechanical speed [rad/s] (FREE mode) */
+  /* cogging torque on the rotor (FREE mode; plant_mech.c):
+   * T_cog = cog_amp sin(cog_order theta_m + cog_phase); cog_amp 0: none */
+  double cog_amp;   /* [N m] */
+  int cog_order;    /* periods per mechanical turn */
+  double cog_phase; /* [rad] */
 } plant_mech_t;
 
 typedef struct {
@@ -273,6 +286,7 @@ typedef struct {
   /* ziggurat tables of the noise generator (plant_sensors.c) */
   uint32_t zig_k[PLANT_ZIG_N];
   double zig_w[PLANT_ZIG_N], zig_f[PLANT_ZIG_N];
+  int drops; /* any device drop of the inverter is not 0 (plant_inverter_t) */
 } plant_aux_t;
 
 typedef struct {
@@ -307,6 +321,15 @@ int plant_check(const plant_params_t *p, const char **field);
  * the default 0.1 Ohm, 470 uF link at 16 kHz is 1.33 with one step). With
  * the faults, R_s and C at the extremes of their scale profiles' bounds. */
 #define PLANT_HC_MAX 2.0
+/* Largest device drops of the inverter (plant_inverter_t): thresholds
+ * [V], resistances [Ohm]. */
+#define PLANT_V_DROP_MAX 5.0
+#define PLANT_R_DROP_MAX 10.0
+/* Bounds of the cogging torque (plant_mech_t): amplitude [N m], order,
+ * phase [rad]. */
+#define PLANT_COG_AMP_MAX   1e4
+#define PLANT_COG_ORDER_MAX 1000
+#define PLANT_COG_PHASE_MAX 7.0
 /* Largest scales of the parameter faults (plant_faults_t). */
 #define PLANT_RS_SCALE_MAX       4.0
 #define PLANT_LAMBDA_M_SCALE_MAX 2.0
@@ -314,9 +337,10 @@ int plant_check(const plant_params_t *p, const char **field);
 #define PLANT_STAR_SHIFT_MAX     7.0 /* [rad electrical]: inject.star_shift within +-this */
 /* The electromechanical mode (the rotor's inertia against the PM flux's
  * stiffness, w_em = p psi_m sqrt(1.5 / (L_min J)), psi_m the PM flux at its
- * largest scale) and the friction's pole (b / J, the passive load's viscous
- * term at its largest included) count too: h w_em <= PLANT_HW_MAX,
- * h b / J <= PLANT_HC_MAX. A tiny inertia needs more than
+ * largest scale), the friction's pole (b / J, the passive load's viscous
+ * term at its largest included) and the cogging torque's stiffness
+ * (w_cog = sqrt(A N / J), plant_mech.c) count too: h w_em <= PLANT_HW_MAX,
+ * h b / J <= PLANT_HC_MAX, h w_cog <= PLANT_HW_MAX. A tiny inertia needs more than
  * PLANT_SUBSTEPS_MAX: the scenario is refused (mechanics.j). */
 int plant_substeps_needed(const plant_params_t *p);
 /* The RC link's share of it alone (1 for an ideal link). */

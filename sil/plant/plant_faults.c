@@ -126,7 +126,12 @@ void plant_faults_period_start(plant_t *pl) {
   const plant_cur_cache_t *c = plant_machine_cur(pl);
   const double te =
       1.5 * pl->p.machine.pole_pairs * (pl->lambda_d * c->i_dq[1] - pl->lambda_q * c->i_dq[0]);
-  const double net = te - plant_mech_input(pl, t); /* aux.fric is 0 here */
+  double net = te - plant_mech_input(pl, t); /* aux.fric is 0 here */
+  if (pl->p.mech.cog_amp != 0.0) {           /* the cogging torque (plant_mech.c) */
+    const plant_mech_t *me = &pl->p.mech;
+    const double cog[3] = {me->cog_amp, (double)me->cog_order, me->cog_phase};
+    net += plant_mech_cogging(cog, pl->theta_m);
+  }
   if (fabs(net) <= tc) {
     a->fric_dir = 0;
     a->fric = net; /* held */

@@ -118,8 +118,15 @@ static inline void plant_mech_input_refresh(plant_t *pl) {
   a->m_t0 = t;
 }
 
+/* The cogging torque at mechanical angle theta [rad] (plant_mech.c):
+ * cog = {amplitude [N m], order, phase [rad]}. */
+static inline double plant_mech_cogging(const double cog[3], double theta) {
+  /* mut: cogging_order_dropped */
+  return cog[0] * sin(cog[1] * theta + cog[2]);
+}
+
 /* Mechanics (plant_mech.c documents the convention):
- * FREE:    J dw/dt = T_e - B w - T_load(t), dtheta/dt = w
+ * FREE:    J dw/dt = T_e + T_cog(theta) - B w - T_load(t), dtheta/dt = w
  * IMPOSED: w = speed(t) (m), dtheta/dt = speed(t), the state w is set from
  *          the profile at the end of each step. */
 static inline void plant_mech_deriv(const plant_t *pl, const double *x, double m, double te,
@@ -129,7 +136,14 @@ static inline void plant_mech_deriv(const plant_t *pl, const double *x, double m
     dx[X_W] = 0.0;
   } else {
     dx[X_TH] = x[X_W];
-    dx[X_W] = (te - pl->p.mech.b * x[X_W] - m) * pl->aux.inv_j;
+    const plant_mech_t *me = &pl->p.mech;
+    const double tn = te - me->b * x[X_W] - m;
+    if (me->cog_amp != 0.0) {
+      const double cog[3] = {me->cog_amp, (double)me->cog_order, me->cog_phase};
+      dx[X_W] = (tn + plant_mech_cogging(cog, x[X_TH])) * pl->aux.inv_j;
+    } else {
+      dx[X_W] = tn * pl->aux.inv_j;
+    }
   }
 }
 

@@ -16,6 +16,17 @@
  * the voltage vector is constant in the stationary frame over the period
  * and is rotated into dq at every RK4 stage with the stage's rotor angle.
  * The DC-link current is sum d_eff,x i_x, so that v_dc i_dc = sum v_x0 i_x.
+ * Device drops (plant_inverter_t; plant_inverter_sw.c says which device
+ * carries the current): over the period the high side conducts for
+ * d_eff,x, the low side for 1 - d_eff,x, so the period-average pole
+ * voltage loses
+ *   i_x > 0:  d_eff,x V_sw(i_x) + (1 - d_eff,x) V_d(i_x)  (high switch, low diode)
+ *   i_x < 0:  d_eff,x V_d(i_x)  + (1 - d_eff,x) V_sw(i_x) (high diode, low switch)
+ * with V_sw(i) = v_th_sw sgn_s(i) + r_on_sw i, V_d(i) = v_f_diode sgn_s(i) +
+ * r_diode i, the same smooth sign (both vanish at i = 0: continuous); the
+ * switching model's period average for a current steady over the period
+ * (the dead time's diode included in d_eff). The link current keeps
+ * sum d_eff,x i_x (the drops are lost in the devices).
  */
 #include "plant_internal.h"
 
@@ -41,6 +52,18 @@ static inline double eff_duty(double d, double kd, double i_norm) {
   return 1.0 < e0 ? 1.0 : e0;
 }
 
+/* The period-average device drop of a leg with effective duty e at
+ * current i (header comment); sg = sgn_s(i). */
+static inline double avg_drop(const double dv[4], double e, double i, double sg) {
+  /* mut: avg_drop_device_swapped */
+  const double vsw = dv[0] * sg + dv[1] * i, vd = dv[2] * sg + dv[3] * i;
+  return i > 0.0 ? e * vsw + (1.0 - e) * vd : e * vd + (1.0 - e) * vsw;
+}
+
+static inline double sat1(double x) {
+  return x > 1.0 ? 1.0 : (x < -1.0 ? -1.0 : x);
+}
+
 /* Rotor angle reference: the stage angles differ from the reference angle
  * by dth <= w_e h, so cos/sin are obtained by angle addition with a Taylor
  * series of dth (plant_cos_sin_near), and libm is called once per period
@@ -62,16 +85,21 @@ typedef struct {
   int one_way;        /* rectifier link */
   double d[3], kd[3]; /* duties; td/Ts for a switching leg (0 < d < 1), else 0 */
   int imposed, ideal; /* mech.mode == IMPOSED, dclink.kind == IDEAL */
+  int drops;          /* device drops (aux.drops): dv = v_th_sw, r_on_sw, v_f_diode, r_diode */
+  double dv[4];
+  double cog[3]; /* cogging torque (plant_mech_t): amplitude (0: none), order, phase */
 } avg_k_t;
 
 /* Derivative at one stage, c and s being cos and sin of the stage's rotor
  * angle. The same expressions as plant_internal.h's inline mechanics and
  * DC link, with the parameters hoisted. `avgs`: integrate the period
  * averages (v_an, v_bn, i_dc, torque, i_dq: the log's; plant_set_averages)
- * as well; the star point's (X_VN, the sensors') always. */
+ * as well; the star point's (X_VN, the sensors') always. `real`: the
+ * device drops and the cogging torque (a copy of their own: the usual
+ * periods without them run the code they ran before, issue 25). */
 static AVG_ALWAYS_INLINE void avg_deriv(const avg_k_t *restrict k, int ideal, int imposed, int avgs,
-                                        double c, double s, const double *restrict x, double m,
-                                        double *restrict dx, const double *i_known) {
+                                        int real, double c, double s, const double *restrict x,
+                                        double m, double *restrict dx, const double *i_known) {
   double id, iq;
   if (i_known != NULL) { /* the state's currents, already computed (the plant's cache) */
     id = i_known[0];
@@ -86,7 +114,12 @@ static AVG_ALWAYS_INLINE void avg_deriv(const avg_k_t *restrict k, int ideal, in
   const double da = eff_duty(k->d[0], k->kd[0], ia * nb);
   const double db = eff_duty(k->d[1], k->kd[1], ib * nb);
   const double dc = eff_duty(k->d[2], k->kd[2], ic * nb);
-  const double va0 = da * vdc, vb0 = db * vdc, vc0 = dc * vdc;
+  double va0 = da * vdc, vb0 = db * vdc, vc0 = dc * vdc;
+  if (real && k->drops) {
+    va0 -= avg_drop(k->dv, da, ia, sat1(ia * nb));
+    vb0 -= avg_drop(k->dv, db, ib, sat1(ib * nb));
+    vc0 -= avg_drop(k->dv, dc, ic, sat1(ic * nb));
+  }
   const double vn = (va0 + vb0 + vc0) * (1.0 / 3.0);
   const double van = va0 - vn, vbn = vb0 - vn;
   const double vbe = (vb0 - vc0) * PLANT_INV_SQRT3;
@@ -101,7 +134,8 @@ static AVG_ALWAYS_INLINE void avg_deriv(const avg_k_t *restrict k, int ideal, in
     dx[X_W] = 0.0;
   } else {
     dx[X_TH] = x[X_W];
-    dx[X_W] = (te - k->b * x[X_W] - m) * k->inv_j;
+    const double tn = te - k->b * x[X_W] - m;
+    dx[X_W] = (real && k->cog[0] != 0.0 ? tn + plant_mech_cogging(k->cog, x[X_TH]) : tn) * k->inv_j;
   }
   dx[X_VN] = vn - 0.5 * vdc;
   const double idc = avgs || !ideal ? da * ia + db * ib + dc * ic : 0.0;
@@ -120,12 +154,12 @@ static AVG_ALWAYS_INLINE void avg_deriv(const avg_k_t *restrict k, int ideal, in
   }
 }
 
-/* The RK4 steps of one period; `ideal`, `imposed` and `avgs` are constants
+/* The RK4 steps of one period; `ideal`, `imposed`, `avgs` and `real` are constants
  * at each call site (specialised copies). State entries whose derivative is
  * identically zero (v_C on an ideal link, w under imposed speed) are left
  * as they are: x + h * 0 = x, the same result without the work. */
 static AVG_ALWAYS_INLINE void avg_rk4(const plant_t *pl, const avg_k_t *restrict kc, int ideal,
-                                      int imposed, int avgs, angle_ref_t *restrict ar,
+                                      int imposed, int avgs, int real, angle_ref_t *restrict ar,
                                       double *restrict x, double *restrict cs_end) {
   /* a stage's state entry; v_C on an ideal link and w under imposed speed
    * are not read by the derivative (nor is their derivative): the entry
@@ -154,22 +188,22 @@ static AVG_ALWAYS_INLINE void avg_rk4(const plant_t *pl, const avg_k_t *restrict
       ar->c = c;
       ar->s = s;
     }
-    avg_deriv(k, ideal, imposed, avgs, ar->c, ar->s, x, m0, k1, j == 0 ? ar->i_known : NULL);
+    avg_deriv(k, ideal, imposed, avgs, real, ar->c, ar->s, x, m0, k1, j == 0 ? ar->i_known : NULL);
     for (int i = 0; i < X_VA; i++) { /* the integrals X_VA.. are not read */
       xs[i] = AVG_STAGE(i, x[i] + h2 * k1[i]);
     }
     stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
-    avg_deriv(k, ideal, imposed, avgs, c, s, xs, m1, k2, NULL);
+    avg_deriv(k, ideal, imposed, avgs, real, c, s, xs, m1, k2, NULL);
     for (int i = 0; i < X_VA; i++) {
       xs[i] = AVG_STAGE(i, x[i] + h2 * k2[i]);
     }
     stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
-    avg_deriv(k, ideal, imposed, avgs, c, s, xs, m1, k3, NULL);
+    avg_deriv(k, ideal, imposed, avgs, real, c, s, xs, m1, k3, NULL);
     for (int i = 0; i < X_VA; i++) {
       xs[i] = AVG_STAGE(i, x[i] + h * k3[i]);
     }
     stage_cos_sin(ar, k->pp * xs[X_TH], &c, &s);
-    avg_deriv(k, ideal, imposed, avgs, c, s, xs, m2, k4, NULL);
+    avg_deriv(k, ideal, imposed, avgs, real, c, s, xs, m2, k4, NULL);
     for (int i = 0; i < X_N; i++) {
       if ((ideal && i == X_VC) || (imposed && i == X_W) || (!avgs && i != X_VN && i >= X_VA)) {
         continue;
@@ -212,6 +246,14 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
   }
   k.imposed = p->mech.mode == PLANT_MECH_IMPOSED;
   k.ideal = p->dclink.kind == PLANT_DC_IDEAL;
+  k.drops = pl->aux.drops;
+  k.dv[0] = p->inverter.v_th_sw;
+  k.dv[1] = p->inverter.r_on_sw;
+  k.dv[2] = p->inverter.v_f_diode;
+  k.dv[3] = p->inverter.r_diode;
+  k.cog[0] = p->mech.cog_amp;
+  k.cog[1] = (double)p->mech.cog_order;
+  k.cog[2] = p->mech.cog_phase;
   angle_ref_t ar;
   if (x[X_TH] == pl->theta_m) { /* always, from plant_step */
     const plant_cur_cache_t *cc = plant_machine_cur(pl);
@@ -229,13 +271,15 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
     ar.i_known = NULL;
   }
   const int avgs = pl->aux.avgs;
-  if (k.ideal && !k.imposed) { /* the usual case */
+  if (k.drops || k.cog[0] != 0.0) { /* device drops, cogging: a copy of their own */
+    avg_rk4(pl, &k, k.ideal, k.imposed, avgs, 1, &ar, x, cs_end);
+  } else if (k.ideal && !k.imposed) { /* the usual case */
     if (avgs) {
-      avg_rk4(pl, &k, 1, 0, 1, &ar, x, cs_end);
+      avg_rk4(pl, &k, 1, 0, 1, 0, &ar, x, cs_end);
     } else {
-      avg_rk4(pl, &k, 1, 0, 0, &ar, x, cs_end);
+      avg_rk4(pl, &k, 1, 0, 0, 0, &ar, x, cs_end);
     }
   } else {
-    avg_rk4(pl, &k, k.ideal, k.imposed, avgs, &ar, x, cs_end);
+    avg_rk4(pl, &k, k.ideal, k.imposed, avgs, 0, &ar, x, cs_end);
   }
 }

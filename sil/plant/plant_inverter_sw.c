@@ -33,6 +33,23 @@
  * its terminal at whatever potential keeps its current zero, without the
  * [0, v_dc] bound of a diode leg (no EV_U events, unbounded in the
  * all-zero state).
+ * Device drops (plant_inverter_t, all 0: none): a conducting leg's pole
+ * voltage is its rail's less the drop of the device that carries i_x
+ * (i_x > 0 flows out of the leg into the phase):
+ *   high side on:  i_x > 0 high switch, i_x < 0 high diode;
+ *   low side on:   i_x > 0 low diode,   i_x < 0 low switch;
+ *   floating (the dead time, gates off): the diode the current holds on;
+ * v_x = rail - (V_0 sgn_s(i_x) + R i_x), (V_0, R) = (v_th_sw, r_on_sw) for a
+ * switch, (v_f_diode, r_diode) for a diode: the pole loses the drop for
+ * i_x > 0 and gains it for i_x < 0. sgn_s is the average model's smooth
+ * sign (plant_inverter.c: a threshold over +-i_band, the knee a real
+ * device's exponential characteristic and the ripple round off), so the
+ * drop vanishes at i_x = 0: the diode events, the blocked leg's range and
+ * the all-zero state keep their rails. The link current is still
+ * sum k_x i_x (k_x the rail, units of v_dc): the drops' power is lost in
+ * the devices. The gate-driven reverse current goes through the diode
+ * (IGBTs; a MOSFET's channel conducting in reverse is not modelled). A
+ * floating shorted pair (a fault) is modelled without drops.
  * A lead shorted to earth (the negative rail) ties its leg's output to that
  * rail: a stuck-closed low side that no desaturation turns off. Two leads
  * shorted together (x, y) tie their legs' outputs: legs of opposite
@@ -102,6 +119,26 @@ static void phase_currents(const plant_t *pl, const sw_cfg_t *cf, const double *
   i[0] = *ial;
   i[1] = -0.5 * *ial + PLANT_SQRT3_2 * *ibe;
   i[2] = -i[0] - i[1];
+}
+
+/* The device drop of leg j of type `type` (diode state cond) at phase
+ * current i (header comment); 0 for a blocked or open leg. */
+static inline double leg_drop(const plant_t *pl, int type, int cond, double i) {
+  const plant_inverter_t *inv = &pl->p.inverter;
+  int diode;
+  if (type == LEG_HI) {
+    diode = i < 0.0;
+  } else if (type == LEG_LO) {
+    diode = i > 0.0;
+  } else if (type == LEG_FLOAT && (cond == COND_LO || cond == COND_HI)) {
+    diode = 1;
+  } else {
+    return 0.0;
+  }
+  const double in = i * pl->aux.inv_band;
+  const double sg = in > 1.0 ? 1.0 : (in < -1.0 ? -1.0 : in);
+  /* mut: sw_drop_device_swapped */
+  return diode ? inv->v_f_diode * sg + inv->r_diode * i : inv->v_th_sw * sg + inv->r_on_sw * i;
 }
 
 /* Allowed potential range of leg j for the all-zero state. */
@@ -186,6 +223,12 @@ static void sw_deriv(const plant_t *pl, const sw_cfg_t *cf, const double *x, dou
       v[j] = k * vdc;
       /* mut: short_link_current_one_way */
       idc += k * i[j];
+    }
+    if (pl->aux.drops && cf->node < 0) { /* the device drops (header comment) */
+      for (int j = 0; j < 3; j++) {
+        /* mut: sw_drop_sign */
+        v[j] -= leg_drop(pl, cf->type[j], cf->cond[j], i[j]);
+      }
     }
     const double val = (2.0 * v[0] - v[1] - v[2]) * (1.0 / 3.0);
     const double vbe = (v[1] - v[2]) * PLANT_INV_SQRT3;

@@ -6,6 +6,15 @@
  *   i.e. a motoring load for w > 0; negative = a load that drives the
  *   rotor forward). It does not flip with the speed sign: describe a load
  *   that always opposes motion by giving it the sign of the speed.
+ *   Cogging torque (FREE mode; mech.cog_amp 0: none): the magnets' pull on
+ *   the stator teeth at zero current, a torque of the rotor angle alone,
+ *   T_cog = A sin(N theta_m + phi), N periods per mechanical turn (the
+ *   least common multiple of slots and poles for the fundamental; one
+ *   harmonic), added to T_e in both inverter models' mechanics and in the
+ *   net torque the passive load's Coulomb friction holds at standstill
+ *   (plant_faults.c). It is not part of T_e (plant_state_t.torque): the
+ *   current does not carry it. Its stiffness A N sets a mode
+ *   sqrt(A N / J) that the integration steps cover (plant_substeps_mech).
  * IMPOSED mode (dynamometer): w = mech.speed(t) exactly, theta_m is the
  *   integral of the profile (RK4 quadrature, exact for constant and ramp
  *   profiles except within the step that holds a ramp corner or a step); J, B and the load are not
@@ -38,6 +47,12 @@ int plant_mech_check(const plant_mech_t *m, const char **field) {
     bad = "mech.theta0";
   } else if (!isfinite(m->omega0)) {
     bad = "mech.omega0";
+  } else if (!(fabs(m->cog_amp) <= PLANT_COG_AMP_MAX)) {
+    bad = "mech.cog_amp";
+  } else if (m->cog_amp != 0.0 && (m->cog_order < 1 || m->cog_order > PLANT_COG_ORDER_MAX)) {
+    bad = "mech.cog_order";
+  } else if (!(fabs(m->cog_phase) <= PLANT_COG_PHASE_MAX)) {
+    bad = "mech.cog_phase";
   }
   for (int k = 0; bad == NULL && k < 2; k++) {
     const char *sub = NULL;

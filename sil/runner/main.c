@@ -33,11 +33,13 @@
 #include "isr_record.h"
 #include "log_npy.h"
 #include "scenario.h"
+#include "scenario_params.h"
 #include "scenario_keys.h"
 #include "sil_preempt.h"
 #include "signals_json.h"
 #include "sil_run.h"
 #include "summary.h"
+#include "truth.h"
 
 static volatile int stop_flag;
 
@@ -85,8 +87,8 @@ static int parse_long(const char *opt, const char *s, long lo, long hi, long *ou
 /* What the command line asks for. */
 typedef struct {
   const char *scenario, *log_path, *summary_path, *record_path, *dump_path, *can;
-  const char *keys_doc, *keys_doc_write;
-  int bench, print_config, print_params, print_signals, realtime, keys, help;
+  const char *keys_doc, *keys_doc_write, *params_path;
+  int bench, print_config, print_params, print_signals, realtime, keys, help, print_truth;
   long decimate, preempt_n, seed, node, can_timeout, max_gap_us;
 } cli_t;
 
@@ -122,11 +124,18 @@ static int set_long(cli_t *o, const option_t *op, const char *arg) {
 #define LONG(f, lo, hi) set_long, offsetof(cli_t, f), (lo), (hi)
 static const option_t options[] = {
     {"--log", "PATH.npy", "write the log (docs/log-format.md)", PATH(log_path)},
+    {"--params", "FILE.json",
+     "the drive's parameters from a parameter file (a commissioning's), the plant keeping the "
+     "scenario's machine (default: $FLUXDRIVE_PARAMS if set; docs/commissioning.md)",
+     PATH(params_path)},
     {"--summary", "PATH.json", "write the summary too (it is printed)", PATH(summary_path)},
     {"--decimate", "N", "log every N-th period (overrides log.decimation)",
      LONG(decimate, 1, 1000000)},
     {"--bench", NULL, "no log; print steps, wall time and the real-time factor", FLAG(bench)},
     {"--print-config", NULL, "print the resolved parameters (JSON) and exit", FLAG(print_config)},
+    {"--print-truth", NULL,
+     "print the plant's true values a commissioning identifies (JSON, truth.h) and exit",
+     FLAG(print_truth)},
     {"--print-params", NULL, "print the parameter table (JSON; no scenario needed) and exit",
      FLAG(print_params)},
     {"--print-signals", NULL,
@@ -233,6 +242,14 @@ int main(int argc, char **argv) {
     fprintf(stderr, "fluxdrive-sil: %s\n", err);
     return 2;
   }
+  const char *params = cli.params_path != NULL ? cli.params_path : getenv("FLUXDRIVE_PARAMS");
+  if (params != NULL && params[0] != '\0') {
+    if (scenario_apply_params(&sc, params, err, sizeof err) != 0) {
+      fprintf(stderr, "fluxdrive-sil: %s\n", err);
+      return 2;
+    }
+    fprintf(stderr, "fluxdrive-sil: the drive's parameters from %s\n", params);
+  }
   if (cli.dump_path != NULL) {
     if (scenario_dump(&sc, cli.dump_path) != 0) {
       fprintf(stderr, "fluxdrive-sil: %s: cannot write the dump\n", cli.dump_path);
@@ -242,6 +259,15 @@ int main(int argc, char **argv) {
   }
   if (cli.print_config) {
     char *js = config_json(&sc);
+    if (js == NULL) {
+      return 1;
+    }
+    printf("%s\n", js);
+    free(js);
+    return 0;
+  }
+  if (cli.print_truth) {
+    char *js = truth_json(&sc);
     if (js == NULL) {
       return 1;
     }

@@ -140,6 +140,7 @@ static int set_pwm_frequency(ctx_t *c, scenario_t *sc, const sk_val_t *v);
 static int mechanics_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
 static int sensors_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
 static int controller_params(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int controller_map(ctx_t *c, scenario_t *sc, const sk_val_t *v);
 static int estimates_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
 static int inject_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
 static int current_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v);
@@ -149,6 +150,10 @@ static int can_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
 static int can_dir_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
 static int passive_load_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
 static int board_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int commission_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int commission_proc(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static int commission_post(ctx_t *c, scenario_t *sc, const sk_val_t *v);
+static const char *sil_proc_name(int index);
 
 #define SK_ID(id, ...) id,
 enum { SCENARIO_KEYS(SK_ID) K_COUNT };
@@ -473,6 +478,11 @@ static int machine_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
   if (pm->ld_sat > 0.0 && !(pm->i_sat > 0.0)) {
     return scn_fail(c, "machine.i_sat", "must be given (> 0 A) with machine.ld_sat > 0");
   }
+  /* the cogging torque (plant_mech.c): its order with its amplitude */
+  if (sc->plant.mech.cog_amp != 0.0 && sc->plant.mech.cog_order < 1) {
+    return scn_fail(c, "machine.cogging_order",
+                    "must be given (periods per mechanical turn, >= 1) with machine.cogging_amp");
+  }
   /* star_phi_iq: both terms' shift (a turned saliency axis: phi_a = phi_iq,
    * phi_b = 2 phi_iq of (3.97)), an alias of the pair */
   if (cJSON_GetObjectItemCaseSensitive(m, "star_phi_iq") != NULL) {
@@ -557,6 +567,28 @@ static int controller_params(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
       return -1;
     }
   }
+  return 0;
+}
+
+/* The drive's own flux map (controller.map: an identified one, the
+ * commissioning's), the plant keeping its own: both maps of one machine
+ * (the same pole pairs). */
+static int controller_map(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  const cJSON *it = v->it;
+  if (sc->plant.machine.map == NULL) {
+    return scn_fail(c, v->path, "needs a flux-map machine (machine.map or a map preset)");
+  }
+  char why[640];
+  const int pp = sc->plant.machine.pole_pairs;
+  const map_load_t *e = map_load(it->valuestring, c->origin, pp, why, sizeof why);
+  if (e == NULL) {
+    return scn_fail(c, v->path, "%s", why);
+  }
+  if (e->map.pole_pairs != (float)pp) {
+    return scn_fail(c, v->path, "%s has %g pole pairs, the machine %d", it->valuestring,
+                    (double)e->map.pole_pairs, pp);
+  }
+  sc->drive.machine_map = e->words;
   return 0;
 }
 
@@ -781,9 +813,10 @@ static int resolve_substeps(ctx_t *c, scenario_t *sc) {
                                                          : "machine.lq";
       return scn_fail(c, key,
                       "the plant cannot integrate this machine at this PWM period: its electrical "
-                      "time constant L/R_s (%.3g s with L = %.3g H) needs %d integration steps per "
-                      "period, at most %d",
-                      lmin / p->machine.rs, lmin, need, PLANT_SUBSTEPS_MAX);
+                      "time constant L/R (%.3g s with L = %.3g H, R = R_s and the inverter's "
+                      "device resistance) needs %d integration steps per period, at most %d",
+                      lmin / (p->machine.rs + fmax(p->inverter.r_on_sw, p->inverter.r_diode)), lmin,
+                      need, PLANT_SUBSTEPS_MAX);
     }
     p->inverter.substeps = need;
   } else if (p->inverter.substeps < need) {
@@ -1191,4 +1224,40 @@ int scenario_dump(const scenario_t *sc, const char *path) {
   }
   const int ok = fwrite(&d, sizeof d, 1, f) == 1;
   return (fclose(f) == 0 && ok) ? 0 : -1;
+}
+
+/* ---- commission: identification procedures (sil_commission.h) ---- */
+
+static const char *sil_proc_name(int index) {
+  const proc_row_t *r = proc_row((proc_id_t)index);
+  return r != NULL ? r->name : NULL;
+}
+
+static int commission_pre(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  if (v->index >= SIL_COMMISSION_MAX) {
+    return scn_fail(c, v->path, "too many procedures (at most %d)", SIL_COMMISSION_MAX);
+  }
+  sc->commission.n = v->index + 1;
+  sc->commission.proc[v->index] = -1;
+  return 0;
+}
+
+/* Only the rows the host may run alone. */
+static int commission_proc(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  const proc_row_t *r = proc_row((proc_id_t)(int)v->num);
+  if (r == NULL || (r->caps & PROC_CAP_IDENT) == 0u) {
+    return scn_fail(c, v->path, "\"%s\" is not an identification procedure",
+                    r != NULL ? r->name : "?");
+  }
+  *(int *)(void *)((char *)&sc->commission.proc[0] + v->shift) = (int)v->num;
+  return 0;
+}
+
+static int commission_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
+  if (sc->commission.proc[v->index] < 0) {
+    char q[190];
+    scn_join(q, sizeof q, v->path, "proc");
+    return scn_fail(c, q, "required: an identification procedure");
+  }
+  return 0;
 }

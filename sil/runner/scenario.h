@@ -15,6 +15,7 @@
 #include "sil_adc_faults.h"
 #include "sil_enc_faults.h"
 #include "sil_can_faults.h"
+#include "sil_commission.h"
 
 typedef struct {
   char name[96];
@@ -25,6 +26,8 @@ typedef struct {
   double hw_trip;        /* hardware overcurrent comparator level [A], 0 = none */
   double enable_at;      /* enable command time [s] */
   double disable_at;     /* disable command time [s], <= enable_at = never */
+  /* identification procedures run in turn before the enable (sil_commission.h) */
+  sil_commission_list_t commission;
   struct {
     profile_t torque; /* [N m] */
     profile_t speed;  /* mechanical [rad/s] */

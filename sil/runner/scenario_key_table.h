@@ -105,6 +105,15 @@
   X(K_M_STAR_P, .parent = K_MACHINE, .key = "star_p", .type = SK_NUM,                              \
     RANGE(-0.999999, 0.999999), AT_CTX(F64, star_p), .dflt = "none",                               \
     .doc = "anisotropy p of (3.7), keeping L0, M0, L2; not with ld, lq, star_m2")                  \
+  X(K_M_COG_AMP, .parent = K_MACHINE, .key = "cogging_amp", .type = SK_NUM,                        \
+    RANGE(-PLANT_COG_AMP_MAX, PLANT_COG_AMP_MAX), AT(F64, plant.mech.cog_amp), .dflt = "0 (none)", \
+    .plant_field = "mech.cog_amp", .doc = "cogging torque amplitude A [N m]; needs cogging_order") \
+  X(K_M_COG_ORDER, .parent = K_MACHINE, .key = "cogging_order", .type = SK_INT,                    \
+    RANGE(1.0, PLANT_COG_ORDER_MAX), AT(INT, plant.mech.cog_order), .dflt = "none",                \
+    .plant_field = "mech.cog_order", .doc = "its periods N per mechanical turn")                   \
+  X(K_M_COG_PHASE, .parent = K_MACHINE, .key = "cogging_phase", .type = SK_NUM,                    \
+    RANGE(-PLANT_COG_PHASE_MAX, PLANT_COG_PHASE_MAX), AT(F64, plant.mech.cog_phase), .dflt = "0",  \
+    .plant_field = "mech.cog_phase", .doc = "its phase phi [rad]: A sin(N theta_m + phi)")         \
   /* ---- inverter ---- */                                                                         \
   X(K_INVERTER, .parent = K_ROOT, .key = "inverter", .type = SK_OBJECT, .post = inverter_post,     \
     .doc = "the inverter model, PWM frequency, dead time")                                         \
@@ -120,6 +129,18 @@
     .plant_field = "ts", .doc = "PWM and ISR frequency [Hz]")                                      \
   X(K_INV_HW_TRIP, .parent = K_INVERTER, .key = "hw_trip", .type = SK_NUM, RANGE(0.0, 1e5),        \
     AT(F64, hw_trip), .dflt = "0 (none)", .doc = "hardware overcurrent comparator [A], latched")   \
+  X(K_INV_V_TH_SW, .parent = K_INVERTER, .key = "v_th_sw", .type = SK_NUM,                         \
+    RANGE(0.0, PLANT_V_DROP_MAX), AT(F64, plant.inverter.v_th_sw), DEF(0.0),                       \
+    .doc = "a conducting switch's threshold voltage [V]")                                          \
+  X(K_INV_R_ON_SW, .parent = K_INVERTER, .key = "r_on_sw", .type = SK_NUM,                         \
+    RANGE(0.0, PLANT_R_DROP_MAX), AT(F64, plant.inverter.r_on_sw), DEF(0.0),                       \
+    .doc = "its on-resistance [Ohm]")                                                              \
+  X(K_INV_V_F_DIODE, .parent = K_INVERTER, .key = "v_f_diode", .type = SK_NUM,                     \
+    RANGE(0.0, PLANT_V_DROP_MAX), AT(F64, plant.inverter.v_f_diode), DEF(0.0),                     \
+    .doc = "a conducting diode's forward voltage [V]")                                             \
+  X(K_INV_R_DIODE, .parent = K_INVERTER, .key = "r_diode", .type = SK_NUM,                         \
+    RANGE(0.0, PLANT_R_DROP_MAX), AT(F64, plant.inverter.r_diode), DEF(0.0),                       \
+    .doc = "its resistance [Ohm]")                                                                 \
   /* ---- dc_link ---- */                                                                          \
   X(K_DC_LINK, .parent = K_ROOT, .key = "dc_link", .type = SK_OBJECT,                              \
     .doc = "the DC source, link capacitor, rectifier, chopper")                                    \
@@ -208,6 +229,8 @@
   X(K_CONTROLLER, .parent = K_ROOT, .key = "controller", .type = SK_OBJECT, .params = 1,           \
     .set = controller_params,                                                                      \
     .doc = "the drive's parameters (`docs/parameters.md`)")                \
+  X(K_C_MAP, .parent = K_CONTROLLER, .key = "map", .type = SK_STRING, .set = controller_map,       \
+    .dflt = "the machine's", .doc = "the drive's own flux map (a commissioned one), the plant keeping machine.map") \
   X(K_C_ESTIMATES, .parent = K_CONTROLLER, .key = "estimates", .type = SK_OBJECT,                  \
     .post = estimates_post, .doc = "detuning: the controller's machine as factors of the plant's") \
   X(K_C_E_RS, .parent = K_C_ESTIMATES, .key = "rs_scale", .type = SK_NUM, RANGE(0.1, 10.0),        \
@@ -237,6 +260,13 @@
     SK_PROFILE_DOC("q current reference [A] (current mode)"))                                      \
   X(K_R_FLUX, .parent = K_REFERENCES, .key = "flux", AT(PROFILE, ref.flux),                        \
     SK_PROFILE_DOC("flux reference [Vs], 0 = automatic"))                                          \
+  /* ---- commission ---- */                                                                       \
+  X(K_COMMISSION, .parent = K_ROOT, .key = "commission", .type = SK_OBJECTS,                        \
+    .max = SIL_COMMISSION_MAX, .stride = sizeof(int), .set = commission_pre, .post = commission_post, \
+    .doc = "identification procedures run in turn, drive disabled, before the enable (docs/commissioning.md)") \
+  X(K_CM_PROC, .parent = K_COMMISSION, .key = "proc", .type = SK_ENUM, .name_of = sil_proc_name,   \
+    .req = "an identification procedure", .set = commission_proc, AT(INT, commission.proc[0]),     \
+    .doc = "the procedure (proc.h: a row with PROC_CAP_IDENT)")                                   \
   /* ---- inject ---- */                                                                           \
   X(K_INJECT, .parent = K_ROOT, .key = "inject", .type = SK_OBJECT, .post = inject_post,           \
     .doc = "injected failures")                                                                    \

@@ -312,6 +312,7 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
   res->min_speed = INFINITY;
   res->first_fault_t = -1.0;
   res->first_watchdog_t = -1.0;
+  sil_commission_init(&res->commission, &sc->commission);
 
   plant_state_t st;
   plant_brief_t br; /* what the metrics need: cheaper than plant_state_t */
@@ -343,7 +344,9 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
             opts->can_io(opts->can_user, &x.hal, t);
           }
         } else {
-          sil_command_references(&x.drv, sc, t);
+          if (!sil_commission_main(&res->commission, &sc->commission, &x.drv, t, x.plant.theta_m)) {
+            sil_command_references(&x.drv, sc, t);
+          }
           sil_main_injections(&x, sc, t);
           drive_background(&x.drv);
         }
@@ -385,6 +388,9 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
         res->max_phase_current = a;
         res->max_phase_current_t = t;
       }
+    }
+    if (!res->commission.done) {
+      sil_commission_observe(&res->commission, br.i_abc, x.plant.theta_m);
     }
     /* fmin/fmax semantics (a NaN sample is ignored), without the calls */
     res->v_dc_min = br.v_dc < res->v_dc_min ? br.v_dc : res->v_dc_min;

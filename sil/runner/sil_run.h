@@ -58,6 +58,7 @@
 #include "hal_sil.h"
 #include "plant.h"
 #include "scenario.h"
+#include "sil_commission.h"
 
 typedef struct {
   uint64_t k;
@@ -93,12 +94,13 @@ typedef struct {
   uint32_t faults_seen; /* union over the run */
   drive_state_t final_state;
   uint32_t watchdog_kicks;
-  uint32_t watchdog_resets;   /* MCU resets by the watchdog */
-  uint32_t pwm_clamped;       /* PWM writes the board had to clamp (hal_sil_t) */
-  double voltage_balance_max; /* the phase check's largest |D| / v_dc (drive_phase_check.h) */
-  double first_watchdog_t;    /* -1 if none */
-  can_proto_stats_t can;      /* CAN runs only */
-  bool stopped;               /* ended early on request (sil_opts_t.stop) */
+  uint32_t watchdog_resets;    /* MCU resets by the watchdog */
+  uint32_t pwm_clamped;        /* PWM writes the board had to clamp (hal_sil_t) */
+  double voltage_balance_max;  /* the phase check's largest |D| / v_dc (drive_phase_check.h) */
+  double first_watchdog_t;     /* -1 if none */
+  can_proto_stats_t can;       /* CAN runs only */
+  bool stopped;                /* ended early on request (sil_opts_t.stop) */
+  sil_commission_t commission; /* the scenario's identification run (key "commission") */
 } sil_result_t;
 
 /* Moves frames between a bus and the HAL queues; t is the simulated time. */

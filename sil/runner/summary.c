@@ -19,6 +19,52 @@ static cJSON *fault_list(uint32_t bits) {
   return a;
 }
 
+static const char *const proc_status_names[] = {"idle",   "running", "done",
+                                                "failed", "aborted", "refused"};
+
+static cJSON *float_array(const float *v, int n) {
+  cJSON *a = cJSON_CreateArray();
+  for (int k = 0; k < n; ++k) {
+    cJSON_AddItemToArray(a, cJSON_CreateNumber((double)v[k]));
+  }
+  return a;
+}
+
+/* The identification run (sil_commission.h): each procedure's record and
+ * its points. */
+static cJSON *commission_json(const sil_commission_t *cm) {
+  cJSON *a = cJSON_CreateArray();
+  for (int k = 0; k < cm->n; ++k) {
+    const sil_commission_step_t *s = &cm->step[k];
+    const proc_row_t *row = proc_row((proc_id_t)s->proc);
+    cJSON *e = cJSON_CreateObject();
+    cJSON_AddStringToObject(e, "proc", row != NULL ? row->name : "?");
+    cJSON_AddStringToObject(e, "status",
+                            (unsigned)s->status < 6u ? proc_status_names[s->status] : "?");
+    cJSON_AddItemToObject(e, "fault", fault_list(s->fault));
+    cJSON_AddItemToObject(e, "result", float_array(s->result, PROC_RESULTS));
+    cJSON_AddNumberToObject(e, "t0", s->t0);
+    cJSON_AddNumberToObject(e, "t1", s->t1);
+    cJSON_AddNumberToObject(e, "i_peak", s->i_peak);
+    cJSON_AddNumberToObject(e, "move", s->move);
+    cJSON *pts = cJSON_AddArrayToObject(e, "points");
+    for (int j = 0; j < cm->n_points; ++j) {
+      const sil_commission_point_t *p = &cm->points[j];
+      if (p->step == (uint8_t)k) {
+        cJSON *q = cJSON_CreateArray();
+        cJSON_AddItemToArray(q, cJSON_CreateNumber((double)p->phase));
+        for (int x = 0; x < PROC_RESULTS; ++x) {
+          cJSON_AddItemToArray(q, cJSON_CreateNumber((double)p->result[x]));
+        }
+        cJSON_AddItemToArray(pts, q);
+      }
+    }
+    cJSON_AddBoolToObject(e, "points_full", cm->points_full);
+    cJSON_AddItemToArray(a, e);
+  }
+  return a;
+}
+
 char *summary_json(const scenario_t *sc, const sil_result_t *r) {
   cJSON *o = cJSON_CreateObject();
   cJSON_AddStringToObject(o, "scenario", sc->name);
@@ -47,6 +93,9 @@ char *summary_json(const scenario_t *sc, const sil_result_t *r) {
   cJSON_AddNumberToObject(o, "first_watchdog_t", r->first_watchdog_t);
   cJSON_AddNumberToObject(o, "pwm_clamped", (double)r->pwm_clamped);
   cJSON_AddNumberToObject(o, "voltage_balance_max", r->voltage_balance_max);
+  if (sc->commission.n > 0) {
+    cJSON_AddItemToObject(o, "commission", commission_json(&r->commission));
+  }
   char *s = cJSON_Print(o);
   cJSON_Delete(o);
   return s;
@@ -153,6 +202,16 @@ char *params_json(void) {
     for (unsigned v = 0; v < lists[l].count; ++v) {
       cJSON_AddItemToArray(a, cJSON_CreateString(lists[l].name(v)));
     }
+  }
+  /* the procedures (proc.h PROC_LIST): CMD_PROC's and TM_PROC's value
+   * tables, the commissioning's identification procedures */
+  cJSON *pr = cJSON_AddArrayToObject(o, "procs");
+  for (unsigned k = 0; k < (unsigned)PROC_COUNT; ++k) {
+    const proc_row_t *r = proc_row((proc_id_t)k);
+    cJSON *p = cJSON_CreateObject();
+    cJSON_AddStringToObject(p, "name", r->name);
+    cJSON_AddBoolToObject(p, "ident", (r->caps & PROC_CAP_IDENT) != 0u);
+    cJSON_AddItemToArray(pr, p);
   }
   cJSON *f = cJSON_AddArrayToObject(o, "faults");
   for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {

@@ -73,9 +73,13 @@ static void rows_agree_with_the_list(void **state) {
     assert_non_null(r->init);
     assert_non_null(r->step);
     assert_non_null(r->publish);
-    /* a procedure shows as a start state: gates off or on by its caps */
+    /* a procedure shows as a start state: gates off or on by its caps; an
+     * identification's gated rows as ident */
     const bool gates = (r->caps & PROC_CAP_GATES) != 0u;
-    assert_int_equal(r->state, gates ? DRIVE_STATE_ALIGN : DRIVE_STATE_OFFSET_CAL);
+    const bool ident = (r->caps & PROC_CAP_IDENT) != 0u && gates;
+    assert_int_equal(r->state, ident   ? DRIVE_STATE_IDENT
+                               : gates ? DRIVE_STATE_ALIGN
+                                       : DRIVE_STATE_OFFSET_CAL);
   }
   assert_null(proc_row(PROC_COUNT));
   assert_null(proc_row((proc_id_t)1000));
@@ -392,6 +396,84 @@ static void drive_publishes_the_procedures(void **state) {
   assert_int_equal(tm.proc.status, PROC_ST_ABORTED);
 }
 
+/* An identification run (drive_cmd_identify): only rows with
+ * PROC_CAP_IDENT, not while enabled; the offsets, then idle with the gates
+ * off and the results published; a stop request and an enable end it. */
+static void identification_runs_alone_and_stops(void **state) {
+  (void)state;
+  static hal_sil_t hal;
+  static drive_t drv;
+  const hal_sil_board_t board = {0.0f, 1.0f, 0u, 1e-6f, 62.5e-6f, 50u, false, 0.0f, 0.0f};
+  hal_sil_init(&hal, &board);
+  hal_sil_bind(&hal);
+  drive_config_t cfg;
+  drive_config_default(&cfg);
+  assert_int_equal(drive_init(&drv, &cfg, NULL), 0);
+  memset(&hal.sample, 0, sizeof hal.sample);
+  hal.sample.i_abc[0] = 0.2f;
+  hal.sample.i_abc[1] = -0.1f;
+  hal.sample.i_abc[2] = -0.1f;
+  hal.sample.v_dc = 310.0f;
+  hal.sample.enc_valid = true;
+  hal.sample.valid = true;
+  const char *field = NULL;
+  assert_non_null(drive_cmd_identify(&drv, PROC_ALIGN, &field)); /* not an identification */
+  assert_string_equal(field, "proc");
+  assert_non_null(drive_cmd_identify(&drv, PROC_COUNT + 3, &field));
+  drive_cmd_enable(&drv, true);
+  assert_non_null(drive_cmd_identify(&drv, PROC_OFFSET, &field)); /* enabled */
+  assert_string_equal(field, "enable");
+  drive_cmd_enable(&drv, false);
+  drive_isr(&drv);
+  assert_null(drive_cmd_identify(&drv, PROC_OFFSET, &field));
+  drive_isr(&drv);
+  assert_int_equal(drv.state, DRIVE_STATE_OFFSET_CAL);
+  assert_false(hal.gates_on);
+  for (unsigned k = 0; k < cfg.offset_samples; ++k) {
+    drive_isr(&drv);
+  }
+  assert_int_equal(drv.state, DRIVE_STATE_IDLE); /* not the run: no enable */
+  assert_false(hal.gates_on);
+  drive_telemetry_t tm;
+  assert_true(drive_telemetry_read(&drv, &tm));
+  assert_int_equal(tm.proc.id, PROC_OFFSET);
+  assert_int_equal(tm.proc.status, PROC_ST_DONE);
+  assert_float_equal(tm.proc.result[0], 0.2f, 1e-6f);
+  assert_float_equal(drv.offset[1], -0.1f, 1e-6f);
+  /* a stop request ends it */
+  assert_null(drive_cmd_identify(&drv, PROC_OFFSET, NULL));
+  drive_isr(&drv);
+  drive_isr(&drv);
+  assert_int_equal(drv.state, DRIVE_STATE_OFFSET_CAL);
+  assert_null(drive_cmd_identify(&drv, PROC_NONE, NULL));
+  drive_isr(&drv);
+  assert_int_equal(drv.state, DRIVE_STATE_IDLE);
+  assert_false(drv.ident);
+  assert_true(drive_telemetry_read(&drv, &tm));
+  assert_int_equal(tm.proc.status, PROC_ST_ABORTED);
+  /* so does an enable: the start then begins from idle */
+  assert_null(drive_cmd_identify(&drv, PROC_OFFSET, NULL));
+  drive_isr(&drv);
+  assert_int_equal(drv.state, DRIVE_STATE_OFFSET_CAL);
+  drive_cmd_enable(&drv, true);
+  drive_isr(&drv);
+  assert_false(drv.ident);
+  assert_true(drive_telemetry_read(&drv, &tm));
+  assert_int_equal(tm.proc.status, PROC_ST_ABORTED);
+  drive_isr(&drv);
+  assert_int_equal(drv.state, DRIVE_STATE_OFFSET_CAL); /* the start's offsets */
+  /* a request posted while enabled and running is void, later too */
+  drive_cmd_enable(&drv, false);
+  drive_isr(&drv);
+  assert_int_equal(drv.state, DRIVE_STATE_IDLE);
+  drv.cmd.ident = PROC_OFFSET; /* as if posted while enabled (the main loop refuses it) */
+  drv.state = DRIVE_STATE_RUN;
+  drv.req.cmd.ident_count++;
+  drv.req.seq += 2u;
+  drive_isr(&drv);
+  assert_false(drv.ident_new);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(rows_agree_with_the_list),
@@ -404,6 +486,7 @@ int main(void) {
       cmocka_unit_test(held_start_finds_the_north_pole),
       cmocka_unit_test(held_start_without_an_angle_fails_and_aborts_clean),
       cmocka_unit_test(drive_publishes_the_procedures),
+      cmocka_unit_test(identification_runs_alone_and_stops),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

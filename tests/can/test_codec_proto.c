@@ -2,7 +2,8 @@
  * test_codec_proto.c - the CAN protocol on the SIL HAL: replies, bad DLC,
  * out-of-range values naming the signal, unknown identifiers, parameters,
  * the bounded receive (floods), lossless replies, and the command timeout
- * (ramp, then fault) timed to one slow period.
+ * (ramp, then fault) timed to one slow period; identifications (CMD_PROC,
+ * TM_PROC) and the timeout during one.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -650,6 +651,156 @@ static void test_clear_frames_keep_fault_requests(void **state) {
   }
 }
 
+static void push_proc(unsigned v) {
+  uint8_t d[8] = {0};
+  can_codec_set_raw(CAN_SIG_CMD_PROC, d, v);
+  push(CAN_MSG_CMD_PROC, 1, d);
+}
+
+/* The TM_PROC frames sent since the last pop: the results by index, how
+ * many, and the last id and status. */
+typedef struct {
+  float result[PROC_RESULTS];
+  unsigned n, id, status, index_prev;
+  bool cycled; /* every frame's index one past the one before (mod 8) */
+} tm_proc_t;
+
+static void pop_tm_proc(tm_proc_t *t) {
+  hal_can_frame_t f;
+  while (hal_sil_can_pop(&rig.hal.can_tx, &f)) {
+    if (f.id != can_codec_id(CAN_MSG_TM_PROC, 3)) {
+      continue;
+    }
+    assert_int_equal(f.dlc, 8);
+    const unsigned k = can_codec_get_raw(CAN_SIG_PROC_INDEX, f.data);
+    assert_true(k < PROC_RESULTS);
+    if (t->n > 0u && k != (t->index_prev + 1u) % PROC_RESULTS) {
+      t->cycled = false;
+    }
+    t->index_prev = k;
+    t->result[k] = can_codec_get(CAN_SIG_PROC_RESULT, f.data);
+    t->id = can_codec_get_raw(CAN_SIG_PROC_ID, f.data);
+    t->status = can_codec_get_raw(CAN_SIG_PROC_STATUS, f.data);
+    t->n++;
+  }
+}
+
+/* CMD_PROC: refusals naming the signal, the offsets run alone and stopped,
+ * their results in TM_PROC (index cycling, one per frame, every 10 ms). */
+static void test_proc_over_can(void **state) {
+  (void)state;
+  rig_init();
+  const float off[3] = {0.25f, -0.5f, 0.25f};
+  memcpy(rig.hal.sample.i_abc, off, sizeof off);
+  reply_t r[64];
+  tm_proc_t t = {.cycled = true};
+  slow_tick();
+  pop_tm_proc(&t);
+  assert_int_equal(t.n, 1);
+  assert_int_equal(t.id, CAN_PROC_NONE); /* none since start-up */
+  assert_int_equal(t.status, PROC_ST_IDLE);
+  push_proc(PROC_ALIGN);                      /* not an identification */
+  push_proc(PROC_COUNT);                      /* no such procedure */
+  push_proc(CAN_PROC_NONE);                   /* a stop with none running: ok */
+  push(CAN_MSG_CMD_PROC, 2, (uint8_t[8]){0}); /* bad DLC */
+  slow_tick();
+  assert_int_equal(pop_replies(r, 64, NULL), 4);
+  for (unsigned i = 0; i < 4; ++i) {
+    assert_int_equal(r[i].req, CAN_MSG_CMD_PROC);
+    if (i < 3u) { /* the identification asked for: none (a bad DLC reports nothing) */
+      assert_float_equal(r[i].value, (float)CAN_PROC_NONE, 0.0f);
+    }
+  }
+  assert_int_equal(r[0].result, CAN_RESULT_UNAVAILABLE);
+  assert_int_equal(r[0].signal, CAN_SIG_CMD_PROC + 1u);
+  assert_int_equal(r[1].result, CAN_RESULT_OUT_OF_RANGE);
+  assert_int_equal(r[1].signal, CAN_SIG_CMD_PROC + 1u);
+  assert_int_equal(r[2].result, CAN_RESULT_OK);
+  assert_int_equal(r[3].result, CAN_RESULT_BAD_DLC);
+  assert_int_equal(rig.drv.state, DRIVE_STATE_IDLE);
+  /* the offsets over 256 samples (16 ms): running, then done */
+  push_proc(PROC_OFFSET);
+  slow_tick();
+  assert_int_equal(pop_replies(r, 64, NULL), 1);
+  assert_int_equal(r[0].result, CAN_RESULT_OK);
+  assert_float_equal(r[0].value, (float)PROC_OFFSET, 0.0f);
+  assert_int_equal(rig.drv.state, DRIVE_STATE_OFFSET_CAL);
+  memset(&t, 0, sizeof t);
+  t.cycled = true;
+  bool saw_running = false;
+  for (unsigned i = 0; i < 100; ++i) {
+    push_param(0, 31, 0.0f);
+    slow_tick();
+    pop_tm_proc(&t);
+    saw_running |= t.status == PROC_ST_RUNNING;
+  }
+  assert_true(saw_running);
+  assert_int_equal(t.n, 10); /* 100 ms at 10 ms */
+  assert_true(t.cycled);
+  assert_int_equal(t.id, PROC_OFFSET);
+  assert_int_equal(t.status, PROC_ST_DONE);
+  assert_int_equal(rig.drv.state, DRIVE_STATE_IDLE);
+  for (unsigned k = 0; k < PROC_RESULTS; ++k) {
+    assert_float_equal(t.result[k], rig.drv.tm.proc.result[k], 0.0f);
+    assert_float_equal(t.result[k], k < 3u ? off[k] : 0.0f, 1e-6f);
+  }
+  /* stopped while it runs (offset_samples 60000: 3.75 s) */
+  push_param(1, 43, 60000.0f);
+  slow_tick();
+  push_proc(PROC_OFFSET);
+  for (unsigned i = 0; i < 10; ++i) {
+    slow_tick();
+  }
+  assert_int_equal(rig.drv.state, DRIVE_STATE_OFFSET_CAL);
+  push_proc(CAN_PROC_NONE);
+  slow_tick();
+  slow_tick();
+  assert_int_equal(rig.drv.state, DRIVE_STATE_IDLE);
+  assert_int_equal(rig.drv.tm.proc.status, PROC_ST_ABORTED);
+  pop_replies(r, 64, NULL);
+  /* refused while the drive is enabled, naming the enable */
+  push_state(1, 0, CAN_KEEP, CAN_KEEP);
+  push_proc(PROC_OFFSET);
+  slow_tick();
+  assert_int_equal(pop_replies(r, 64, NULL), 2);
+  assert_int_equal(r[1].result, CAN_RESULT_NOT_WHILE_RUNNING);
+  assert_int_equal(r[1].signal, CAN_SIG_ENABLE + 1u);
+}
+
+/* A lost link during an identification: no torque ramp, the fault at
+ * timeout_ms (to one slow period), gates off, the procedure aborted. */
+static void test_proc_command_timeout(void **state) {
+  (void)state;
+  rig_init();
+  rig.p.cfg.timeout_ms = 300;
+  rig.p.cfg.ramp_ms = 100;
+  push_param(1, 43, 60000.0f); /* offset_samples: 3.75 s */
+  slow_tick();
+  push_proc(PROC_OFFSET);
+  slow_tick();
+  assert_int_equal(rig.drv.state, DRIVE_STATE_OFFSET_CAL);
+  const uint32_t last = rig.p.last_rx_us;
+  uint32_t t_fault = 0;
+  for (unsigned i = 0; i < 1000 && t_fault == 0u; ++i) {
+    slow_tick();
+    assert_false(rig.p.ramp);
+    if (rig.drv.state == DRIVE_STATE_FAULT) {
+      t_fault = rig.hal.time_us;
+    }
+  }
+  assert_true(t_fault > 0u);
+  assert_true(abs((int)(t_fault - last) - 300000) <= 1000);
+  assert_int_equal(rig.drv.faults, DRIVE_FAULT_CMD_TIMEOUT);
+  assert_false(rig.hal.gates_on);
+  assert_int_equal(rig.drv.tm.proc.status, PROC_ST_ABORTED);
+  assert_int_equal(rig.p.stats.timeouts, 1);
+  for (unsigned i = 0; i < 100; ++i) { /* and stays there */
+    slow_tick();
+  }
+  assert_int_equal(rig.drv.state, DRIVE_STATE_FAULT);
+  assert_int_equal(rig.p.stats.timeouts, 1);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_unknown_and_other_nodes_ignored),
@@ -667,6 +818,8 @@ int main(void) {
       cmocka_unit_test(test_acknowledged_writes_never_trip_later),
       cmocka_unit_test(test_enable_clear_keep_over_can),
       cmocka_unit_test(test_clear_frames_keep_fault_requests),
+      cmocka_unit_test(test_proc_over_can),
+      cmocka_unit_test(test_proc_command_timeout),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -6,12 +6,13 @@
  * drive_background, can_proto_poll; then sample, ISR, plant).
  *
  * The input is a sequence of operations (docs/fuzzing.md): CAN frames for
- * the drive's node (a message of the protocol, its DLC right or given),
+ * the drive's node (a message of the protocol, its DLC right or given;
+ * CMD_PROC's identifications too, stopped by a timeout, an enable or a stop),
  * raw frames (any identifier, standard or extended, any DLC), time
  * advances (ISR periods, main-loop periods), typed parameter writes, and
  * a switch that stops draining the TX queue (a blocked bus). Checked after
  * every step, __builtin_trap() on a violation (a message first):
- *   - every CMD_* and PARAM_REQ frame for the node gets exactly one REPLY,
+ *   - every CMD_* (CMD_PROC too) and PARAM_REQ frame for the node gets exactly one REPLY,
  *     in order, answering its request (reply_req), bad_dlc when and only
  *     when its DLC is wrong; no REPLY without a request; all replies out by
  *     the end;
@@ -53,6 +54,7 @@
 #define REL_TOL        1e-5f  /* float rounding of a limit */
 #define CAN_BASE_CMD   0x100u /* CMD_STATE; CMD_* and PARAM_REQ every 0x10 */
 #define CAN_BASE_HB    0x160u
+#define CAN_BASE_PROC  0x170u /* CMD_PROC */
 #define CAN_BASE_REPLY 0x180u
 
 int LLVMFuzzerInitialize(int *argc, char ***argv);
@@ -117,6 +119,9 @@ int LLVMFuzzerInitialize(int *argc, char ***argv) {
 
 /* The reply a frame for the node asks for: its reply_req, or -1 (none). */
 static int expected_req(const hal_can_frame_t *f) {
+  if (!f->extended && f->id == CAN_BASE_PROC + NODE) {
+    return (int)CAN_MSG_CMD_PROC; /* after HOST_HB, answered */
+  }
   if (f->extended || f->id < CAN_BASE_CMD + NODE || f->id >= CAN_BASE_HB + NODE) {
     return -1;
   }
@@ -132,7 +137,9 @@ static void push_frame(const hal_can_frame_t *f) {
   if (r < 0) {
     return;
   }
-  static const uint8_t dlc[] = {4u, 4u, 4u, 8u, 4u, 8u}; /* docs/can.md */
+  /* by reply_req (docs/can.md); HOST_HB (6) is never answered, CMD_PROC is 7 */
+  static const uint8_t dlc[] = {4u, 4u, 4u, 8u, 4u, 8u, 1u, 1u};
+  _Static_assert(CAN_MSG_CMD_PROC == 7, "reply_req of CMD_PROC");
   if (st.head - st.tail >= REQ_QUEUE) {
     violated("more requests outstanding than the harness tracks");
   }
@@ -254,6 +261,9 @@ static can_msg_t node_msg(uint8_t b) {
   static const can_msg_t m[] = {CAN_MSG_CMD_STATE,   CAN_MSG_CMD_TORQUE, CAN_MSG_CMD_SPEED,
                                 CAN_MSG_CMD_CURRENT, CAN_MSG_CMD_FLUX,   CAN_MSG_PARAM_REQ,
                                 CAN_MSG_HOST_HB};
+  if (b == 0xFFu) { /* CMD_PROC: the others keep the corpus's meaning (b % 7) */
+    return CAN_MSG_CMD_PROC;
+  }
   return m[b % (sizeof m / sizeof m[0])];
 }
 

@@ -17,6 +17,7 @@ ROOT = pathlib.Path(__file__).resolve().parent / "corpus"
 # 7 scaled parameter write. Messages of op 0: index into
 # CMD_STATE, CMD_TORQUE, CMD_SPEED, CMD_CURRENT, CMD_FLUX, PARAM_REQ, HOST_HB.
 STATE, TORQUE, SPEED, CURRENT, FLUX, PARAM, HB = range(7)
+PROC = 0xFF  # CMD_PROC (the message byte 255; the others: byte % 7)
 
 
 def frame(msg, data, dlc=None):
@@ -84,6 +85,13 @@ CAN = {
     + frame(CURRENT, [0], dlc=12) + param(1, 200, 1.0) + state(7)
     + bytes([2, 0x61, 0x01, 4]) + bytes(8) + bytes([2, 0x01, 0x81, 8]) + bytes(8)
     + state(1, mode=0, law=1) + wait_ms(30) + state(0, clear=1),
+    # identifications (CMD_PROC): the offsets run, stopped, run again; one
+    # refused while enabled, one not an identification, one out of range;
+    # the last left to the command timeout
+    "seed-proc": frame(PROC, [0]) + wait_ms(5) + frame(PROC, [255]) + wait_ms(2)
+    + frame(PROC, [1]) + frame(PROC, [200]) + frame(PROC, [0]) + wait_ms(10)
+    + state(1, mode=0) + wait_ms(10) + frame(PROC, [0]) + state(0) + wait_ms(5)
+    + bytes([7, 43, 5]) + frame(PROC, [0]) + bytes([6, 1]),  # offset_samples x 10: 160 ms
 }
 
 

@@ -126,7 +126,7 @@ def flood_frames(proto: Protocol, rng: random.Random, n: int):
     """(frame, expected reply or None): random garbage and known messages
     with wrong lengths, out-of-range and valid values, in send order."""
     host_ids = {proto.frame_id(m) for m in ("CMD_STATE", "CMD_TORQUE", "CMD_SPEED", "CMD_CURRENT",
-                                           "CMD_FLUX", "PARAM_REQ", "HOST_HB")}
+                                           "CMD_FLUX", "PARAM_REQ", "HOST_HB", "CMD_PROC")}
     out = []
     for _ in range(n):
         k = rng.random()

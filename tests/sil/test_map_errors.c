@@ -137,6 +137,18 @@ static void refused_maps(void **state) {
                                   "\"map_ok2.fdmap\", \"pole_pairs\": 2}}",
                                   "maps.json", &sc, err, sizeof err),
                    0);
+  /* the drive's own map (controller.map): a map machine's, the same pole pairs */
+  assert_int_not_equal(scenario_parse("{\"duration\": 0.01, \"controller\": {\"map\": "
+                                      "\"map_ok2.fdmap\"}}",
+                                      "maps.json", &sc, err, sizeof err),
+                       0);
+  assert_non_null(strstr(err, "controller.map: needs a flux-map machine"));
+  assert_int_equal(scenario_parse("{\"duration\": 0.01, \"machine\": {\"map\": "
+                                  "\"map_ok2.fdmap\"}, \"controller\": {\"map\": "
+                                  "\"map_ok2.fdmap\"}}",
+                                  "maps.json", &sc, err, sizeof err),
+                   0);
+  assert_non_null(sc.drive.machine_map);
 }
 
 /* issue 23, point 14: the drive's current limit inside the map's grid

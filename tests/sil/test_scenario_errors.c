@@ -78,6 +78,13 @@ static const bad_case_t cases[] = {
     {"{\"duration\": 1, \"mechanics\": {\"j\": 1e-9}}",
      "mechanics.j: the plant cannot integrate this inertia at this PWM period: the rotor against "
      "the PM flux (and the friction) needs 81 integration steps per period, at most 64"},
+    /* issue 25: the inverter's device drops, the cogging torque */
+    {"{\"duration\": 1, \"inverter\": {\"v_th_sw\": 6}}", "inverter.v_th_sw: must be in [0, 5]"},
+    {"{\"duration\": 1, \"inverter\": {\"r_diode\": -0.1}}",
+     "inverter.r_diode: must be in [0, 10]"},
+    {"{\"duration\": 1, \"machine\": {\"cogging_amp\": 0.1}}",
+     "machine.cogging_order: must be given (periods per mechanical turn, >= 1) with "
+     "machine.cogging_amp"},
     {"{\"duration\": 1, \"controller\": {\"pos_source\": \"hall\"}}",
      "controller.pos_source: must be one of: encoder"},
     {"{\"duration\": 1, \"controller\": {\"slow_div\": 2.5}}",

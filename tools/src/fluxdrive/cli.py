@@ -309,6 +309,9 @@ def build_parser() -> argparse.ArgumentParser:
     add_machines_parser(sub)
 
     add_can_parser(sub)
+    from fluxdrive.commission import add_parser as add_commission_parser  # fluxdrive commission
+
+    add_commission_parser(sub)
     return parser
 
 

@@ -31,7 +31,9 @@ DOC_REL = Path("docs/parameters.md")
 TABLES_REL = Path("tools/src/fluxdrive/drive_tables.json")
 
 # DBC message ids of the signals whose value tables come from the firmware
-CMD_STATE, REPLY, STATUS, HEARTBEAT = 256, 384, 512, 1792
+CMD_STATE, CMD_PROC, REPLY, STATUS, TM_PROC, HEARTBEAT = 256, 368, 384, 512, 880, 1792
+#: CMD_PROC.cmd_proc: stops the identification running; TM_PROC.proc_id: none yet
+PROC_STOP = 255
 
 
 @lru_cache(maxsize=1)
@@ -60,6 +62,16 @@ def fault_names(bits: int) -> list[str]:
     return [n for b, n in enumerate(tables()["faults"]) if bits & (1 << b)]
 
 
+def proc_ids() -> dict[str, int]:
+    """Every procedure of the firmware's table (proc.h PROC_LIST) by name."""
+    return {p["name"]: i for i, p in enumerate(tables()["procs"])}
+
+
+def ident_procs() -> list[str]:
+    """The identification procedures (PROC_CAP_IDENT: CMD_PROC runs them), in table order."""
+    return [p["name"] for p in tables()["procs"] if p["ident"]]
+
+
 def keep() -> int:
     return int(tables()["can_keep"])
 
@@ -86,7 +98,10 @@ def dbc_lines(t: dict) -> dict[str, str]:
     params = [(p["id"], p["name"]) for p in sorted(t["params"], key=lambda p: p["id"])]
     params += [(p["id"], p["name"]) for p in t["can_params"]]
     faults = ", ".join(f"{b} {n}" for b, n in enumerate(t["faults"]))
+    procs = [(i, p["name"]) for i, p in enumerate(t["procs"])]
     out = {
+        f"VAL_ {CMD_PROC} cmd_proc ": _val(CMD_PROC, "cmd_proc", procs + [(PROC_STOP, "stop")]),
+        f"VAL_ {TM_PROC} proc_id ": _val(TM_PROC, "proc_id", procs + [(PROC_STOP, "none")]),
         f"VAL_ {CMD_STATE} enable ": _val(CMD_STATE, "enable", [(0, "disable"), (1, "enable"),
                                                                   (k, "keep")]),
         f"VAL_ {CMD_STATE} mode ": _val(CMD_STATE, "mode", modes + [(k, "keep")]),
@@ -174,6 +189,9 @@ def render_doc(t: dict) -> str:
     for key, title in (("laws", "Control laws"), ("modes", "Modes"), ("states", "States"),
                        ("pos_sources", "Position sources")):
         out.append(f"* {title}: " + ", ".join(f"{i} `{n}`" for i, n in enumerate(t[key])))
+    out.append("* Procedures (`CMD_PROC`, `TM_PROC`; * identification, run alone by `CMD_PROC`): "
+               + ", ".join(f"{i} `{p['name']}`{' *' if p['ident'] else ''}"
+                           for i, p in enumerate(t["procs"])))
     out.append("* Fault bits: " + ", ".join(f"{b} `{n}`" for b, n in enumerate(t["faults"])))
     out.append("* CAN reply results: " + ", ".join(f"{i} `{n}`"
                                                    for i, n in enumerate(t["can_results"])))

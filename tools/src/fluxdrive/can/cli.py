@@ -207,6 +207,9 @@ def cmd_send(args: argparse.Namespace) -> int:
             p, v = need(2)
             print(f"{p} = {drv.set_param(p, float(v)):.7g} (acknowledged)")
             return 0
+        elif what == "identify":
+            (name,) = need(1)
+            r = drv.identify(name)  # "stop" stops the one running
         elif what == "heartbeat":
             drv.bus.send(drv.proto.encode("HOST_HB", host_hb_count=0))
             print("heartbeat sent")
@@ -230,7 +233,8 @@ def cmd_doc(args: argparse.Namespace) -> int:
 
 
 SEND_HELP = ("enable | disable | clear | mode torque|speed|current | law foc|pi_dfvc|db_dfvc | "
-             "torque NM | speed RPM | current ID IQ | flux VS | get PARAM | set PARAM VALUE | heartbeat")
+             "torque NM | speed RPM | current ID IQ | flux VS | get PARAM | set PARAM VALUE | "
+             "identify PROC|stop | heartbeat")
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -265,7 +269,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = csub.add_parser("send", help="command or parameter write, acknowledge checked")
     add_bus_args(p)
     p.add_argument("what", choices=["enable", "disable", "clear", "mode", "law", "torque", "speed",
-                                    "current", "flux", "get", "set", "heartbeat"], help=SEND_HELP)
+                                    "current", "flux", "get", "set", "identify", "heartbeat"], help=SEND_HELP)
     p.add_argument("values", nargs="*")
     p.add_argument("--timeout", type=float, default=1.0, help="reply timeout [s] (default 1)")
     p.set_defaults(func=cmd_send)

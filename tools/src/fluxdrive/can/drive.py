@@ -12,6 +12,8 @@ Example (SIL: ``fluxdrive-sil sil/scenarios/can_demo.json --can socketcand:29536
         print(drv.read_telemetry())               # {"speed_rpm": ..., "torque_est": ...}
         drv.set_param("speed_bw", 40.0)           # written, read back
         drv.disable()
+        drv.identify("offset")                    # CMD_PROC: an identification, drive disabled
+        print(drv.wait_proc("offset").results)    # TM_PROC: its eight results
 
 Every command waits for the drive's REPLY and raises :class:`DriveError`
 (naming the rejected signal) unless it is ``ok``. The drive stops on its
@@ -25,6 +27,7 @@ import logging
 import queue
 import threading
 import time
+from dataclasses import dataclass, replace
 from typing import Any, Callable
 
 import can
@@ -33,11 +36,33 @@ from fluxdrive import params
 from fluxdrive.can.protocol import Protocol, Reply
 from fluxdrive.errors import FluxdriveError
 
+#: TM_PROC.proc_status: the procedure's end (it is no longer running)
+PROC_ENDED = ("done", "failed", "aborted", "refused")
 TELEMETRY = ("TM_SPEED", "TM_TORQUE", "TM_PHASE", "TM_DQ", "TM_FLUX", "TM_POSITION")  # TM_CPU: 100 ms, ask for it
 # names and numbers from the firmware's tables (fluxdrive params)
 MODES = params.mode_ids()
 LAWS = params.law_ids()
 KEEP_ENABLE = KEEP_MODE = KEEP_LAW = params.keep()
+
+
+@dataclass
+class ProcStatus:
+    """The procedure telemetry (TM_PROC) as collected by the host."""
+
+    proc: str  # procedure name (cmd_proc's value table), "none" before the first
+    status: str  # idle, running, done, failed, aborted, refused
+    phase: int  # the procedure's own phase or point counter
+    results: list[float | None]  # PROC_RESULTS values; None: not received since the status changed
+    since: float  # local monotonic time the (proc, status) pair was first seen
+
+    @property
+    def ended(self) -> bool:
+        return self.status in PROC_ENDED
+
+    @property
+    def complete(self) -> bool:
+        """Every result received since the status last changed."""
+        return all(r is not None for r in self.results)
 
 
 class DriveError(FluxdriveError):
@@ -78,6 +103,9 @@ class Drive:
         self._req_lock = threading.Lock()
         self._hb_task: can.broadcastmanager.CyclicSendTaskABC | None = None
         self._hb_count = 0
+        self.procs = {v: k for k, v in self.proto.proc_names.items()}  # name -> cmd_proc
+        n_res = self.proto.proc_results
+        self._proc = ProcStatus("none", "idle", 0, [None] * n_res, time.monotonic())
         self.notifier = can.Notifier(self.bus, [self._on_frame], timeout=0.02)
 
     # --------------------------------------------------------- plumbing
@@ -92,10 +120,26 @@ class Drive:
                 self._replies.put(r)
             return
         with self._cond:
+            if name == "TM_PROC":
+                self._on_proc(sigs)
             self._values.update({k: float(v) for k, v in sigs.items()})
             self._stamp[name] = time.monotonic()
             self._frame_time[name] = float(frame.timestamp)
             self._cond.notify_all()
+
+    def _on_proc(self, sigs: dict[str, Any]) -> None:
+        """TM_PROC: one result per frame; the results restart when the
+        procedure or its status changes (so a complete set is the end's)."""
+        pid, st = int(sigs["proc_id"]), int(sigs["proc_status"])
+        proc = self.proto.proc_names.get(pid, "none")
+        status = self.proto.proc_status_names.get(st, str(st))
+        p = self._proc
+        if (proc, status) != (p.proc, p.status):
+            p = self._proc = ProcStatus(proc, status, 0, [None] * len(p.results), time.monotonic())
+        p.phase = int(sigs["proc_phase"])
+        k = int(sigs["proc_index"])
+        if 0 <= k < len(p.results):
+            p.results[k] = float(sigs["proc_result"])
 
     def request(self, message: str, check: bool = True, **signals: Any) -> Reply:
         """Sends a CMD_* or PARAM_REQ frame and returns the drive's REPLY.
@@ -161,6 +205,50 @@ class Drive:
     def set_flux(self, flux: float) -> Reply:
         """Stator flux reference [Vs], 0 = automatic."""
         return self.request("CMD_FLUX", cmd_flux=flux)
+
+    def identify(self, name: str) -> Reply:
+        """CMD_PROC: runs identification procedure `name` (the drive
+        disabled: the offsets, then it, then the gates off); "stop" stops the
+        one running. Raises DriveError when refused (unavailable: not an
+        identification; not_while_running: the drive is enabled)."""
+        try:
+            pid = self.procs[name]
+        except KeyError:
+            raise DriveError(f"unknown procedure {name!r}; known: {', '.join(self.procs)}") from None
+        return self.request("CMD_PROC", cmd_proc=pid)
+
+    def stop_identify(self) -> Reply:
+        return self.identify("stop")
+
+    def proc_status(self) -> ProcStatus:
+        """The procedure telemetry (TM_PROC) as received so far (a copy)."""
+        with self._cond:
+            p = self._proc
+            return replace(p, results=list(p.results))
+
+    def wait_proc(self, name: str, timeout: float = 60.0, after: float | None = None,
+                  progress: Callable[[ProcStatus], None] | None = None) -> ProcStatus:
+        """Waits until procedure `name` has ended (a status change seen after
+        `after`, default now) and all its results of that end have arrived.
+        `progress` is called with each new status (at most every 0.1 s)."""
+        t0 = time.monotonic() if after is None else after
+        deadline = time.monotonic() + timeout
+        last = None
+        while True:
+            with self._cond:
+                self._cond.wait(timeout=0.1)
+                p = self._proc
+                done = p.proc == name and p.ended and p.since >= t0 and p.complete
+                snap = replace(p, results=list(p.results))
+            if progress is not None and snap.proc == name and (snap.status, snap.phase) != last \
+                    and (snap.since >= t0 or not snap.ended):
+                last = (snap.status, snap.phase)
+                progress(snap)
+            if done:
+                return snap
+            if time.monotonic() > deadline:
+                raise DriveError(f"procedure {name} did not end within {timeout} s "
+                                 f"(last: {snap.proc} {snap.status}, phase {snap.phase})")
 
     def get_param(self, name: str | int) -> float:
         pid = self.proto.param_id(name)

@@ -1,0 +1,168 @@
+"""Commissioning: rs and ldq in the SIL against the plant's truth (issue 25 a, b;
+docs/commissioning.md).
+
+Each case builds a scenario: a preset machine or a drawn one
+(`fluxdrive.machines`, fixed seeds; more with FLUXDRIVE_SEEDS or --seed). It
+adds current noise (`sensors.i_noise`) on the board's ADC quantisation, dead
+time, a free rotor, and `"commission": [{"proc": "rs"}, {"proc": "ldq"}]`.
+It runs the SIL and compares the procedure results in the summary's
+"commission" entries with the truth from `--print-config` (the resolved
+plant machine). The limits are the issue's:
+  - R_s within 2 %; L_d and L_q within 5 % (linear machines);
+  - the true peak current within the procedure's limit: rs's `id_rs_current`
+    (0: i_max / 2); ldq's design bound of 1.5 i_b (i_b = i_max / 3);
+  - the rotor's movement within the stated bound: rs one electrical turn
+    plus a quarter for the swing, ldq half a turn plus a quarter;
+  - with the average inverter, the voltage error at the top level within
+    10 % of the dead time's plateau, (4/3) v_dc t_dead / ts along alpha.
+At least one rs case runs the switching inverter.
+
+Broken on purpose (tests/mutation/mutants.json): rs_single_level (R = V / I)
+fails test_rs_* by the dead time's V_0 / I; ldq_delay fails test_ldq_*.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import subprocess
+import tempfile
+
+import pytest
+
+from conftest import REAL_SIL
+from fluxdrive import machines as mach
+
+SEEDS_SPM = [1, 2, 3]
+SEEDS_IPM = [1, 2]
+LINEAR_PRESETS = ["rubino2020_spm", "fabbri2022_t51"]
+TOL_R = 0.02
+TOL_L = 0.05
+
+real_sil = pytest.mark.skipif(not REAL_SIL.exists(), reason="fluxdrive-sil not built")
+
+
+def _seeds(config, base):
+    extra = [int(s) for s in os.environ.get("FLUXDRIVE_SEEDS", "").split()]
+    extra += list(config.getoption("--seed") or [])
+    return extra or base
+
+
+def _run(sc: dict):
+    """Runs the SIL: (summary, resolved config), or skips when the runner has
+    no commission path yet."""
+    with tempfile.TemporaryDirectory() as d:
+        p = os.path.join(d, "sc.json")
+        out = os.path.join(d, "summary.json")
+        with open(p, "w") as f:
+            json.dump(sc, f)
+        cfg = subprocess.run([str(REAL_SIL), p, "--print-config"], capture_output=True, text=True,
+                             timeout=60)
+        if cfg.returncode != 0 and "commission" in cfg.stderr:
+            pytest.skip("the SIL has no commission path: " + cfg.stderr.strip()[:200])
+        assert cfg.returncode == 0, cfg.stderr
+        r = subprocess.run([str(REAL_SIL), p, "--summary", out], capture_output=True, text=True,
+                           timeout=600)
+        assert r.returncode == 0, r.stderr
+        with open(out) as f:
+            return json.load(f), json.loads(cfg.stdout)
+
+
+def _scenario(sections: dict, name: str, inverter: str = "average") -> dict:
+    s = json.loads(json.dumps(sections))
+    s.setdefault("controller", {})
+    s["controller"].update({"law": "foc", "mode": "torque"})
+    s["mechanics"] = dict(s.get("mechanics", {}), mode="free")
+    s["inverter"] = {"model": inverter, "dead_time": 1e-6}
+    i_max = s["controller"].get("i_max")
+    s.setdefault("sensors", {})
+    s["sensors"]["i_noise"] = 0.002 * (i_max or 3.5)
+    s.update({"name": name, "duration": 3.5,
+              "references": {"torque": [{"type": "const", "value": 0.0}]},
+              "commission": [{"proc": "rs"}, {"proc": "ldq"}]})
+    return s
+
+
+def _entry(summary: dict, proc: str) -> dict:
+    for e in summary["commission"]:
+        if e["proc"] == proc:
+            return e
+    raise AssertionError(f"no {proc} in the summary's commission")
+
+
+def _check_rs(summary, cfg, name):
+    m = cfg["machine"]
+    c = cfg["controller"]
+    e = _entry(summary, "rs")
+    r = e["result"]
+    print(f"{name}: rs {e['status']} R {r[0]:.6g} (true {m['rs']:.6g}) v_err {r[1]:.4g} V "
+          f"knee {r[2]:.4g} A i_peak {e['i_peak']:.4g} move {e['move']:.4g}")
+    assert e["status"] == "done", e
+    assert abs(r[0] / m["rs"] - 1.0) < TOL_R
+    lim = min(c.get("id_rs_current") or 0.5 * c["i_max"], c["i_max"])
+    assert e["i_peak"] <= lim * 1.02  # the PWM ripple of the switching inverter
+    assert e["move"] <= 1.25 * 2.0 * math.pi / m["pole_pairs"]
+    return e
+
+
+def _check_ldq(summary, cfg, name, saturated=False):
+    m = cfg["machine"]
+    c = cfg["controller"]
+    e = _entry(summary, "ldq")
+    r = e["result"]
+    print(f"{name}: ldq {e['status']} L_d {r[0]:.6g} (true {m.get('ld')}) L_q {r[1]:.6g} "
+          f"(true {m.get('lq')}) i_b {r[2]:.4g} i_peak {e['i_peak']:.4g} move {e['move']:.4g}")
+    assert e["status"] == "done", e
+    i_b = min(c.get("id_ldq_current") or c["i_max"] / 3.0, 0.5 * c["i_max"])
+    assert e["i_peak"] <= 1.5 * i_b * 1.02
+    assert e["move"] <= 2.0 * math.pi / m["pole_pairs"]
+    if not saturated:
+        assert abs(r[0] / m["ld"] - 1.0) < TOL_L
+        assert abs(r[1] / m["lq"] - 1.0) < TOL_L
+    else:  # the incremental inductances at the bias: positive, finite
+        assert 0.0 < r[0] < 10.0 and 0.0 < r[1] < 10.0
+
+
+# Known open (issue 25, identrl's report): a free rotor that swings about
+# the alignment (no damping without a speed estimate) corrupts the averages:
+# fabbri2022_t51's ldq L_d +7 % after rs left the rotor at pi.
+SWING = pytest.mark.xfail(strict=True, reason="free rotor swinging through the measurement "
+                          "(alignment without damping): open, docs/commissioning.md")
+
+
+@real_sil
+@pytest.mark.parametrize("preset", [LINEAR_PRESETS[0],
+                                    pytest.param(LINEAR_PRESETS[1], marks=SWING)])
+def test_rs_ldq_presets(preset):
+    sc = _scenario({"machine": {"preset": preset}, "board": {"preset": "g474_nucleo"}},
+                   f"commission rl {preset}")
+    summary, cfg = _run(sc)
+    e = _check_rs(summary, cfg, preset)
+    # the average inverter's dead-time plateau along alpha: 2/3 (e + e/2 * 2)
+    v0 = cfg["v_dc"] * cfg["dead_time"] / cfg["ts"]
+    assert abs(e["result"][1] / (4.0 / 3.0 * v0) - 1.0) < 0.10
+    _check_ldq(summary, cfg, preset)
+
+
+@real_sil
+def test_rs_switching_inverter():
+    sc = _scenario({"machine": {"preset": "rubino2020_spm"}, "board": {"preset": "g474_nucleo"}},
+                   "commission rl switching", inverter="switching")
+    sc["commission"] = [{"proc": "rs"}]
+    sc["duration"] = 2.2
+    summary, cfg = _run(sc)
+    _check_rs(summary, cfg, "rubino2020_spm switching")
+
+
+@real_sil
+@SWING  # spm seed 2: R_s -5.6 %, the rotor swinging (0.55 rad)
+def test_rs_ldq_random_machines(pytestconfig):
+    cases = [("spm", s) for s in _seeds(pytestconfig, SEEDS_SPM)]
+    cases += [("ipm", s) for s in _seeds(pytestconfig, SEEDS_IPM)]
+    for kind, seed in cases:
+        d = mach.draw(kind, seed)
+        print(d.params_line())
+        summary, cfg = _run(_scenario(d.sections, f"commission rl {kind} {seed}"))
+        _check_rs(summary, cfg, f"{kind} {seed}")
+        _check_ldq(summary, cfg, f"{kind} {seed}")

@@ -1,0 +1,299 @@
+"""``fluxdrive commission``: identifies the motor over CAN (issue 25, point 3).
+
+Runs the drive's identification procedures one after the other (CMD_PROC:
+each alone, the drive disabled: the offsets, then it, then the gates off;
+docs/commissioning.md), follows each through TM_PROC (status, phase, its
+eight results, one per frame) with a plain-text progress line, writes what
+each found back into the drive as parameters (PARAM_REQ), writes a
+parameter file and prints a report::
+
+    fluxdrive commission --interface socketcan --channel can0          # a board
+    fluxdrive commission offset --sil sil/scenarios/can_demo.json      # the SIL, with its truth
+
+With ``--sil SCENARIO`` it starts ``fluxdrive-sil SCENARIO --can
+socketcand:0 --realtime`` itself and the report adds the plant's truth and
+the error of each value (``fluxdrive-sil --print-truth`` when the runner
+has it, else ``--print-config`` and the scenario's sensor and injected
+current offsets).
+
+What a procedure's results mean is its row's (proc.h, each row's
+publish()); :data:`RESULTS` maps each result index to a name, a unit and
+the drive parameter it is written to (None: reported, not written).
+Adding a procedure to the commissioning is one entry there; one in
+:data:`ORDER` if it must run before or after another.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import select
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from fluxdrive import params
+from fluxdrive.errors import FluxdriveError
+
+#: the order a full commissioning runs the identification procedures in, as
+#: far as the drive has them (each needs the ones before: the offsets, R_s
+#: for the inductances' voltage, the poles and encoder before the flux at
+#: speed, the mechanics last; the flux maps after the linear values).
+#: Procedures the drive has that are not listed run after these, in the
+#: drive's order.
+ORDER = ("offset", "rs", "ldq", "poles", "enc", "flux", "mech", "fmap")
+
+
+@dataclass(frozen=True)
+class Result:
+    """Result `index` of a procedure (proc_telemetry_t.result[index])."""
+
+    index: int
+    name: str  # the report's and the parameter file's name
+    unit: str
+    param: str | None = None  # drive parameter (PARAM_REQ name) it is written to; None: none
+
+
+#: procedure -> its results, from each row's publish() (proc.h). The
+#: identification procedures being written for issue 25 add their rows
+#: here as they land (e.g. "rs": [Result(0, "rs", "ohm", "rs")]); a
+#: procedure without an entry has its eight raw results reported and
+#: nothing written.
+RESULTS: dict[str, list[Result]] = {
+    # proc_offset.c: the three current-sensor offsets [A] (measured again
+    # at every enable: no parameter holds them)
+    "offset": [Result(0, "offset_a", "A"), Result(1, "offset_b", "A"), Result(2, "offset_c", "A")],
+}
+
+
+def results_of(proc: str) -> list[Result]:
+    return RESULTS.get(proc) or [Result(k, f"{proc}_result{k}", "") for k in range(8)]
+
+
+def default_procs(available: list[str]) -> list[str]:
+    """Every identification procedure the drive has, in ORDER first."""
+    return [p for p in ORDER if p in available] + [p for p in available if p not in ORDER]
+
+
+# ------------------------------------------------------------------ truth
+def _profile_const(v: Any) -> float | None:
+    """A profile's value when it is a constant (a number or one step at t=0)."""
+    if isinstance(v, (int, float)):
+        return float(v)
+    return None
+
+
+def truth_from_sil(sil: Path, scenario: Path) -> dict[str, float]:
+    """The plant's true values by result name: ``--print-truth`` when the
+    runner has it (its flat keys), else the resolved machine
+    (``--print-config``) and the current offsets the scenario puts in the
+    sensors (``sensors.offset_error`` plus constant ``inject.current``
+    offsets)."""
+    truth: dict[str, float] = {}
+    r = subprocess.run([str(sil), str(scenario), "--print-truth"], capture_output=True, text=True,
+                       timeout=60)
+    if r.returncode == 0 and r.stdout.strip().startswith("{"):
+        def flat(o: Any, prefix: str = "") -> None:
+            for k, v in o.items():
+                if isinstance(v, dict):
+                    flat(v, f"{prefix}{k}.")
+                elif isinstance(v, (int, float)) and not isinstance(v, bool):
+                    truth.setdefault(k, float(v))
+                    truth[prefix + k] = float(v)
+        flat(json.loads(r.stdout))
+    r = subprocess.run([str(sil), str(scenario), "--print-config"], capture_output=True, text=True,
+                       timeout=60)
+    if r.returncode != 0:
+        raise FluxdriveError(f"{sil} {scenario} --print-config failed: {r.stderr.strip()}")
+    cfg = json.loads(r.stdout)
+    for k, v in cfg.get("machine", {}).items():
+        if isinstance(v, (int, float)) and not isinstance(v, bool):
+            truth.setdefault(k, float(v))
+    sc = json.loads(Path(scenario).read_text(encoding="utf-8"))
+    off = list(sc.get("sensors", {}).get("offset_error", [0.0, 0.0, 0.0]))
+    for inj in sc.get("inject", {}).get("current", []):
+        v = _profile_const(inj.get("value"))
+        if inj.get("kind") == "offset" and v is not None and "active" not in inj:
+            off["abc".index(inj["channel"])] += v
+    for k, ch in enumerate("abc"):
+        truth.setdefault(f"offset_{ch}", float(off[k]))
+    return truth
+
+
+# -------------------------------------------------------------------- SIL
+class SilProcess:
+    """fluxdrive-sil SCENARIO --can socketcand:0 --realtime on a free port."""
+
+    def __init__(self, sil: Path, scenario: Path, node: int) -> None:
+        self.proc = subprocess.Popen([str(sil), str(scenario), "--can", "socketcand:0", "--realtime",
+                                      "--node", str(node)], stdout=subprocess.PIPE,
+                                     stderr=subprocess.PIPE, text=True)
+        ready, _, _ = select.select([self.proc.stderr], [], [], 30.0)
+        line = self.proc.stderr.readline() if ready else ""
+        m = re.search(r"127\.0\.0\.1:(\d+)", line)
+        if not m:
+            self.stop()
+            raise FluxdriveError(f"the SIL did not start its CAN server: {line.strip()}")
+        self.port = int(m.group(1))
+
+    def stop(self) -> str:
+        if self.proc.poll() is None:
+            self.proc.terminate()
+        try:
+            _, err = self.proc.communicate(timeout=20)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            _, err = self.proc.communicate()
+        return err or ""
+
+
+# --------------------------------------------------------------- progress
+class Progress:
+    """A plain-text progress line per procedure: [k/n] name, a bar over the
+    procedures, its status and phase, the time it has taken."""
+
+    def __init__(self, procs: list[str], out=sys.stdout) -> None:
+        self.procs = procs
+        self.out = out
+        self.t0 = time.monotonic()
+
+    def __call__(self, k: int, st) -> None:
+        n = len(self.procs)
+        width = 20
+        fill = int(width * (k + (1.0 if st.ended else 0.5)) / n)
+        bar = "#" * fill + "." * (width - fill)
+        print(f"[{bar}] {k + 1}/{n} {self.procs[k]:<8} {st.status:<8} phase {st.phase:3d} "
+              f"({time.monotonic() - self.t0:6.2f} s)", file=self.out, flush=True)
+
+
+# ------------------------------------------------------------------- run
+def commission(drv, procs: list[str], write: bool = True, timeout: float = 120.0,
+               out=sys.stdout) -> list[dict]:
+    """Runs `procs` in turn on an open Drive; returns one record per
+    procedure run ({proc, status, phase, results, named, written,
+    duration}). Stops at the first that does not end done."""
+    st = drv.status()
+    if st["state_name"] == "fault":
+        raise FluxdriveError(f"the drive is in fault ({', '.join(st['fault_names'])}): clear it first")
+    if st["cmd_enabled"]:
+        drv.disable()
+    progress = Progress(procs, out)
+    records = []
+    for k, name in enumerate(procs):
+        t0 = time.monotonic()
+        drv.identify(name)
+        end = drv.wait_proc(name, timeout=timeout, after=t0, progress=lambda s, k=k: progress(k, s))
+        rec: dict[str, Any] = {"proc": name, "status": end.status, "phase": end.phase,
+                               "results": end.results, "named": {}, "written": {},
+                               "duration": time.monotonic() - t0}
+        records.append(rec)
+        if end.status != "done":
+            faults = drv.status()["fault_names"]
+            print(f"{name}: {end.status}" + (f" (faults: {', '.join(faults)})" if faults else "")
+                  + "; the commissioning stops here", file=out)
+            break
+        for r in results_of(name):
+            rec["named"][r.name] = end.results[r.index]
+            if r.param is not None and write:
+                rec["written"][r.param] = drv.set_param(r.param, end.results[r.index])
+    return records
+
+
+def parameter_file(records: list[dict]) -> dict:
+    """The parameter file: the written parameters under their scenario keys
+    (docs/parameters.md, e.g. machine.rs: merge it into a scenario) and
+    every result, by procedure, under "identified"."""
+    keys = {p["name"]: p["scenario"] for p in params.tables()["params"]}
+    out: dict[str, Any] = {}
+    for rec in records:
+        for name, value in rec["written"].items():
+            section, _, key = keys[name].partition(".")
+            out.setdefault(section, {})[key] = value
+    out["identified"] = {rec["proc"]: {"status": rec["status"], "duration": round(rec["duration"], 3),
+                                       "results": rec["results"], **rec["named"]} for rec in records}
+    return out
+
+
+def report(records: list[dict], truth: dict[str, float] | None, out=sys.stdout) -> None:
+    head = f"{'procedure':<10} {'value':<14} {'identified':>12} {'unit':<6} {'parameter':<10}"
+    if truth is not None:
+        head += f" {'true':>12} {'error':>10} {'error %':>8}"
+    print(head, file=out)
+    for rec in records:
+        for r in results_of(rec["proc"]):
+            v = rec["named"].get(r.name)
+            if v is None:
+                continue
+            line = f"{rec['proc']:<10} {r.name:<14} {v:12.6g} {r.unit:<6} {r.param or '-':<10}"
+            t = None if truth is None else truth.get(r.param or r.name, truth.get(r.name))
+            if t is not None:
+                rel = f"{100.0 * (v - t) / t:8.2f}" if t != 0.0 else f"{'-':>8}"
+                line += f" {t:12.6g} {v - t:10.3g} {rel}"
+            print(line, file=out)
+        print(f"{rec['proc']:<10} {'status':<14} {rec['status']:>12} ({rec['duration']:.2f} s)", file=out)
+
+
+def main(args: argparse.Namespace) -> int:
+    from fluxdrive.can.drive import Drive, open_bus
+    from fluxdrive.sil import locate_sil
+
+    available = params.ident_procs()
+    procs = args.procs or default_procs(available)
+    unknown = [p for p in procs if p not in available]
+    if unknown:
+        raise FluxdriveError(f"not an identification procedure of this drive: {', '.join(unknown)}",
+                             hint="known: " + ", ".join(available))
+    sil = None
+    truth = None
+    port = args.port
+    if args.sil:
+        sil_bin = locate_sil(args.sil_bin)
+        truth = truth_from_sil(sil_bin, Path(args.sil))
+        sil = SilProcess(sil_bin, Path(args.sil), args.node)
+        port = sil.port
+    ok = False
+    try:
+        try:
+            bus = open_bus(args.channel, args.interface, args.host, port)
+        except Exception as exc:  # python-can raises many kinds
+            raise FluxdriveError(f"cannot open the CAN bus ({args.interface} {args.channel}): {exc}") from None
+        with Drive(node=args.node, bus=bus, reply_timeout=args.reply_timeout, retries=args.retries) as drv:
+            drv.heartbeat(args.heartbeat)  # keeps the command timeout away while they run
+            records = commission(drv, procs, write=not args.no_write, timeout=args.timeout)
+        bus.shutdown()
+        ok = all(r["status"] == "done" for r in records) and len(records) == len(procs)
+        pf = parameter_file(records)
+        Path(args.out).write_text(json.dumps(pf, indent=1) + "\n", encoding="utf-8")
+        print()
+        report(records, truth)
+        print(f"\nparameter file: {args.out}")
+    finally:
+        if sil is not None:
+            sil.stop()
+    return 0 if ok else 1
+
+
+def add_parser(sub) -> None:
+    from fluxdrive.can.cli import add_bus_args
+
+    p = sub.add_parser("commission", help="identify the motor over CAN: run the identification "
+                       "procedures, load the results into the drive, write a parameter file, report")
+    p.add_argument("procs", nargs="*", metavar="PROC",
+                   help="procedures in the order to run (default: every identification procedure "
+                   "the drive has: " + ", ".join(ORDER) + " as far as they exist)")
+    add_bus_args(p)
+    p.add_argument("--sil", metavar="SCENARIO", help="start fluxdrive-sil SCENARIO --can socketcand "
+                   "--realtime and report the plant's truth beside each value")
+    p.add_argument("--sil-bin", metavar="PATH", help="the fluxdrive-sil to start (default: "
+                   "$FLUXDRIVE_SIL, else build/host-release)")
+    p.add_argument("--out", default="commission.json", help="parameter file (default commission.json)")
+    p.add_argument("--no-write", action="store_true", help="do not load the results into the drive")
+    p.add_argument("--timeout", type=float, default=120.0, help="per procedure [s] (default 120)")
+    p.add_argument("--heartbeat", type=float, default=0.05, help="HOST_HB period [s] (default 0.05)")
+    p.add_argument("--reply-timeout", type=float, default=1.0, help="per request [s] (default 1)")
+    p.add_argument("--retries", type=int, default=2, help="resends of an unanswered request (default 2)")
+    p.set_defaults(func=main)

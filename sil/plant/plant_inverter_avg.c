@@ -247,13 +247,7 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
   k.imposed = p->mech.mode == PLANT_MECH_IMPOSED;
   k.ideal = p->dclink.kind == PLANT_DC_IDEAL;
   k.drops = pl->aux.drops;
-  k.dv[0] = p->inverter.v_th_sw;
-  k.dv[1] = p->inverter.r_on_sw;
-  k.dv[2] = p->inverter.v_f_diode;
-  k.dv[3] = p->inverter.r_diode;
   k.cog[0] = p->mech.cog_amp;
-  k.cog[1] = (double)p->mech.cog_order;
-  k.cog[2] = p->mech.cog_phase;
   angle_ref_t ar;
   if (x[X_TH] == pl->theta_m) { /* always, from plant_step */
     const plant_cur_cache_t *cc = plant_machine_cur(pl);
@@ -272,6 +266,12 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
   }
   const int avgs = pl->aux.avgs;
   if (k.drops || k.cog[0] != 0.0) { /* device drops, cogging: a copy of their own */
+    k.dv[0] = p->inverter.v_th_sw;  /* read by that copy only */
+    k.dv[1] = p->inverter.r_on_sw;
+    k.dv[2] = p->inverter.v_f_diode;
+    k.dv[3] = p->inverter.r_diode;
+    k.cog[1] = (double)p->mech.cog_order;
+    k.cog[2] = p->mech.cog_phase;
     avg_rk4(pl, &k, k.ideal, k.imposed, avgs, 1, &ar, x, cs_end);
   } else if (k.ideal && !k.imposed) { /* the usual case */
     if (avgs) {

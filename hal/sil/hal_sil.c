@@ -6,6 +6,8 @@
 
 #include <string.h>
 
+#define HAL_SIL_DUTY_TOL 1e-6f /* float rounding of off - on (hal_pwm_write) */
+
 static hal_sil_t *bound;
 
 void hal_sil_init(hal_sil_t *h, const hal_sil_board_t *board) {
@@ -15,6 +17,8 @@ void hal_sil_init(hal_sil_t *h, const hal_sil_board_t *board) {
   h->caps.dead_time = board->dead_time;
   h->caps.duty_min = board->duty_min;
   h->caps.duty_max = board->duty_max;
+  h->clamp_lo = board->duty_min - HAL_SIL_DUTY_TOL;
+  h->clamp_hi = board->duty_max + HAL_SIL_DUTY_TOL;
   h->caps.t_i = 0.0f;       /* the plant samples at the valley */
   h->caps.t_i_clear = 0.0f; /* an ideal sampler */
   h->caps.t_enc = 0.0f;
@@ -42,10 +46,9 @@ void hal_adc_read(hal_sample_t *s) {
 }
 
 void hal_pwm_write(const hal_pwm_t *p, hal_pwm_t *applied) {
-  const float tol = 1e-6f; /* float rounding of off - on */
-  for (int x = 0; x < 3; ++x) {
+  for (int x = 0; x < 3; ++x) { /* the range with its tolerance: hal_sil_init */
     const float d = p->off[x] - p->on[x];
-    if (!(d >= bound->caps.duty_min - tol && d <= bound->caps.duty_max + tol)) {
+    if (!(d >= bound->clamp_lo && d <= bound->clamp_hi)) {
       bound->pwm_clamped++;
       break;
     }

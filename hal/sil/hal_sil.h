@@ -40,15 +40,16 @@ typedef struct {
 typedef struct {
   hal_caps_t caps;
   uint32_t timer_counts;
-  hal_pattern_t timer;  /* the timer model of caps and timer_counts (hal_pattern.h) */
-  hal_sample_t sample;  /* what hal_adc_read returns */
-  hal_pwm_t pwm;        /* preloaded pattern (acts from the next period) */
-  uint32_t pwm_clamped; /* writes with a leg outside the duty range (caps): the
-                         * drive asked for what the board cannot do */
-  bool gates_on;        /* modulating (the preloaded pattern) */
-  bool asc;             /* active short circuit: all low sides on (hal_pwm_short) */
-  bool hw_tripped;      /* break input latch (set by the runner) */
-  uint32_t hw_source;   /* which break input latched (HAL_BREAK_*; 0: the comparator) */
+  hal_pattern_t timer;      /* the timer model of caps and timer_counts (hal_pattern.h) */
+  hal_sample_t sample;      /* what hal_adc_read returns */
+  hal_pwm_t pwm;            /* preloaded pattern (acts from the next period) */
+  uint32_t pwm_clamped;     /* writes with a leg outside the duty range (caps): the
+                             * drive asked for what the board cannot do */
+  float clamp_lo, clamp_hi; /* caps.duty_min - tol, caps.duty_max + tol (hal_pwm_write) */
+  bool gates_on;            /* modulating (the preloaded pattern) */
+  bool asc;                 /* active short circuit: all low sides on (hal_pwm_short) */
+  bool hw_tripped;          /* break input latch (set by the runner) */
+  uint32_t hw_source;       /* which break input latched (HAL_BREAK_*; 0: the comparator) */
   uint32_t time_us;
   /* watchdog: the runner calls hal_sil_watchdog_expired() every period */
   uint32_t watchdog_timeout_us;

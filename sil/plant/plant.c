@@ -306,8 +306,11 @@ void plant_get_brief(plant_t *pl, plant_brief_t *out) {
   out->i_abc[1] = c->i_abc[1];
   out->i_abc[2] = c->i_abc[2];
   out->omega_m = pl->omega_m;
-  out->torque = torque_of(pl, c);
   out->v_dc = pl->v_dc;
+}
+
+double plant_get_torque(plant_t *pl) {
+  return torque_of(pl, plant_machine_cur(pl));
 }
 
 void plant_get_state(const plant_t *pl, plant_state_t *out) {

@@ -203,11 +203,12 @@ typedef struct {
   double i_dq[2], i_abc[3];
 } plant_cur_cache_t;
 
-/* The part of the true state that run metrics need (plant_get_brief). */
+/* The part of the true state that run metrics need every period
+ * (plant_get_brief; the torque, needed over the run's tail only, from
+ * plant_get_torque). */
 typedef struct {
   double i_abc[3]; /* [A] */
   double omega_m;  /* [rad/s] */
-  double torque;   /* [N m] */
   double v_dc;     /* [V] */
 } plant_brief_t;
 
@@ -281,6 +282,7 @@ typedef struct {
   int fric_dir; /* periods since cur's cos/sin last came from libm */
   /* sensor constants (plant_sensors.c) */
   double adc_levels, adc_ilsb, adc_vlsb, enc_step;
+  double adc_gain[3], adc_code_max, adc_i_off; /* 1 + gain_error, levels - 1, levels / 2 */
   /* ziggurat tables of the noise generator (plant_sensors.c) */
   uint32_t zig_k[PLANT_ZIG_N];
   double zig_w[PLANT_ZIG_N], zig_f[PLANT_ZIG_N];
@@ -426,5 +428,7 @@ bool plant_take_desat(plant_t *pl);
  * cheaply: the currents are computed once per state and shared with
  * plant_sample() (hence not const). */
 void plant_get_brief(plant_t *pl, plant_brief_t *out);
+/* plant_get_state()'s torque [N m], as cheaply. */
+double plant_get_torque(plant_t *pl);
 
 #endif

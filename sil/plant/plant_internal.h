@@ -57,13 +57,18 @@ static inline void plant_cos_sin_near(double th_ref, double c_ref, double s_ref,
  * rounding instruction: floor is a call on every period's wraps, ADC codes
  * and encoder count): the truncation, one lower for a negative fraction;
  * libm for |y| >= 2^52 (already an integer) and NaN; -0.0 gives +0.0, which
- * every caller adds to or scales. */
+ * every caller adds to or scales. With SSE4.1 (the release runner's
+ * x86-64-v2, sil/CMakeLists.txt) floor is the ROUNDSD instruction. */
 static inline double plant_floor(double y) {
+#if defined(__SSE4_1__)
+  return floor(y); /* ROUNDSD (x86-64-v2 release runner): one instruction */
+#else
   if (!(y > -4503599627370496.0 && y < 4503599627370496.0)) {
     return floor(y);
   }
   const double t = (double)(long long)y;
   return t > y ? t - 1.0 : t;
+#endif
 }
 
 /* Integration state vector. The last four entries are integrals over the

@@ -40,14 +40,16 @@
 
 /* d_eff for a leg with duty d and kd = td/Ts when 0 < d < 1, else kd = 0
  * (no switching, no dead time: d_eff = d - 0 = d; only a NaN current, i.e.
- * an already diverged state, gives NaN there). The clamps are branches:
- * well predicted (a current crosses its band a few times per electrical
- * period), they keep the comparisons off the stage-to-stage dependency
- * chain, which bounds the speed of the integrator. */
+ * an already diverged state, gives NaN there). Each clamp is written as
+ * `bound OP v ? bound : v`, the operand order of SSE's MAXSD/MINSD (the
+ * second operand when unordered: NaN passes through, as before), so that
+ * the compiler emits the two instructions instead of compares and
+ * branches: the same values for every input, signed zeros included. */
 static inline double eff_duty(double d, double kd, double i_norm) {
-  const double sg = i_norm > 1.0 ? 1.0 : (i_norm < -1.0 ? -1.0 : i_norm);
-  const double e = d - kd * sg;
-  return e < 0.0 ? 0.0 : (e > 1.0 ? 1.0 : e);
+  const double lo = -1.0 > i_norm ? -1.0 : i_norm;
+  const double sg = 1.0 < lo ? 1.0 : lo;
+  const double e0 = 0.0 > d - kd * sg ? 0.0 : d - kd * sg;
+  return 1.0 < e0 ? 1.0 : e0;
 }
 
 /* The period-average device drop of a leg with effective duty e at
@@ -245,13 +247,7 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
   k.imposed = p->mech.mode == PLANT_MECH_IMPOSED;
   k.ideal = p->dclink.kind == PLANT_DC_IDEAL;
   k.drops = pl->aux.drops;
-  k.dv[0] = p->inverter.v_th_sw;
-  k.dv[1] = p->inverter.r_on_sw;
-  k.dv[2] = p->inverter.v_f_diode;
-  k.dv[3] = p->inverter.r_diode;
   k.cog[0] = p->mech.cog_amp;
-  k.cog[1] = (double)p->mech.cog_order;
-  k.cog[2] = p->mech.cog_phase;
   angle_ref_t ar;
   if (x[X_TH] == pl->theta_m) { /* always, from plant_step */
     const plant_cur_cache_t *cc = plant_machine_cur(pl);
@@ -270,6 +266,12 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
   }
   const int avgs = pl->aux.avgs;
   if (k.drops || k.cog[0] != 0.0) { /* device drops, cogging: a copy of their own */
+    k.dv[0] = p->inverter.v_th_sw;  /* read by that copy only */
+    k.dv[1] = p->inverter.r_on_sw;
+    k.dv[2] = p->inverter.v_f_diode;
+    k.dv[3] = p->inverter.r_diode;
+    k.cog[1] = (double)p->mech.cog_order;
+    k.cog[2] = p->mech.cog_phase;
     avg_rk4(pl, &k, k.ideal, k.imposed, avgs, 1, &ar, x, cs_end);
   } else if (k.ideal && !k.imposed) { /* the usual case */
     if (avgs) {

@@ -164,6 +164,11 @@ void plant_sensors_init(plant_t *pl) {
   a->adc_levels = ldexp(1.0, s->adc_bits);
   a->adc_ilsb = 2.0 * s->i_full_scale / a->adc_levels;
   a->adc_vlsb = s->v_full_scale / a->adc_levels;
+  for (int k = 0; k < 3; k++) {
+    a->adc_gain[k] = 1.0 + s->gain_error[k];
+  }
+  a->adc_code_max = a->adc_levels - 1.0;
+  a->adc_i_off = 0.5 * a->adc_levels;
   a->enc_step = s->encoder_cpr > 0 ? PLANT_TWO_PI / s->encoder_cpr : 0.0;
   pl->rng = splitmix64(pl->p.sensors.seed);
   if (pl->rng == 0) {
@@ -174,14 +179,15 @@ void plant_sensors_init(plant_t *pl) {
 
 static double adc_round(double x, double lsb, double code_min, double code_max, double code_off) {
   double code = plant_floor(x / lsb + 0.5) + code_off;
-  code = code < code_min ? code_min : (code > code_max ? code_max : code);
+  code = code_min > code ? code_min : code; /* MAXSD, MINSD (NaN passes) */
+  code = code_max < code ? code_max : code;
   return (code - code_off) * lsb;
 }
 
 void plant_sample(plant_t *pl, plant_adc_t *out) {
   const plant_sensors_t *s = &pl->p.sensors;
   const plant_aux_t *a = &pl->aux;
-  const double levels = a->adc_levels;
+  const double code_max = a->adc_code_max;
   double n[4] = {0.0, 0.0, 0.0, 0.0};
   if (s->i_noise > 0.0) {
     for (int k = 0; k < 3; k++) {
@@ -194,16 +200,17 @@ void plant_sample(plant_t *pl, plant_adc_t *out) {
   const double *i_abc = plant_machine_cur(pl)->i_abc;
   const double ilsb = a->adc_ilsb;
   for (int k = 0; k < 3; k++) {
-    const double raw = (1.0 + s->gain_error[k]) * i_abc[k] + s->offset_error[k] + s->i_noise * n[k];
-    out->i_abc[k] = adc_round(raw, ilsb, 0.0, levels - 1.0, 0.5 * levels);
+    const double raw = a->adc_gain[k] * i_abc[k] + s->offset_error[k] + s->i_noise * n[k];
+    out->i_abc[k] = adc_round(raw, ilsb, 0.0, code_max, a->adc_i_off);
   }
   const double vlsb = a->adc_vlsb;
-  out->v_dc = adc_round(pl->v_dc + s->v_noise * n[3], vlsb, 0.0, levels - 1.0, 0.0);
+  out->v_dc = adc_round(pl->v_dc + s->v_noise * n[3], vlsb, 0.0, code_max, 0.0);
   out->v_star = pl->aux.v_star;
   if (s->encoder_cpr > 0) {
     const double step = a->enc_step;
     double cnt = plant_floor(pl->theta_m / step);
-    cnt = cnt >= s->encoder_cpr ? 0.0 : (cnt < 0.0 ? 0.0 : cnt);
+    const double c0 = 0.0 > cnt ? 0.0 : cnt; /* MAXSD (NaN passes) */
+    cnt = cnt >= s->encoder_cpr ? 0.0 : c0;
     out->enc_angle = cnt * step;
   } else {
     out->enc_angle = pl->theta_m;

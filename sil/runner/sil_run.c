@@ -398,7 +398,7 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
     res->max_speed = br.omega_m > res->max_speed ? br.omega_m : res->max_speed;
     res->min_speed = br.omega_m < res->min_speed ? br.omega_m : res->min_speed;
     if (k >= tail) {
-      torque_tail += br.torque;
+      torque_tail += plant_get_torque(&x.plant);
     }
     res->faults_seen |= x.drv.faults;
     if (x.drv.faults != 0u && res->first_fault_t < 0.0) {

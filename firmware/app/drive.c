@@ -24,7 +24,8 @@
 #include "math/frames.h"
 
 static bool gates_on_state(drive_state_t s) {
-  return s == DRIVE_STATE_RUN || s == DRIVE_STATE_ALIGN || s == DRIVE_STATE_IDENT;
+  /* one test of a mask, however many states (every period) */
+  return ((1u << (unsigned)s) & DRIVE_GATES_ON_STATES) != 0u;
 }
 
 /* The mode in force (drive_t.mode): current mode only with a law that has

@@ -292,12 +292,19 @@ int drive_config_validate(const drive_config_t *cfg, drive_law_t law, const hal_
 /* *dm, *dmap = *m, *map with dm's map pointer on dmap. */
 void drive_machine_copy(machine_t *dm, flux_map_t *dmap, const machine_t *m, const flux_map_t *map);
 
-/* States in which the drive is enabled: offset calibration, alignment, run
+/* The states with the gates modulating, and those in which the drive is
+ * enabled (below), as masks of 1 << state. */
+#define DRIVE_GATES_ON_STATES                                                                      \
+  ((1u << DRIVE_STATE_RUN) | (1u << DRIVE_STATE_ALIGN) | (1u << DRIVE_STATE_IDENT))
+#define DRIVE_ENABLED_STATES (DRIVE_GATES_ON_STATES | (1u << DRIVE_STATE_OFFSET_CAL))
+_Static_assert(DRIVE_STATE_COUNT <= 32, "drive states: a mask of 1 << state");
+
+/* States in which the drive is enabled: offset calibration, alignment, run,
+ * identification
  * (non-LIVE parameters are refused then). Inline: the ISR asks every
  * period. */
 static inline bool drive_state_enabled(drive_state_t s) {
-  return s == DRIVE_STATE_OFFSET_CAL || s == DRIVE_STATE_RUN || s == DRIVE_STATE_ALIGN ||
-         s == DRIVE_STATE_IDENT;
+  return ((1u << (unsigned)s) & DRIVE_ENABLED_STATES) != 0u; /* one test, every period */
 }
 
 /* The enable in force as the main loop sees it (STATUS.cmd_enabled): an

@@ -129,8 +129,8 @@ FD_COLD static float rs_fit(const proc_rs_t *r, uint8_t used, float c_out[2]) {
   float sxx = 0.0f;
   float mi[2], mv[2];
   for (unsigned s = 0; s < 2u; ++s) {
-    const float *li = &r->lv_i[s * r->n_levels];
-    const float *lv = &r->lv_v[s * r->n_levels];
+    const float *li = &r->lv_i[(size_t)s * r->n_levels];
+    const float *lv = &r->lv_v[(size_t)s * r->n_levels];
     float si = 0.0f, sv = 0.0f;
     for (unsigned k = 0; k < used; ++k) {
       si += li[k];

@@ -4,12 +4,14 @@
 #include "sil_commission.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 #define CM_PI 3.14159265358979323846
 
 void sil_commission_init(sil_commission_t *cm, const sil_commission_list_t *list) {
-  memset(cm, 0, sizeof *cm);
+  /* the record's fields, not its points' storage (written before read) */
+  memset(cm, 0, offsetof(sil_commission_t, points));
   cm->done = list->n == 0;
 }
 

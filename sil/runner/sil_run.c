@@ -6,6 +6,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stddef.h>
 #include <string.h>
 #include <time.h>
 
@@ -279,7 +280,9 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
   static const sil_opts_t no_opts = {0};
   static can_proto_t proto;
   static sil_ctx_t x; /* large: keep off the stack; one run at a time */
-  memset(res, 0, sizeof *res);
+  /* the commission record clears its own (sil_commission_init): its
+   * points' storage is left as it is */
+  memset(res, 0, offsetof(sil_result_t, commission));
   if (sil_setup(&x, sc, err, errlen) != 0) {
     return -1;
   }

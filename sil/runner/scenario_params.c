@@ -121,7 +121,8 @@ int scenario_apply_params(scenario_t *sc, const char *path, char *err, size_t er
   drive_config_t d = sc->drive;
   int r = 0;
   for (const cJSON *it = root->child; it != NULL && r == 0; it = it->next) {
-    r = apply_one(&d, sc, it, path, err, errlen);
+    /* "identified": the commissioning's record (fluxdrive commission), not a parameter */
+    r = strcmp(it->string, "identified") == 0 ? 0 : apply_one(&d, sc, it, path, err, errlen);
   }
   cJSON_Delete(root);
   if (r == 0) {

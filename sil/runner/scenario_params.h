@@ -8,7 +8,9 @@
  *
  * The file is one JSON object {"name": value, ...}; enumerations (law,
  * mode, pos_source) by name; "map": a flux-map file, the drive's own
- * (like controller.map). Every error names the file and the parameter.
+ * (like controller.map); "identified" (the commissioning's record of what
+ * each procedure found) is skipped. Every error names the file and the
+ * parameter.
  */
 #ifndef FD_SIL_SCENARIO_PARAMS_H
 #define FD_SIL_SCENARIO_PARAMS_H

@@ -83,11 +83,12 @@ def test_commission_offset_over_can(tmp_path):
 
 def test_default_order_and_parameter_file():
     """The default procedures: ORDER first, then the drive's others; the
-    parameter file places a written parameter under its scenario key."""
+    parameter file holds a written parameter by its table name (what
+    fluxdrive-sil --params reads) and the record under "identified"."""
     assert default_procs(["mech", "x", "offset", "rs"]) == ["offset", "rs", "mech", "x"]
     pf = parameter_file([{"proc": "rs", "status": "done", "results": [0.5] + [0.0] * 7,
                           "named": {"rs": 0.5}, "written": {"rs": 0.5}, "duration": 1.0}])
-    assert pf["machine"] == {"rs": 0.5}
+    assert pf["rs"] == 0.5
     assert pf["identified"]["rs"]["rs"] == 0.5
 
 

@@ -31,7 +31,8 @@ def _config(tmp_path, params: dict | str, env: bool = False) -> subprocess.Compl
 def test_drive_takes_the_file_plant_keeps_its_machine(tmp_path):
     base = json.loads(_config(tmp_path, {}).stdout)
     for env in (False, True):
-        r = _config(tmp_path, {"rs": 0.5, "ld": 1e-3, "inertia": 0.03, "pos_source": "encoder"}, env)
+        r = _config(tmp_path, {"rs": 0.5, "ld": 1e-3, "inertia": 0.03, "pos_source": "encoder",
+                               "identified": {"rs": {"status": "done"}}}, env)
         assert r.returncode == 0, r.stderr
         cfg = json.loads(r.stdout)
         assert cfg["controller"]["rs"] == pytest.approx(0.5)

@@ -56,6 +56,7 @@ class Result:
     name: str  # the report's and the parameter file's name
     unit: str
     param: str | None = None  # drive parameter (PARAM_REQ name) it is written to; None: none
+    relative: bool = False  # written as the parameter in force plus the result (a correction)
 
 
 #: procedure -> its results, from each row's publish() (proc.h). The
@@ -72,6 +73,25 @@ RESULTS: dict[str, list[Result]] = {
     # star.b)
     "star": [Result(0, "star.a", "", "dfc_a"), Result(1, "star.b", "", "dfc_b"),
              Result(2, "star_p", ""), Result(4, "star_residual", "")],
+    # proc_rs.c: R_s (the slope over the levels above the knee), the
+    # inverter's voltage error at the top level, the knee current
+    "rs": [Result(0, "machine.rs", "ohm", "rs"), Result(1, "v_err_top", "V"),
+           Result(2, "v_err_knee", "A")],
+    # proc_ldq.c: L_d, L_q at the bias (incremental inductances)
+    "ldq": [Result(0, "machine.ld", "H", "ld"), Result(1, "machine.lq", "H", "lq")],
+    # proc_poles.c: pole pairs (rounded; the residue in result 3), polarity
+    "poles": [Result(0, "machine.pole_pairs", "", "pole_pairs"), Result(1, "polarity", ""),
+              Result(3, "poles_residue", "")],
+    # proc_enc.c: the offset's correction [rad electrical] on the one in
+    # force (theta_e = p theta_m - enc_offset, pos_encoder.c), the direction
+    "enc": [Result(0, "enc_offset_error", "rad", "enc_offset", relative=True),
+            Result(1, "encoder.direction", "")],
+    # proc_flux.c: lambda_m (both directions' mean)
+    "flux": [Result(0, "machine.lambda_m", "Vs", "lambda_m")],
+    # proc_mech.c: J, Coulomb friction, viscous friction (the drive's
+    # `friction` is the viscous B of the Kalman filter's model (4.46))
+    "mech": [Result(0, "mechanics.j", "kg m^2", "inertia"), Result(1, "mechanics.coulomb", "N m"),
+             Result(2, "mechanics.viscous", "N m s/rad", "friction")],
 }
 
 
@@ -196,6 +216,9 @@ def commission(drv, procs: list[str], write: bool = True, timeout: float = 120.0
                                "results": end.results, "named": {}, "written": {},
                                "duration": time.monotonic() - t0}
         records.append(rec)
+        if end.status == "refused":  # this drive's set cannot run it (no star point ...)
+            print(f"{name}: refused by the drive's parameter set; skipped", file=out)
+            continue
         if end.status != "done":
             faults = drv.status()["fault_names"]
             print(f"{name}: {end.status}" + (f" (faults: {', '.join(faults)})" if faults else "")
@@ -204,20 +227,21 @@ def commission(drv, procs: list[str], write: bool = True, timeout: float = 120.0
         for r in results_of(name):
             rec["named"][r.name] = end.results[r.index]
             if r.param is not None and write:
-                rec["written"][r.param] = drv.set_param(r.param, end.results[r.index])
+                v = end.results[r.index]
+                if r.relative:
+                    v = drv.get_param(r.param) + v
+                rec["written"][r.param] = drv.set_param(r.param, v)
     return records
 
 
 def parameter_file(records: list[dict]) -> dict:
-    """The parameter file: the written parameters under their scenario keys
-    (docs/parameters.md, e.g. machine.rs: merge it into a scenario) and
-    every result, by procedure, under "identified"."""
-    keys = {p["name"]: p["scenario"] for p in params.tables()["params"]}
+    """The parameter file: the written parameters by the parameter table's
+    names (docs/parameters.md; what ``fluxdrive-sil --params`` and
+    PARAM_REQ take), and every result, by procedure, under "identified"
+    (the record: ``--params`` ignores it)."""
     out: dict[str, Any] = {}
     for rec in records:
-        for name, value in rec["written"].items():
-            section, _, key = keys[name].partition(".")
-            out.setdefault(section, {})[key] = value
+        out.update(rec["written"])
     out["identified"] = {rec["proc"]: {"status": rec["status"], "duration": round(rec["duration"], 3),
                                        "results": rec["results"], **rec["named"]} for rec in records}
     return out
@@ -270,7 +294,7 @@ def main(args: argparse.Namespace) -> int:
             drv.heartbeat(args.heartbeat)  # keeps the command timeout away while they run
             records = commission(drv, procs, write=not args.no_write, timeout=args.timeout)
         bus.shutdown()
-        ok = all(r["status"] == "done" for r in records) and len(records) == len(procs)
+        ok = all(r["status"] in ("done", "refused") for r in records) and len(records) == len(procs)
         pf = parameter_file(records)
         Path(args.out).write_text(json.dumps(pf, indent=1) + "\n", encoding="utf-8")
         print()

@@ -665,15 +665,16 @@ static void drive_overrun_row(drive_t *drv, bool due) {
 FD_COLD static FD_NOINLINE void drive_pos_check_row(drive_t *drv, bool due) {
   const drive_config_t *c = &drv->cfg;
   const drive_telemetry_t *tm = &drv->tm;
-  const protect_pos_view_t v = {
-      c->pos_emf_tol > 0.0f && drv->state == DRIVE_STATE_RUN && tm->state == DRIVE_STATE_RUN &&
-          (drv->pos_src->caps & POS_CAP_GATED) == 0u && fd_isfinite(tm->v_dc),
-      due,
-      drv->pos.out.omega,
-      tm->theta_e,
-      (dq_t){tm->i_dq[0], tm->i_dq[1]},
-      (ab_t){tm->v_ab_applied[0], tm->v_ab_applied[1]},
-      tm->v_dc};
+  /* !gated: the source's POS_CAP_GATED (drive_derive), one load */
+  const protect_pos_view_t v = {c->pos_emf_tol > 0.0f && drv->state == DRIVE_STATE_RUN &&
+                                    tm->state == DRIVE_STATE_RUN && !drv->gated &&
+                                    fd_isfinite(tm->v_dc),
+                                due,
+                                drv->pos.out.omega,
+                                tm->theta_e,
+                                (dq_t){tm->i_dq[0], tm->i_dq[1]},
+                                (ab_t){tm->v_ab_applied[0], tm->v_ab_applied[1]},
+                                tm->v_dc};
   const uint32_t pf = protect_pos_step(&drv->pos_chk, &v);
   if (pf != 0u) {
     drive_trip(drv, pf);
@@ -739,7 +740,7 @@ static void drive_torque_row(drive_t *drv, bool due) {
  * whether this slow period is one of every `divider` (a row may need the
  * other periods too: the position check restarts when it does not apply,
  * checked or not). The rows of an ISR run in the table's order (phases
- * that fall in one ISR, slow_div < 4: MID, AFTER, NEXT, START; the torque
+ * that fall in one ISR, slow_div < 4: MID, AFTER, START, NEXT; the torque
  * then reaches the law a loop later). The phases split the slow work so
  * that no ISR carries two heavy items (issue 24 point 8): the current-sum
  * check at the start (where the main loop's commands come in the SIL), the
@@ -789,30 +790,32 @@ static void drive_schedule(drive_t *drv) {
   const uint32_t div = drv->cfg.slow_div;
   const uint32_t k = drv->isr_count - 1u;
   const uint32_t at = k % div;
-  const uint32_t off[DRIVE_PHASES] = {0u, 1u % div, 2u % div, div / 2u}; /* START ... MID */
+  const uint32_t mid = div / 2u;
+  /* the phases' offsets, START, NEXT, AFTER, MID: 0, 1, 2, slow_div / 2,
+   * those beyond the slow period folded onto 0 (1 % div, 2 % div) */
+  const uint32_t off[DRIVE_PHASES] = {0u, div > 1u ? 1u : 0u, div > 2u ? 2u : 0u, mid};
   /* the ISRs to the next phase, from this ISR's place in the slow period
-   * (from any place: the count restarts here after a new slow_div) */
-  uint32_t next = div;
-  for (unsigned p = 1u; p < DRIVE_PHASES; ++p) {
-    if (off[p] > at && off[p] < next) {
-      next = off[p];
-    }
-  }
+   * (from any place: the count restarts here after a new slow_div): the
+   * next of 0, 1, 2, then MID, then the next slow period's START (a folded
+   * offset is one already passed) */
+  const uint32_t next = at < off[2] ? at + 1u : (at < mid ? mid : div);
   drv->slow_wait = next - at;
   const uint32_t slow_n = k / div;
   /* unrolled: the table is constant, so each row's phase and divider fold
    * at compile time; the rows whose phase is this ISR, in the table's order */
-  bool busy = false;
 #pragma GCC unroll 16
   for (unsigned r = 0; r < DRIVE_SLOW_ROWS; ++r) {
     const drive_slow_row_t *row = &drive_slow_rows[r];
     if (at == off[row->phase]) {
+      if (row->defer) { /* the source puts off what can wait (pos_input_t.busy) */
+        drv->pos.in.busy = true;
+      }
       row->run(drv, slow_n % row->divider == 0u);
-      busy = busy || row->defer;
     }
   }
-  /* the source puts off what can wait (pos_input_t.busy: the RLS's halves) */
-  drv->pos.in.busy = busy;
+  /* cleared by the next ISR without a row (above): a phase without a
+   * deferring row right after one (MID after AFTER, slow_div 6 or 7) stays
+   * busy, which only puts an RLS half off by one more period */
 }
 
 static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {

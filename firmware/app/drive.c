@@ -318,6 +318,11 @@ FD_COLD static bool configure_live(drive_t *drv, const drive_config_t *cfg) {
   drv->speed.cfg.torque_max = fabsf(scfg.torque_max);
   drv->speed.pi.kp = scfg.kp;
   drv->speed.pi.ki = scfg.ki;
+  /* the loop's torque on its way to the law (drive_torque_row), and the
+   * one the law has, within a lowered torque_max at once */
+  const float tm = drv->speed.cfg.torque_max;
+  drv->speed_torque_new = fd_clampf(drv->speed_torque_new, -tm, tm);
+  drv->speed_torque = fd_clampf(drv->speed_torque, -tm, tm);
   return rest;
 }
 
@@ -668,15 +673,16 @@ static void drive_overrun_row(drive_t *drv, bool due) {
 FD_COLD static FD_NOINLINE void drive_pos_check_row(drive_t *drv, bool due) {
   const drive_config_t *c = &drv->cfg;
   const drive_telemetry_t *tm = &drv->tm;
-  const protect_pos_view_t v = {
-      c->pos_emf_tol > 0.0f && drv->state == DRIVE_STATE_RUN && tm->state == DRIVE_STATE_RUN &&
-          (drv->pos_src->caps & POS_CAP_GATED) == 0u && fd_isfinite(tm->v_dc),
-      due,
-      drv->pos.out.omega,
-      tm->theta_e,
-      (dq_t){tm->i_dq[0], tm->i_dq[1]},
-      (ab_t){tm->v_ab_applied[0], tm->v_ab_applied[1]},
-      tm->v_dc};
+  /* !gated: the source's POS_CAP_GATED (drive_derive), one load */
+  const protect_pos_view_t v = {c->pos_emf_tol > 0.0f && drv->state == DRIVE_STATE_RUN &&
+                                    tm->state == DRIVE_STATE_RUN && !drv->gated &&
+                                    fd_isfinite(tm->v_dc),
+                                due,
+                                drv->pos.out.omega,
+                                tm->theta_e,
+                                (dq_t){tm->i_dq[0], tm->i_dq[1]},
+                                (ab_t){tm->v_ab_applied[0], tm->v_ab_applied[1]},
+                                tm->v_dc};
   const uint32_t pf = protect_pos_step(&drv->pos_chk, &v);
   if (pf != 0u) {
     drive_trip(drv, pf);
@@ -699,12 +705,10 @@ static void drive_speed_row(drive_t *drv, bool due) {
     }
     /* the limit in force re-clamps the reference (a live speed_max write) */
     const float w_ref = fd_clampf(drv->cmd.speed, -c->speed_max, c->speed_max);
-    /* to the law in this ISR, with the limits in force (a torque handed a
-     * period later missed a live torque_max write: fuzz_can corpus
-     * live_torque_max_below_speed_torque) */
-    drv->speed_torque =
+    /* to the law in the next ISR (drive_torque_row) */
+    drv->speed_torque_new =
         speed_ctrl_update(&drv->speed, w_ref, w, drv->torque_min_avail, drv->torque_max_avail);
-    const protect_ra_view_t v = {w, drv->speed.w_ref_ramped, drv->speed_torque};
+    const protect_ra_view_t v = {w, drv->speed.w_ref_ramped, drv->speed_torque_new};
     const uint32_t ra = protect_ra_step(&drv->ra, &v);
     if (ra != 0u) {
       drv->tm.lc_cause = ra;
@@ -714,8 +718,24 @@ static void drive_speed_row(drive_t *drv, bool due) {
     speed_ctrl_reset(&drv->speed, drv->omega_m, 0.0f);
     drv->speed_active = false;
     drv->speed_torque = 0.0f;
+    drv->speed_torque_new = 0.0f;
   }
   drv->tm.speed_ref = drv->speed_active ? drv->speed.w_ref_ramped : 0.0f;
+}
+
+/* The speed loop's torque to the law, in the ISR after the loop's: the
+ * law's work on a new torque reference (FOC: the MTPA current,
+ * machine_mtpa_current, about 330 cycles on a salient machine) and the
+ * speed loop's (about 320) fall in two ISRs, not one (the worst case of the
+ * ISR, issue 24 point 8). The loop's output reaches the machine a period
+ * (62.5 us) later, within a speed-loop period of 1 ms (at a speed bandwidth
+ * of 30 rad/s, 0.1 degrees of phase). A live torque_max write between the
+ * two re-clamps the torque on its way (configure_live: the law never sees
+ * a torque beyond the limit in force, fuzz_can corpus
+ * live_torque_max_below_speed_torque). */
+static void drive_torque_row(drive_t *drv, bool due) {
+  (void)due;
+  drv->speed_torque = drv->speed_torque_new;
 }
 
 /* The slow-rate schedule: what runs once per slow period (slow_div ISRs,
@@ -723,36 +743,44 @@ static void drive_speed_row(drive_t *drv, bool due) {
  * the table every period (drive_schedule: DRIVE_SLOW_ROWS rows, bounded);
  * a row runs in the ISR whose phase in the slow period is its phase
  * (DRIVE_PHASE_START: the first ISR, the one after the slow period's last
- * rate sample; DRIVE_PHASE_NEXT: the second; DRIVE_PHASE_MID: slow_div / 2
- * ISRs after the first), and `due` tells it whether this slow period is
- * one of every `divider` (a row may need the other periods too: the
- * position check restarts when it does not apply, checked or not). The
- * rows of an ISR run in the table's order (phases that fall in one ISR,
- * slow_div < 3: MID, NEXT, START). The phases split the slow work so that
- * the worst-case ISR does not carry it all: the speed loop and its
- * run-away check, the current-sum check at the start (the loop's torque
- * reaches the law in the same ISR), the overrun check in the next ISR, the position check (one
- * sine, one model evaluation) half a slow period later (issue 24 point 8: the overrun check out of
- * the speed loop's ISR, the worst with FOC, and out of the position check's, the worst with DFVC on
- * an encoder). The current-sum check stays at the start: it samples one period a slow period, and
+ * rate sample; DRIVE_PHASE_NEXT: the second; DRIVE_PHASE_AFTER: the third;
+ * DRIVE_PHASE_MID: slow_div / 2 ISRs after the first), and `due` tells it
+ * whether this slow period is one of every `divider` (a row may need the
+ * other periods too: the position check restarts when it does not apply,
+ * checked or not). The rows of an ISR run in the table's order (phases
+ * that fall in one ISR, slow_div < 4: MID, AFTER, START, NEXT; the torque
+ * then reaches the law a loop later). The phases split the slow work so
+ * that no ISR carries two heavy items (issue 24 point 8): the current-sum
+ * check at the start (where the main loop's commands come in the SIL), the
+ * speed loop and its run-away check in the next ISR, the loop's torque to
+ * the law (the law's work on it) and the overrun check in the one after,
+ * the position check (one sine, one model evaluation) half a slow period
+ * later. The first three ISRs (`defer`: the current-sum check, where
+ * the main loop's commands come in too, the speed loop, the law's work on
+ * its torque) are the position source's busy periods (pos_input_t.busy):
+ * the RLS's halves wait for a free one (pos_rls.c). Before, the speed loop, the law's MTPA current
+ * on its torque and an RLS half met in one ISR: the sensorless worst case (board estimate 51 % of
+ * the budget). The current-sum check stays at the start: it samples one period a slow period, and
  * at another place in the slow period its trip in sil/test_adc_faults (a channel stuck at 0 at 0.2
  * N m) came at 25.5 ms, not 11 ms (the samples fall elsewhere on the currents' wave). A new slow
  * check is one row here and one part in protect/ (docs/architecture.md, "Adding a protection"). */
-enum { DRIVE_PHASE_START, DRIVE_PHASE_NEXT, DRIVE_PHASE_MID };
+enum { DRIVE_PHASE_START, DRIVE_PHASE_NEXT, DRIVE_PHASE_AFTER, DRIVE_PHASE_MID, DRIVE_PHASES };
 
 typedef struct {
   // cppcheck-suppress unusedStructMember
   const char *name; /* for docs and debuggers (a row's name in a backtrace) */
   uint8_t phase;    /* DRIVE_PHASE_* */
   uint8_t divider;  /* due every divider-th slow period (1: each) */
+  bool defer;       /* heavy: the position source puts off what can wait (pos_input_t.busy) */
   void (*run)(drive_t *drv, bool due);
 } drive_slow_row_t;
 
 static const drive_slow_row_t drive_slow_rows[] = {
-    {"pos_check", DRIVE_PHASE_MID, DRIVE_POS_CHECK_DIV, drive_pos_check_row},
-    {"overrun", DRIVE_PHASE_NEXT, 1u, drive_overrun_row},
-    {"current_sum", DRIVE_PHASE_START, 1u, drive_isum_row},
-    {"speed_loop", DRIVE_PHASE_START, 1u, drive_speed_row},
+    {"pos_check", DRIVE_PHASE_MID, DRIVE_POS_CHECK_DIV, false, drive_pos_check_row},
+    {"torque_ref", DRIVE_PHASE_AFTER, 1u, true, drive_torque_row},
+    {"overrun", DRIVE_PHASE_AFTER, 1u, false, drive_overrun_row},
+    {"current_sum", DRIVE_PHASE_START, 1u, true, drive_isum_row},
+    {"speed_loop", DRIVE_PHASE_NEXT, 1u, true, drive_speed_row},
 };
 #define DRIVE_SLOW_ROWS (sizeof drive_slow_rows / sizeof drive_slow_rows[0])
 
@@ -764,15 +792,21 @@ static void drive_schedule(drive_t *drv) {
    * division of the ISR count (issue 24 point 8) */
   if (drv->slow_wait > 1u) {
     drv->slow_wait--;
+    drv->pos.in.busy = false;
     return;
   }
   const uint32_t div = drv->cfg.slow_div;
   const uint32_t k = drv->isr_count - 1u;
   const uint32_t at = k % div;
-  const uint32_t off[3] = {0u, 1u % div, div / 2u}; /* START, NEXT, MID */
+  const uint32_t mid = div / 2u;
+  /* the phases' offsets, START, NEXT, AFTER, MID: 0, 1, 2, slow_div / 2,
+   * those beyond the slow period folded onto 0 (1 % div, 2 % div) */
+  const uint32_t off[DRIVE_PHASES] = {0u, div > 1u ? 1u : 0u, div > 2u ? 2u : 0u, mid};
   /* the ISRs to the next phase, from this ISR's place in the slow period
-   * (from any place: the count restarts here after a new slow_div) */
-  const uint32_t next = off[1] > at ? off[1] : (off[2] > at ? off[2] : div);
+   * (from any place: the count restarts here after a new slow_div): the
+   * next of 0, 1, 2, then MID, then the next slow period's START (a folded
+   * offset is one already passed) */
+  const uint32_t next = at < off[2] ? at + 1u : (at < mid ? mid : div);
   drv->slow_wait = next - at;
   const uint32_t slow_n = k / div;
   /* unrolled: the table is constant, so each row's phase and divider fold
@@ -781,9 +815,15 @@ static void drive_schedule(drive_t *drv) {
   for (unsigned r = 0; r < DRIVE_SLOW_ROWS; ++r) {
     const drive_slow_row_t *row = &drive_slow_rows[r];
     if (at == off[row->phase]) {
+      if (row->defer) { /* the source puts off what can wait (pos_input_t.busy) */
+        drv->pos.in.busy = true;
+      }
       row->run(drv, slow_n % row->divider == 0u);
     }
   }
+  /* cleared by the next ISR without a row (above): a phase without a
+   * deferring row right after one (MID after AFTER, slow_div 6 or 7) stays
+   * busy, which only puts an RLS half off by one more period */
 }
 
 static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
@@ -848,9 +888,10 @@ static proc_setup_t drive_proc_setup(drive_t *drv) {
  * the pattern in the middle of the duty range, then the gates. */
 FD_COLD FD_NOINLINE static void drive_gates_start(drive_t *drv) {
   ctrl_reset(&drv->ctrl);
-  drv->pos.in = (pos_input_t){0.0f, 0.0f}; /* no torque before the run */
+  drv->pos.in = (pos_input_t){0.0f, 0.0f, false}; /* no torque before the run */
   drv->speed_active = false;
   drv->speed_torque = 0.0f;
+  drv->speed_torque_new = 0.0f;
   protect_lc_reset(&drv->lc);
   protect_ra_reset(&drv->ra);
   drv->tm.lc_cause = 0u;

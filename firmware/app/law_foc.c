@@ -32,9 +32,14 @@ FD_COLD static int foc_init(ctrl_state_t *s, const ctrl_setup_t *su) {
   return 0;
 }
 
+/* The MTPA cache primed with the answer for no torque, the least current
+ * (none) on every machine: the run's first period starts from zero torque
+ * (the speed loop's), and solving it there met the speed loop's first
+ * period in one ISR (issue 24 point 8: the sensorless worst case). */
 static void foc_reset(ctrl_state_t *s) {
   current_ctrl_reset(&s->foc.cc);
-  s->foc.mtpa_t = NAN;
+  s->foc.mtpa_t = 0.0f;
+  s->foc.mtpa_i = (dq_t){0.0f, 0.0f};
 }
 
 /* machine_mtpa_current(m, t), computed again only when t changes. */

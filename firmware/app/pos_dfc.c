@@ -189,7 +189,7 @@ void pos_star_update(pos_state_t *s, const drive_config_t *cfg, const hal_sample
     dfc_signals_vector(&m->sig, 2.0f * pos_track_omega(s), &v);
     if (warm) {
       w = frames_sincos(2.0f * pos_track_theta(s));
-      id->step(s, cfg, &v, &w, out);
+      id->step(s, cfg, &v, &w, in->busy, out);
       c2 = w.c;
       s2 = w.s;
       m->trace[0] = c2; /* the start, for logs */

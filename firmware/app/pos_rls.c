@@ -41,6 +41,7 @@ FD_COLD static void rls_init(pos_state_t *s, const drive_config_t *cfg) {
   s->star.id.avg[1] = 0.0f;
   s->star.id.warm2 = 1.0f;
   s->star.id.health_due = false;
+  s->star.id.upd_due = false;
   rls_guarded(&s->star.id.rls, cfg, &s->star.meas.dc); /* the RLS's start, guarded */
 }
 
@@ -59,22 +60,34 @@ static void warm_gain(pos_state_t *s) {
   s->star.id.warm2 = c * c;
 }
 
-/* The RLS of a, b (4.51)-(4.57) on this vector at the filter's predicted
- * angle u (the IVD's a, b from it in the next period: rls_step). One
- * update per refresh of the whole vector (when component a is the newest:
- * every third period, 5.3 kHz, the thesis's DFC rate): successive updates
- * then share no sample, as the RLS's independent noise assumes. */
-static bool rls_update(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v,
-                       const sincos_t *u) {
-  rls_ab_t *r = &s->star.id.rls;
-  bool upd = false;
+/* Whether this period refreshes the RLS: one update per refresh of the
+ * whole vector (when component a is the newest: every third period, 5.3
+ * kHz, the thesis's DFC rate), so that successive updates share no sample,
+ * as the RLS's independent noise assumes; aligned and above rls_w_min. */
+static bool rls_refresh(const pos_state_t *s, const drive_config_t *cfg) {
+  bool due = false;
   if (s->star.meas.miss == 0u && s->star.meas.sig.last == 0u && s->star.pol.aligned &&
       /* mut: rls_never_updates */
       fabsf(pos_track_omega(s)) > cfg->rls_w_min) {
-    r->cfg = rls_cfg_of(cfg); /* the live tuning, for this update and rls_health */
-    upd = rls_ab_update(r, v->al, v->be, u->c, u->s, v->k);
+    due = true;
   }
-  return upd;
+  return due;
+}
+
+/* The RLS of a, b (4.51)-(4.57) on a refresh's vector (al, be; km its
+ * map of the 4theta term) at the filter's predicted angle (c, s: e^{j 2
+ * theta}); the IVD's a, b from it in a later period (rls_step). */
+static void rls_update(pos_state_t *s, const drive_config_t *cfg, float al, float be, float c,
+                       float sn, const float *km) {
+  pos_ident_state_t *id = &s->star.id;
+  id->upd_due = false;
+  id->rls.cfg = rls_cfg_of(cfg); /* the live tuning, for this update and rls_health */
+  id->health_due = rls_ab_update(&id->rls, al, be, c, sn, km);
+}
+
+static void rls_update_held(pos_state_t *s, const drive_config_t *cfg) {
+  const pos_ident_state_t *id = &s->star.id;
+  rls_update(s, cfg, id->held.al, id->held.be, id->held.c, id->held.s, id->held.k);
 }
 
 /* The RLS's health (rls_ok), after each update: its a and b have settled
@@ -109,24 +122,63 @@ static bool rls_health(pos_state_t *s, const drive_config_t *cfg) {
   return ok && am > 0.25f * a0 && am < 4.0f * a0 && fabsf(r->x[1]) < POS_DFC_P_MAX * am;
 }
 
-/* One period: the last period's update into the IVD's a, b (within the
- * guards; they move only here, pos_star_update keeps them), the warm
- * gain and the health (rls_ok), then this period's update. The update's
- * period (every third) carries the update alone, the next one the rest:
- * the ISR's worst case is where one of them meets the slow-rate rows (the
- * speed loop and the torque reference's MTPA current), and the two halves
- * are about equal (about 150 instructions each). They come before any
- * further update, on that update's a, b and covariance: the IVD takes the
- * new a, b and rls_ok is set a period (62.5 us) after the update. */
+/* The last update's a, b into the IVD (within the guards; they move only
+ * here, pos_star_update keeps them), the warm gain and the health
+ * (rls_ok), on that update's a, b and covariance. */
+static void rls_settle(pos_state_t *s, const drive_config_t *cfg, pos_estimate_t *out) {
+  s->star.id.health_due = false;
+  rls_guarded(&s->star.id.rls, cfg, &s->star.meas.dc);
+  warm_gain(s);
+  out->rls_ok = rls_health(s, cfg);
+}
+
+/* One period. A refresh's work comes in two halves of about 150
+ * instructions each, the update (rls_update) and its settling
+ * (rls_settle), each in a period of its own, in order, and not in a
+ * period that carries the drive's heavier slow-rate work (busy: the slow
+ * period's first three ISRs, the current-sum check and the main loop's
+ * commands, the speed loop, the law's work on the loop's new torque;
+ * drive.c, drive_schedule): one half per free period, the older first
+ * (issue 24 point 8: the ISR's worst case was where an RLS half met the
+ * speed loop and the law's MTPA current). Unbusy, a refresh is updated in
+ * its own period and settled in the next, the IVD taking the new a, b a
+ * period (62.5 us) after the update; after the busy periods the halves
+ * catch up within a few periods (two per three periods, one a period).
+ * The regressor of a refresh that cannot be updated at once is held
+ * (pos_ident_state_t.held); should the next refresh come before its update
+ * ran (slow_div < 9: fewer free periods than halves), that update, and the settling
+ * before it, run first, busy or not: every update runs, on its own
+ * regressor, in order, at most two halves a period. */
 static void rls_step(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v,
-                     const sincos_t *u, pos_estimate_t *out) {
-  if (s->star.id.health_due) {
-    s->star.id.health_due = false;
-    rls_guarded(&s->star.id.rls, cfg, &s->star.meas.dc);
-    warm_gain(s);
-    out->rls_ok = rls_health(s, cfg);
+                     const sincos_t *u, bool busy, pos_estimate_t *out) {
+  pos_ident_state_t *id = &s->star.id;
+  bool refresh = rls_refresh(s, cfg);
+  if (!busy) { /* one half, the older first */
+    if (id->health_due) {
+      rls_settle(s, cfg, out);
+    } else if (id->upd_due) {
+      rls_update_held(s, cfg);
+    } else if (refresh) {
+      rls_update(s, cfg, v->al, v->be, u->c, u->s, v->k);
+      refresh = false;
+    }
   }
-  s->star.id.health_due = rls_update(s, cfg, v, u);
+  if (refresh) {
+    if (id->upd_due) { /* the held regressor has found no free period */
+      if (id->health_due) {
+        rls_settle(s, cfg, out);
+      }
+      rls_update_held(s, cfg);
+    }
+    id->held.al = v->al; /* this one's, until its update */
+    id->held.be = v->be;
+    id->held.c = u->c;
+    id->held.s = u->s;
+    for (unsigned j = 0u; j < 4u; ++j) {
+      id->held.k[j] = v->k[j];
+    }
+    id->upd_due = true;
+  }
 }
 
 /* the warm start's gain at the a, b in force (pos_star_align: once per start) */

@@ -46,6 +46,8 @@ typedef struct {
 typedef struct {
   float i_q;    /* rotor-frame q current [A] (the Full IVD's phase shifts) */
   float torque; /* electromagnetic torque estimate [N m] (the Kalman filter's input) */
+  bool busy;    /* the drive's slow-rate rows run in this ISR (drive_schedule): a source
+                   puts off what can wait a period (pos_rls.c) */
 } pos_input_t;
 
 /* A source's input and estimate, one argument (the update's fourth: all
@@ -96,7 +98,11 @@ typedef struct {
   rls_ab_t rls;
   float avg[2];    /* a, b low-passed over the RLS's updates (pos_rls.c, rls_health) */
   float warm2;     /* ((2|p|)^n)^2 of the warm-started IVD at the RLS's a, b (pos_rls.c) */
-  bool health_due; /* an update's a, b, warm gain and health go in in the next period (pos_rls.c) */
+  bool health_due; /* an update's a, b, warm gain and health wait for their period (pos_rls.c) */
+  bool upd_due;    /* a refresh's update waits for a period without slow-rate rows (pos_rls.c) */
+  struct {         /* its regressor, as the refresh's period had it (dfc_vec_t, sincos_t) */
+    float al, be, c, s, k[4];
+  } held;
 } pos_ident_state_t;
 
 typedef struct {

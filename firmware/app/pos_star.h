@@ -69,9 +69,10 @@ struct pos_ident_s {
   /* the identification's a, b into s->star.meas.dc, and its state */
   void (*init)(pos_state_t *s, const drive_config_t *cfg);
   /* one period on the vector v at the prediction w (e^{j 2 theta}); when
-   * a, b moved, whether they have settled into out->rls_ok */
+   * a, b moved, whether they have settled into out->rls_ok; busy: the
+   * drive's slow-rate rows run in this period (pos_input_t.busy) */
   void (*step)(pos_state_t *s, const drive_config_t *cfg, const dfc_vec_t *v, const sincos_t *w,
-               pos_estimate_t *out);
+               bool busy, pos_estimate_t *out);
   /* the alignment has ended (the warm start's gain) */
   void (*aligned)(pos_state_t *s);
   const char *(*check)(const drive_config_t *cfg, const char **field);

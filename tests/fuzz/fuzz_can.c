@@ -201,7 +201,9 @@ static void check_isr(void) {
   }
   if (d->state != DRIVE_STATE_RUN) {
     st.speed_loop_prev = false;
-  } else if ((d->isr_count - 1u) % c->slow_div == 0u) { /* the speed loop's period */
+  } else if ((d->isr_count - 1u) % c->slow_div == (c->slow_div > 1u ? 1u : 0u)) {
+    /* the speed loop's ISR: the slow period's second (drive.c's schedule,
+     * DRIVE_PHASE_NEXT; the first at slow_div 1), one loop step apart */
     const float w_prev = fabsf(st.speed_ref_prev);
     /* the ramp's step, where float resolves it at this speed */
     const float step = c->accel_max * c->ts * (float)c->slow_div;

@@ -269,6 +269,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--check-cycles", type=_percent, metavar="PCT",
                    help="fail when the DB-DFVC worst case's estimated cycles exceed PCT %% of "
                    "the 10625-cycle budget (170 MHz / 16 kHz)")
+    p.add_argument("--check-board", type=_percent, metavar="PCT",
+                   help="fail when a run's board worst case (estimated cycles, the core's "
+                   "trigonometry on the CORDIC co-processor) exceeds PCT %% of its budget "
+                   "(needs --board-elf)")
     p.add_argument("--board-elf", metavar="PATH", help="board image (e.g. build/stm32g474/boards/"
                    "stm32g4/fluxdrive-g474.elf): add the ISR wrapper, exception and board HAL "
                    "(fluxdrive cycles-board) to a board estimate")

@@ -426,6 +426,9 @@ class Counts:
     calls: dict[str, tuple[float, float]] = field(default_factory=dict)
     #: the image's replay-HAL functions the board replaces (cm4_cycles.stand_ins)
     stand_ins: frozenset = frozenset(cm4_cycles.BOARD_HAL)
+    #: per law ISR: (cycles, cycles in the software trigonometry the board binds to
+    #: its CORDIC (cm4_cycles.BOARD_TRIG, leaves), {function: calls} of it)
+    trig_isr: list = field(default_factory=list)
 
     @property
     def cpi(self) -> float:
@@ -467,6 +470,11 @@ def law_counts(tr: TraceResult, host: np.ndarray,
         out.cycles_mean, out.cycles_worst, out.cycles_worst_isr = float(y.mean()), int(y[wy]), \
             run[wy]
         out.block_cycles, out.func_cycles = _mean_by(run, tr.func_cycles)
+        if len(tr.calls) >= n:
+            out.trig_isr = [
+                (tr.cycles[j], sum(tr.func_cycles[j].get(f, 0) for f in cm4_cycles.BOARD_TRIG),
+                 {f: tr.calls[j][f][0] for f in cm4_cycles.BOARD_TRIG if f in tr.calls[j]})
+                for j in run]
     if len(tr.calls) >= n:
         tot: dict[str, list[int]] = {}
         for j in run:
@@ -604,6 +612,22 @@ def board_estimate(c: Counts, board: cm4_cycles.BoardBound) -> tuple[float, floa
             c.cycles_worst + base + w.hal_cycles + w.wrapper_cycles)
 
 
+def board_estimate_cordic(c: Counts, board: cm4_cycles.BoardBound) -> tuple[float, float] | None:
+    """board_estimate with, besides the HAL, the core's software trigonometry
+    replaced by the board's CORDIC bindings (cordic_bind.c; cycles per call
+    from `fluxdrive cycles-board`), ISR by ISR: (typical: the mean, worst:
+    the largest). None without the per-ISR calls."""
+    if not c.trig_isr:
+        return None
+    hw = {p.name: p.cycles for p in board.trig}
+    y = [cy - sw + sum(k * hw.get(f, 0) for f, k in calls.items())
+         for cy, sw, calls in c.trig_isr]
+    base = -c.stand_in_cycles()
+    t, w = board.typical, board.worst
+    return (sum(y) / len(y) + base + t.hal_cycles + t.wrapper_cycles,
+            max(y) + base + w.hal_cycles + w.wrapper_cycles)
+
+
 def trig_on_cordic(c: Counts, board: cm4_cycles.BoardBound) -> float | None:
     """Instructions per ISR with the core's software trigonometry
     (fd_sincosf, fd_atan2f, the Q31 CORDIC: what cordic_bind.c binds to the
@@ -656,6 +680,13 @@ def format_report(runs: list[PilRun], isrs: int, cpi: float | None = None,
                 f"wrapper and exception, `fluxdrive cycles-board`): typical {bt:.0f} "
                 f"({_pct(bt, bud)}), worst {bw:.0f} ({_pct(bw, bud)})"
             )
+            bc = board_estimate_cordic(c, board)
+            if bc is not None:
+                lines.append(
+                    f"board estimate with the core's trigonometry on the board's CORDIC "
+                    f"co-processor (cordic_bind.c, per call, ISR by ISR): typical {bc[0]:.0f} "
+                    f"({_pct(bc[0], bud)}), worst {bc[1]:.0f} ({_pct(bc[1], bud)})"
+                )
             tc = trig_on_cordic(c, board)
             if tc is not None:
                 lines.append(
@@ -725,15 +756,21 @@ def format_markdown(runs: list[PilRun], isrs: int, cpi: float | None, build: str
             f"period) / {w.wrapper_cycles} worst (a third, spurious entry, overrun "
             f"bookkeeping, ART misses); board HAL called by "
             f"`drive_isr` {t.hal_cycles} / {w.hal_cycles} (replaces the PIL's replay HAL). "
-            f"Board estimate = PIL cycles - replay HAL + board HAL + wrapper:"
+            f"Board estimate = PIL cycles - replay HAL + board HAL + wrapper; with the "
+            f"CORDIC: also the core's software trigonometry replaced by the board's "
+            f"co-processor bindings, ISR by ISR:"
         )
         out.append("")
-        out.append("| scenario | law | board typical (PIL mean) | board worst (PIL worst) |")
-        out.append("|---|---|---:|---:|")
+        out.append("| scenario | law | board typical (PIL mean) | board worst (PIL worst) | "
+                   "with the CORDIC: typical | worst |")
+        out.append("|---|---|---:|---:|---:|---:|")
         for r in runs:
             bt, bw = board_estimate(r.counts, board)
+            bc = board_estimate_cordic(r.counts, board)
+            cc = (f"{bc[0]:.0f} ({_pct(bc[0], r.budget)}) | {bc[1]:.0f} "
+                  f"({_pct(bc[1], r.budget)})" if bc is not None else "- | -")
             out.append(f"| {r.scenario} | {r.law} | {bt:.0f} ({_pct(bt, r.budget)}) | "
-                       f"{bw:.0f} ({_pct(bw, r.budget)}) |")
+                       f"{bw:.0f} ({_pct(bw, r.budget)}) | {cc} |")
         out.append("")
     out.append("Share of the mean per block (instructions per ISR, % of the mean; estimated "
                "cycles per ISR):")
@@ -828,6 +865,16 @@ def main(args) -> int:
     rc = check_runs(runs, args.check_worst, getattr(args, "check_cycles", None),
                     getattr(args, "check_mean", None), getattr(args, "check_call", None),
                     getattr(args, "check_worst_all", None))
+    lim = getattr(args, "check_board", None)
+    if lim:
+        for r in runs:
+            bc = board_estimate_cordic(r.counts, board) if board is not None else None
+            ok = bc is not None and bc[1] <= lim / 100.0 * r.budget
+            got = "not measured (needs --board-elf)" if bc is None else \
+                f"{bc[1]:.0f} estimated cycles = {100 * bc[1] / r.budget:.1f} % of {r.budget}"
+            print(f"{'check' if ok else 'FAIL'}: {r.scenario}/{r.law}: board worst case with the "
+                  f"trigonometry on the CORDIC co-processor {got}, limit {lim:g} %")
+            rc |= 0 if ok else 1
     lim = getattr(args, "check_mean_cordic", None)
     if lim:
         for r in runs:

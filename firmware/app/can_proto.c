@@ -190,8 +190,9 @@ static float value_in_force(const drive_t *drv, can_msg_t m) {
   case CAN_MSG_CMD_FLUX:
     return c->flux;
   case CAN_MSG_CMD_PROC: /* the identification last asked for (255: a stop, or none) */
-    return c->ident_count != 0u && c->ident < (uint32_t)PROC_COUNT ? (float)c->ident
-                                                                   : (float)CAN_PROC_NONE;
+    return drv->req.ident.count != 0u && drv->req.ident.proc < (uint32_t)PROC_COUNT
+               ? (float)drv->req.ident.proc
+               : (float)CAN_PROC_NONE; /* the main loop's own block */
   default:
     return 0.0f;
   }

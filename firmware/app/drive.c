@@ -448,13 +448,6 @@ static void take_commands(drive_t *drv) {
     drv->fault_total_seen = drv->cmd.fault_total;
     take_fault_requests(drv);
   }
-  /* an identification request: acted on in idle (a start) or during an
-   * identification run (a stop); anywhere else it is void (the main loop
-   * refused it with the drive enabled) */
-  if (drv->cmd.ident_count != drv->ident_seen) {
-    drv->ident_seen = drv->cmd.ident_count;
-    drv->ident_new = drv->state == DRIVE_STATE_IDLE || drv->ident;
-  }
 }
 
 /* ---------------------------------------------------------- protections */
@@ -905,6 +898,16 @@ FD_COLD FD_NOINLINE static void drive_gates_start(drive_t *drv) {
 
 static void drive_proc_next(drive_t *drv, uint32_t k);
 
+/* An identification request not yet taken (drive_ident_req_t): read only
+ * when the main loop is not writing the block (seq even; it cannot write
+ * while the ISR runs), so the procedure and its count agree. Idle and the
+ * identification's states only. */
+static bool ident_pending(const drive_t *drv) {
+  const uint32_t seq = drv->req.seq;
+  DRIVE_BARRIER();
+  return (seq & 1u) == 0u && drv->req.ident.count != drv->ident_seen;
+}
+
 /* An identification run ends (done, stopped, aborted): the gates off if
  * they were on, idle. */
 FD_COLD FD_NOINLINE static void drive_ident_end(drive_t *drv) {
@@ -913,7 +916,7 @@ FD_COLD FD_NOINLINE static void drive_ident_end(drive_t *drv) {
     protect_safe_leave_gates(&drv->safe);
   }
   drv->ident = false;
-  drv->ident_new = false;
+  drv->ident_seen = drv->req.ident.count; /* the request that ended it is taken */
   drv->plain = false;
   drv->state = DRIVE_STATE_IDLE;
 }
@@ -922,8 +925,8 @@ FD_COLD FD_NOINLINE static void drive_ident_end(drive_t *drv) {
  * of the offsets and the procedure, or its refusal (PROC_ST_REFUSED: the
  * parameter set in force cannot run it; a stop request: nothing). */
 FD_COLD FD_NOINLINE static void drive_ident_start(drive_t *drv) {
-  drv->ident_new = false;
-  const proc_id_t id = (proc_id_t)drv->cmd.ident;
+  drv->ident_seen = drv->req.ident.count;
+  const proc_id_t id = (proc_id_t)drv->req.ident.proc; /* read with its count (ident_pending) */
   if (id >= PROC_NONE) {
     return;
   }
@@ -1126,21 +1129,25 @@ void drive_isr(drive_t *drv) {
     if (drv->cmd.law != drv->ctrl.law && drv->cmd.law != drv->law_refused && !drv->cfg_pending) {
       drive_select_law(drv);
     }
+    /* an identification request is taken here (a start) or during its run
+     * (a stop); an enable voids it, so does a fault (below): a request never
+     * waits for a later idle */
     if (enable && !drv->safe.asc) { /* the short first ends (protect/drive_safe.c) */
+      drv->ident_seen = drv->req.ident.count;
       drv->pos_src->reset(&drv->pos_st);
       drive_proc_next(drv, 0u); /* the start's first procedure: the offsets */
-    } else if (drv->ident_new) {
-      drv->ident_new = false;
+    } else if (ident_pending(drv)) {
       if (!enable && !drv->safe.asc) {
         drive_ident_start(drv);
       }
+      drv->ident_seen = drv->req.ident.count;
     }
     break;
   case DRIVE_STATE_OFFSET_CAL:
   case DRIVE_STATE_IDENT:
     /* the start's offsets stop on a disable; an identification's run on an
      * enable or another request (a stop) */
-    if (drv->ident ? (enable || drv->ident_new) : !enable) {
+    if (drv->ident ? (enable || ident_pending(drv)) : !enable) {
       drive_proc_abort(drv);
       if (drv->ident) {
         drive_ident_end(drv);
@@ -1171,8 +1178,8 @@ void drive_isr(drive_t *drv) {
     if (drv->proc != NULL) { /* tripped by another cause during a procedure */
       drive_proc_abort(drv);
     }
-    drv->ident = false; /* an identification ends with the fault */
-    drv->ident_new = false;
+    drv->ident = false; /* an identification ends with the fault, its requests void */
+    drv->ident_seen = drv->req.ident.count;
     break; /* all off or shorted: drive_safe */
   }
   if (!gates_on_state(drv->state)) {

@@ -110,9 +110,16 @@ typedef struct {
   uint32_t clear_enable_mark;              /* enable_count at the last clear */
   uint32_t fault_count[DRIVE_FAULT_COUNT]; /* drive_request_fault() per bit */
   uint32_t fault_total;                    /* drive_request_fault() calls, all bits */
-  uint32_t ident;       /* the identification asked for (proc_id_t; PROC_NONE: stop it) */
-  uint32_t ident_count; /* drive_cmd_identify() calls */
 } drive_cmd_t;
+
+/* The main loop's identification request (drive_t.req.ident, beside the
+ * command block and under its sequence lock, but not copied with it: the
+ * ISR reads it only in idle and during an identification, when seq is
+ * even, so the run's command copy stays as short as it was). */
+typedef struct {
+  uint32_t proc;  /* the identification asked for (proc_id_t; PROC_NONE: stop it) */
+  uint32_t count; /* drive_cmd_identify() calls */
+} drive_ident_req_t;
 
 typedef struct drive_s {
   /* ===== owned by the ISR ===== */
@@ -192,6 +199,7 @@ typedef struct drive_s {
   struct {
     volatile uint32_t seq; /* odd while being written */
     drive_cmd_t cmd;
+    drive_ident_req_t ident;
   } req;
   struct {
     volatile uint32_t seq;
@@ -213,9 +221,8 @@ typedef struct drive_s {
   drive_law_t law_refused;   /* a law whose switch the ISR refused (DRIVE_LAW_COUNT: none) */
   uint32_t fault_total_seen; /* req.fault_total taken */
   uint32_t fault_seen[DRIVE_FAULT_COUNT];
-  uint32_t ident_seen;    /* cmd.ident_count taken */
-  bool ident_new;         /* an identification request taken, not yet acted on (idle or
-                             identifying: drive.c, "the identification") */
+  uint32_t ident_seen;    /* req.ident.count taken (in idle, during an identification, on
+                             an enable or in a fault: drive.c) */
   bool ident;             /* the procedures in force are an identification run's */
   proc_id_t ident_seq[2]; /* that run: the offsets, then the procedure (proc_ident_sequence) */
   uint32_t ident_n;       /* its length */

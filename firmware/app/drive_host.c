@@ -206,9 +206,9 @@ const char *drive_cmd_identify(drive_t *drv, proc_id_t id, const char **field) {
   *f = NULL;
   /* whether the parameter set in force can run it is the ISR's to say
    * (PROC_ST_REFUSED): the set and the machine are its */
-  drive_cmd_t *c = cmd_begin(drv);
-  c->ident = (uint32_t)id;
-  c->ident_count++;
+  (void)cmd_begin(drv);
+  drv->req.ident.proc = (uint32_t)id;
+  drv->req.ident.count++;
   cmd_end(drv);
   return NULL;
 }

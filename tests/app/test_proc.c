@@ -466,12 +466,16 @@ static void identification_runs_alone_and_stops(void **state) {
   drive_cmd_enable(&drv, false);
   drive_isr(&drv);
   assert_int_equal(drv.state, DRIVE_STATE_IDLE);
-  drv.cmd.ident = PROC_OFFSET; /* as if posted while enabled (the main loop refuses it) */
+  drv.req.ident.proc = PROC_OFFSET; /* as if posted while enabled (the main loop refuses it) */
   drv.state = DRIVE_STATE_RUN;
-  drv.req.cmd.ident_count++;
+  drv.req.ident.count++;
   drv.req.seq += 2u;
   drive_isr(&drv);
-  assert_false(drv.ident_new);
+  drv.state = DRIVE_STATE_IDLE;
+  drive_cmd_enable(&drv, true); /* then an enable: it voids the request */
+  drive_isr(&drv);
+  assert_false(drv.ident);
+  assert_int_equal(drv.ident_seen, drv.req.ident.count);
 }
 
 int main(void) {

@@ -210,7 +210,7 @@ static void test_params(void **state) {
   push_param(0, 31, 0.0f);   /* get speed_bw */
   push_param(1, 31, 40.0f);  /* set speed_bw */
   push_param(1, 10, 50.0f);  /* i_max 50 A > i_trip: inconsistent */
-  push_param(1, 200, 1.0f);  /* unknown */
+  push_param(1, 250, 1.0f);  /* unknown */
   push_param(1, 40, 1e-4f);  /* ts: read only */
   push_param(1, 2, -1.0f);   /* rs < 0: out of range */
   push_param(1, 65, 250.0f); /* can_timeout_ms */

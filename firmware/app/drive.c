@@ -23,9 +23,9 @@
 #include "math/fd_math.h"
 #include "math/frames.h"
 
-static bool gates_on_state(drive_state_t s) {
-  /* one test of a mask, however many states (every period) */
-  return ((1u << (unsigned)s) & DRIVE_GATES_ON_STATES) != 0u;
+__attribute__((always_inline)) static inline bool gates_on_state(drive_state_t s) {
+  /* the run, and the states from the alignment on (drive.h: the last two) */
+  return s == DRIVE_STATE_RUN || s >= DRIVE_STATE_ALIGN;
 }
 
 /* The mode in force (drive_t.mode): current mode only with a law that has

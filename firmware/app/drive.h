@@ -306,13 +306,22 @@ void drive_machine_copy(machine_t *dm, flux_map_t *dmap, const machine_t *m, con
   ((1u << DRIVE_STATE_RUN) | (1u << DRIVE_STATE_ALIGN) | (1u << DRIVE_STATE_IDENT))
 #define DRIVE_ENABLED_STATES (DRIVE_GATES_ON_STATES | (1u << DRIVE_STATE_OFFSET_CAL))
 _Static_assert(DRIVE_STATE_COUNT <= 32, "drive states: a mask of 1 << state");
+/* what drive_state_enabled() and drive.c's gates_on_state() test, in their
+ * cheapest form (every period): */
+#define DRIVE_ALL_STATES ((1u << DRIVE_STATE_COUNT) - 1u)
+_Static_assert(DRIVE_ENABLED_STATES ==
+                   (DRIVE_ALL_STATES & ~((1u << DRIVE_STATE_IDLE) | (1u << DRIVE_STATE_FAULT))),
+               "drive states: enabled = all but idle and fault");
+_Static_assert(DRIVE_GATES_ON_STATES == ((1u << DRIVE_STATE_RUN) |
+                                         (DRIVE_ALL_STATES & ~((1u << DRIVE_STATE_ALIGN) - 1u))),
+               "drive states: gates on = the run and the states from the alignment on");
 
 /* States in which the drive is enabled: offset calibration, alignment, run,
  * identification
  * (non-LIVE parameters are refused then). Inline: the ISR asks every
  * period. */
 static inline bool drive_state_enabled(drive_state_t s) {
-  return ((1u << (unsigned)s) & DRIVE_ENABLED_STATES) != 0u; /* one test, every period */
+  return s != DRIVE_STATE_IDLE && s != DRIVE_STATE_FAULT; /* two tests, every period */
 }
 
 /* The enable in force as the main loop sees it (STATUS.cmd_enabled): an

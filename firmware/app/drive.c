@@ -318,10 +318,8 @@ FD_COLD static bool configure_live(drive_t *drv, const drive_config_t *cfg) {
   drv->speed.cfg.torque_max = fabsf(scfg.torque_max);
   drv->speed.pi.kp = scfg.kp;
   drv->speed.pi.ki = scfg.ki;
-  /* the loop's torque on its way to the law (drive_torque_row), and the
-   * one the law has, within a lowered torque_max at once */
+  /* the torque the law has, within a lowered torque_max at once */
   const float tm = drv->speed.cfg.torque_max;
-  drv->speed_torque_new = fd_clampf(drv->speed_torque_new, -tm, tm);
   drv->speed_torque = fd_clampf(drv->speed_torque, -tm, tm);
   return rest;
 }
@@ -698,10 +696,9 @@ static void drive_speed_row(drive_t *drv, bool due) {
     }
     /* the limit in force re-clamps the reference (a live speed_max write) */
     const float w_ref = fd_clampf(drv->cmd.speed, -c->speed_max, c->speed_max);
-    /* to the law in the next ISR (drive_torque_row) */
-    drv->speed_torque_new =
+    drv->speed_torque =
         speed_ctrl_update(&drv->speed, w_ref, w, drv->torque_min_avail, drv->torque_max_avail);
-    const protect_ra_view_t v = {w, drv->speed.w_ref_ramped, drv->speed_torque_new};
+    const protect_ra_view_t v = {w, drv->speed.w_ref_ramped, drv->speed_torque};
     const uint32_t ra = protect_ra_step(&drv->ra, &v);
     if (ra != 0u) {
       drv->tm.lc_cause = ra;
@@ -711,24 +708,8 @@ static void drive_speed_row(drive_t *drv, bool due) {
     speed_ctrl_reset(&drv->speed, drv->omega_m, 0.0f);
     drv->speed_active = false;
     drv->speed_torque = 0.0f;
-    drv->speed_torque_new = 0.0f;
   }
   drv->tm.speed_ref = drv->speed_active ? drv->speed.w_ref_ramped : 0.0f;
-}
-
-/* The speed loop's torque to the law, in the ISR after the loop's: the
- * law's work on a new torque reference (FOC: the MTPA current,
- * machine_mtpa_current, about 330 cycles on a salient machine) and the
- * speed loop's (about 320) fall in two ISRs, not one (the worst case of the
- * ISR, issue 24 point 8). The loop's output reaches the machine a period
- * (62.5 us) later, within a speed-loop period of 1 ms (at a speed bandwidth
- * of 30 rad/s, 0.1 degrees of phase). A live torque_max write between the
- * two re-clamps the torque on its way (configure_live: the law never sees
- * a torque beyond the limit in force, fuzz_can corpus
- * live_torque_max_below_speed_torque). */
-static void drive_torque_row(drive_t *drv, bool due) {
-  (void)due;
-  drv->speed_torque = drv->speed_torque_new;
 }
 
 /* The slow-rate schedule: what runs once per slow period (slow_div ISRs,
@@ -741,16 +722,17 @@ static void drive_torque_row(drive_t *drv, bool due) {
  * whether this slow period is one of every `divider` (a row may need the
  * other periods too: the position check restarts when it does not apply,
  * checked or not). The rows of an ISR run in the table's order (phases
- * that fall in one ISR, slow_div < 4: MID, AFTER, START, NEXT; the torque
- * then reaches the law a loop later). The phases split the slow work so
+ * that fall in one ISR, slow_div < 4: MID, AFTER, START, NEXT). The phases split the slow work so
  * that no ISR carries two heavy items (issue 24 point 8): the current-sum
  * check at the start (where the main loop's commands come in the SIL), the
- * speed loop and its run-away check in the next ISR, the loop's torque to
- * the law (the law's work on it) and the overrun check in the one after,
+ * speed loop and its run-away check in the next ISR (its torque to the law
+ * in that ISR: handed a period later it met the sensorless worst case's
+ * target, 45 %, but lost a sensorless start, test_random_machines star seed
+ * 1 dfc+kf from 0.99 rad), the overrun check in the one after,
  * the position check (one sine, one model evaluation) half a slow period
- * later. The first three ISRs (`defer`: the current-sum check, where
- * the main loop's commands come in too, the speed loop, the law's work on
- * its torque) are the position source's busy periods (pos_input_t.busy):
+ * later. The first two ISRs (`defer`: the current-sum check, where
+ * the main loop's commands come in too, the speed loop and the law's work
+ * on its torque) are the position source's busy periods (pos_input_t.busy):
  * the RLS's halves wait for a free one (pos_rls.c). Before, the speed loop, the law's MTPA current
  * on its torque and an RLS half met in one ISR: the sensorless worst case (board estimate 51 % of
  * the budget). The current-sum check stays at the start: it samples one period a slow period, and
@@ -770,7 +752,6 @@ typedef struct {
 
 static const drive_slow_row_t drive_slow_rows[] = {
     {"pos_check", DRIVE_PHASE_MID, DRIVE_POS_CHECK_DIV, false, drive_pos_check_row},
-    {"torque_ref", DRIVE_PHASE_AFTER, 1u, true, drive_torque_row},
     {"overrun", DRIVE_PHASE_AFTER, 1u, false, drive_overrun_row},
     {"current_sum", DRIVE_PHASE_START, 1u, true, drive_isum_row},
     {"speed_loop", DRIVE_PHASE_NEXT, 1u, true, drive_speed_row},
@@ -884,7 +865,6 @@ FD_COLD FD_NOINLINE static void drive_gates_start(drive_t *drv) {
   drv->pos.in = (pos_input_t){0.0f, 0.0f, false}; /* no torque before the run */
   drv->speed_active = false;
   drv->speed_torque = 0.0f;
-  drv->speed_torque_new = 0.0f;
   protect_lc_reset(&drv->lc);
   protect_ra_reset(&drv->ra);
   drv->tm.lc_cause = 0u;

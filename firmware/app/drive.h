@@ -158,8 +158,7 @@ typedef struct drive_s {
   ab_t v_applied;     /* voltage applied over the period ending at this sample */
   speed_ctrl_t speed; /* run every slow_div ISRs */
   bool speed_active;
-  float speed_torque;     /* torque reference from the speed loop, to the law [N m] */
-  float speed_torque_new; /* ... as the loop left it: to the law in the next ISR (row torque_ref) */
+  float speed_torque; /* torque reference from the speed loop, to the law [N m] */
   float torque_min_avail, torque_max_avail; /* what the law can deliver now */
   /* the law's flux of the last period it ran without a fault (the safe
    * state's trapped-flux input; tm.law_tm also holds a faulted period's) */

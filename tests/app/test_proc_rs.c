@@ -33,43 +33,7 @@ typedef struct {
 
 static fixture_t fx;
 
-/* The model: R, L, the voltage error's plateau V0 and knee per phase. */
-typedef struct {
-  float r, l, v0, knee, noise, lsb;
-  float i_a, i_b; /* alpha, beta current [A] */
-  uint32_t seed;
-  float i_peak; /* the largest true current amplitude [A] */
-} model_t;
-
-static float model_noise(model_t *m) {
-  m->seed = m->seed * 1664525u + 1013904223u;
-  return ((float)(m->seed >> 8) / 16777216.0f - 0.5f) * 2.0f * m->noise;
-}
-
-/* one phase's voltage error (the inverter's dead time: odd in its current) */
-static float phase_err(const model_t *m, float i) {
-  return fabsf(i) >= m->knee ? copysignf(m->v0, i) : m->v0 * i / m->knee;
-}
-
-/* One period with the voltage asked (alpha, beta): the phases' errors
- * subtracted (Clarke), the R-L response integrated exactly. */
-static void model_step(model_t *m, ab_t v, float ts) {
-  const float ia = m->i_a;
-  const float ib = -0.5f * m->i_a + 0.8660254f * m->i_b;
-  const float ic = -0.5f * m->i_a - 0.8660254f * m->i_b;
-  const float ea = phase_err(m, ia), eb = phase_err(m, ib), ec = phase_err(m, ic);
-  const float e_al = (2.0f / 3.0f) * (ea - 0.5f * eb - 0.5f * ec);
-  const float e_be = (2.0f / 3.0f) * 0.8660254f * (eb - ec);
-  const float k = expf(-m->r * ts / m->l);
-  m->i_a = m->i_a * k + (1.0f - k) * (v.alpha - e_al) / m->r;
-  m->i_b = m->i_b * k + (1.0f - k) * (v.beta - e_be) / m->r;
-  m->i_peak = fmaxf(m->i_peak, sqrtf(m->i_a * m->i_a + m->i_b * m->i_b));
-}
-
-static float model_meas(model_t *m, float i) {
-  const float x = i + model_noise(m);
-  return m->lsb > 0.0f ? m->lsb * roundf(x / m->lsb) : x;
-}
+#include "proc_rl_model.h" /* R, L, the voltage error's plateau V0 and knee per phase */
 
 static void fixture(float r, float l) {
   memset(&fx, 0, sizeof fx);
@@ -123,7 +87,8 @@ static void resistance_and_voltage_error_separated(void **state) {
   static const float ls[] = {1e-4f, 1e-3f, 2e-2f};
   for (unsigned c = 0; c < 3u; ++c) {
     fixture(rs[c], ls[c]);
-    model_t m = {rs[c], ls[c], 0.4f, 0.6f, 0.02f, 0.01f, 0.0f, 0.0f, 12345u + c, 0.0f};
+    model_t m = {rs[c], ls[c], ls[c],      0.4f, 0.6f, 0.02f,       0.01f,
+                 0.0f,  0.0f,  12345u + c, 0.0f, 0,    {0.0f, 0.0f}};
     proc_telemetry_t tm;
     unsigned points;
     assert_int_equal(run(&m, &tm, 200000u, &points), PROC_DONE);
@@ -152,7 +117,7 @@ static void a_single_level_would_not_separate(void **state) {
   /* the broken-on-purpose check of the test's power: R = V / I at the top
    * level carries V0 / I (over 2 % here), the slope does not */
   fixture(0.5f, 1e-3f);
-  model_t m = {0.5f, 1e-3f, 0.4f, 0.6f, 0.02f, 0.01f, 0.0f, 0.0f, 7u, 0.0f};
+  model_t m = {0.5f, 1e-3f, 1e-3f, 0.4f, 0.6f, 0.02f, 0.01f, 0.0f, 0.0f, 7u, 0.0f, 0, {0.0f, 0.0f}};
   proc_telemetry_t tm;
   unsigned points;
   assert_int_equal(run(&m, &tm, 200000u, &points), PROC_DONE);

@@ -23,7 +23,8 @@ ids with FLUXDRIVE_SIL set to the copy's runner), restore the file(s).
 host-release, not host-debug: no mutant needs a sanitizer to be seen (each
 breaks a behaviour an acceptance or SIL test measures), and the optimised
 build runs the SIL tests 2-3x faster (test_preempt: 55 s vs 120 s on a
-loaded machine). A listed test that fails on the unmutated tree is run
+loaded machine). Without link-time optimisation (FD_SIL_LTO=OFF): every
+mutant relinks the runner, and an LTO link costs seconds. A listed test that fails on the unmutated tree is run
 once more: passing then, it is reported FLAKY and the check goes on.
 
     python3 scripts/mutation_check.py                      # all mutants
@@ -290,7 +291,8 @@ class Runner:
         self.build = src / BUILD_REL
 
     def configure(self) -> None:
-        rc, out = sh(["cmake", "--preset", "host-release", f"-DFD_PYTHON={self.python}"],
+        rc, out = sh(["cmake", "--preset", "host-release", f"-DFD_PYTHON={self.python}",
+                      "-DFD_SIL_LTO=OFF"],
                      self.src, log=self.log)
         if rc != 0:
             raise RuntimeError(f"configure failed:\n{out[-3000:]}")

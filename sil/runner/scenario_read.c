@@ -57,7 +57,9 @@ int scn_check_duplicates(ctx_t *c, const cJSON *node, const char *path) {
       for (const cJSON *jt = node->child; jt != it; jt = jt->next) {
         ++k;
       }
-      snprintf(p, sizeof p, "%s[%d]", path, k);
+      /* a longer path is cut (it only names the place in an error); the
+       * bound keeps the index in p */
+      snprintf(p, sizeof p, "%.140s[%d]", path, k);
     }
     if ((cJSON_IsObject(it) || cJSON_IsArray(it)) && scn_check_duplicates(c, it, p) != 0) {
       return -1;

@@ -13,8 +13,9 @@ the plant's a and b of (3.7) from its L_d, L_q, star_m0, star_m2
     L0 = (L_d + L_q)/2 + M0,  L2 = (L_d - L_q) - 2 M2.
 
 Checked on the three star-point presets (`fabbri2022_t51`,
-`fabbri2022_ebike`, `fabbri2022_fig33` at star_p -0.35, -0.2, +0.15 (its
-default) and +0.3) and on random star-point machines of
+`fabbri2022_ebike`, `fabbri2022_fig33` at star_p -0.35 and +0.3, the ends
+of its range (with FLUXDRIVE_STAR_FULL=1 also -0.2 and +0.15, its default))
+and on random star-point machines of
 `fluxdrive machines draw --kind star` (seeds 1..5 in CI; more with
 FLUXDRIVE_STAR_SEEDS="6 7 8"):
 
@@ -73,7 +74,9 @@ PRESETS = {
     "fabbri2022_ebike": (103e-6, 149e-6, 6e-6, -21.42e-6),
 }
 FIG33 = (442.2e-6, 20.7e-6, 103.3e-6)  # L0, M0, L2 kept (docs/dfc.md)
-FIG33_P = [-0.35, -0.2, 0.15, 0.3]
+# the range's ends in CI, two inner points with FLUXDRIVE_STAR_FULL=1
+FIG33_P = ([-0.35, -0.2, 0.15, 0.3] if os.environ.get("FLUXDRIVE_STAR_FULL") == "1"
+           else [-0.35, 0.3])
 
 
 def plant_ab(ld: float, lq: float, m0: float, m2: float) -> tuple[float, float]:

@@ -270,6 +270,9 @@ def main(args: argparse.Namespace) -> int:
     from fluxdrive.can.drive import Drive, open_bus
     from fluxdrive.sil import locate_sil
 
+    if args.sil_preset:  # offline, in the SIL (fluxdrive.commission_sil)
+        from fluxdrive import commission_sil
+        return commission_sil.main(args)
     available = params.ident_procs()
     procs = args.procs or default_procs(available)
     unknown = [p for p in procs if p not in available]
@@ -319,6 +322,14 @@ def add_parser(sub) -> None:
                    "--realtime and report the plant's truth beside each value")
     p.add_argument("--sil-bin", metavar="PATH", help="the fluxdrive-sil to start (default: "
                    "$FLUXDRIVE_SIL, else build/host-release)")
+    p.add_argument("--sil-preset", metavar="PRESET", help="commission a preset offline in the SIL "
+                   "(each procedure a SIL run, the results so far over the drive; 'all': every "
+                   "preset set up in fluxdrive.commission_sil) and write the parameter file")
+    p.add_argument("--durations", action="store_true", help="with --sil-preset: print each "
+                   "procedure's SIL time (t1 - t0) and the total per preset")
+    p.add_argument("--accept", nargs="?", const="ci", choices=("ci", "all"), help="with "
+                   "--sil-preset: then run the preset's paper acceptance tests with "
+                   "FLUXDRIVE_PARAMS=the file (ci: the cheap subset, all: every one on the machine)")
     p.add_argument("--out", default="commission.json", help="parameter file (default commission.json)")
     p.add_argument("--no-write", action="store_true", help="do not load the results into the drive")
     p.add_argument("--timeout", type=float, default=120.0, help="per procedure [s] (default 120)")

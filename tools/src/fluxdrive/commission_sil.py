@@ -43,10 +43,18 @@ from typing import Any
 
 import numpy as np
 
+from fluxdrive import params
 from fluxdrive.commission import parameter_file, report, results_of, truth_from_sil
 from fluxdrive.errors import FluxdriveError
 
 REPO = Path(__file__).resolve().parents[3]
+
+def _merge(a: dict, b: dict) -> dict:
+    out = copy.deepcopy(a)
+    for k, v in b.items():
+        out[k] = _merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
+    return out
+
 
 #: the bench every commissioning runs on: the average inverter with 1 us dead
 #: time and device drops (switch 0.8 V + 50 mOhm, diode 1.0 V + 30 mOhm, as
@@ -71,7 +79,6 @@ class Preset:
     procs: tuple[str, ...]
     sections: dict = field(default_factory=dict)
     per_proc: dict = field(default_factory=dict)
-    duration: float = 20.0
     ci_procs: tuple[str, ...] | None = None  # the CI test's (None: procs)
 
 
@@ -85,19 +92,24 @@ _STAR = {"inverter": {"model": "switching", "dead_time": 5e-7, "v_th_sw": 0.0, "
          "board": {"preset": "g474_nucleo", "asym_edges": 1},
          "controller": {"pos_source": "dfc", "align_time": 0.1}}
 
+#: the flux-map presets' bench (tests/python/test_commission_map.py): 9 x 5 grid
+_FMAP = {"sensors": {"v_full_scale": 1000, "i_noise": 0.002, "v_noise": 0.1, "encoder_cpr": 4096},
+         "controller": {"id_fmap_nd": 9, "id_fmap_nq": 5, "v_dc_max": 800, "v_dc_min": 200}}
+
 PRESETS: dict[str, Preset] = {
     # Rubino 2020 Table I SPM: every value the DB-DFVC and its speed loop use
     "rubino2020_spm": Preset(("offset", "rs", "ldq", "poles", "enc", "flux", "mech"),
-                             {"sensors": {"i_noise": 0.005, "encoder_cpr": 4096}}),
+                             {"sensors": {"i_noise": 0.005, "encoder_cpr": 4096}},
+                             # CI: the values the DB-DFVC's torque uses
+                             ci_procs=("offset", "rs", "ldq", "enc", "flux")),
     # the Table 5.1 motor of Fabbri 2022: the linear values and the star point
     # (a low-voltage drive: MOSFETs, no threshold, their body diodes)
     "fabbri2022_t51": Preset(("offset", "rs", "ldq", "poles", "enc", "flux", "mech", "star"),
                              {"sensors": {"i_noise": 0.005, "encoder_cpr": 65536},
                               "inverter": MOSFET_INVERTER},
                              {"star": _STAR},
-                             # CI: what the sensorless closed loop uses
-                             # most (the star point, the current loop, the flux)
-                             ci_procs=("offset", "rs", "ldq", "flux", "star")),
+                             # CI: the star point, what Fabbri's position is made of
+                             ci_procs=("offset", "star")),
     # the 1.1 kW SyR of Varatharajan 2022: the flux maps over the current
     # range of the paper's test (i_max 4.879 A), no magnet. R_s stays the
     # preset's: rs trips (overcurrent) on this machine (docs/commissioning.md)
@@ -107,20 +119,38 @@ PRESETS: dict[str, Preset] = {
                        "controller": {"i_max": 4.879, "i_trip": 7.3185, "id_fmap_current": 4.879,
                                       "id_fmap_nd": 9, "id_fmap_nq": 5, "id_fmap_dwell": 0.012,
                                       "v_dc_max": 800, "v_dc_min": 200}}),
+    # the other presets: their full commissioning's durations (--durations;
+    # procedures that fail there are open points of docs/commissioning.md)
+    "fabbri2022_ebike": Preset(("offset", "rs", "ldq", "poles", "enc", "flux", "mech", "star"),
+                               {"sensors": {"i_noise": 0.005, "encoder_cpr": 65536},
+                                "inverter": MOSFET_INVERTER}, {"star": _STAR}),
+    "ipm_sat": Preset(("offset", "rs", "ldq", "poles", "enc", "flux", "mech", "fmap"),
+                      _merge(_FMAP, {"controller": {
+                          "i_max": 21.2, "i_trip": 31.8, "id_fmap_current": 21.2,
+                          "id_fmap_dwell": 0.006, "v_dc_min": 50}})),
+    "pmasyr_file": Preset(("offset", "rs", "ldq", "poles", "enc", "flux", "mech", "fmap"),
+                          _merge(_FMAP, {"controller": {
+                              "i_max": 8.0, "i_trip": 12.0, "id_fmap_current": 8.0,
+                              "id_fmap_dwell": 0.006}})),
 }
 
 
-def _merge(a: dict, b: dict) -> dict:
-    out = copy.deepcopy(a)
-    for k, v in b.items():
-        out[k] = _merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
-    return out
+#: the SIL time a procedure's run is first given [s] (the run goes on to
+#: the scenario's end, so not much more than the procedure needs: the
+#: switching inverter's runs are the costly ones); a run the procedure has
+#: not ended in is run again with twice the time, up to MAX_TIME
+PROC_TIME = {"offset": 0.2, "rs": 2.5, "ldq": 2.0, "poles": 8.0, "enc": 3.5, "flux": 3.5,
+             "mech": 4.5, "star": 2.0, "fmap": 4.0}
+MAX_TIME = 200.0
+
+#: each drive parameter's range (the drive's table: PARAM_REQ and --params refuse outside)
+_RANGE = {p["name"]: (p["min"], p["max"]) for p in params.tables()["params"]}
 
 
 def scenario(preset: str, proc: str) -> dict:
     """The SIL scenario that runs `proc` on `preset`'s machine on the bench."""
     p = PRESETS[preset]
-    sc = {"name": f"commission {preset}: {proc}", "duration": p.duration,
+    sc = {"name": f"commission {preset}: {proc}", "duration": PROC_TIME.get(proc, 10.0),
           "machine": {"preset": preset}, "inverter": dict(BENCH_INVERTER),
           "mechanics": {"mode": "free"}, "sensors": {},
           "controller": {"law": "foc", "mode": "torque"},
@@ -200,10 +230,17 @@ def commission_preset(sil: Path, preset: str, out: Path, procs: list[str] | None
             need = name == "fmap" or any(res.relative for res in results_of(name))
             ctrl = _controller(sil, sc_path, params) if need else {}
             summ = tmp / f"{name}.sum.json"
-            r = _sil(sil, [str(sc_path), "--summary", str(summ)], params)
-            if r.returncode != 0:
-                raise FluxdriveError(f"{preset} {name}: the SIL failed: {r.stderr.strip()[-400:]}")
-            c = next(x for x in json.loads(summ.read_text())["commission"] if x["proc"] == name)
+            while True:
+                r = _sil(sil, [str(sc_path), "--summary", str(summ)], params)
+                if r.returncode != 0:
+                    raise FluxdriveError(f"{preset} {name}: the SIL failed: "
+                                         f"{r.stderr.strip()[-400:]}")
+                c = next(x for x in json.loads(summ.read_text())["commission"]
+                         if x["proc"] == name)
+                if c["t1"] >= 0.0 or sc["duration"] >= MAX_TIME:  # ended (or given up)
+                    break
+                sc["duration"] *= 2.0
+                sc_path.write_text(json.dumps(sc))
             rec: dict[str, Any] = {"proc": name, "status": c["status"], "phase": 0,
                                    "results": c["result"], "named": {}, "written": {},
                                    "duration": c["t1"] - c["t0"], "t0": c["t0"], "t1": c["t1"],
@@ -214,12 +251,22 @@ def commission_preset(sil: Path, preset: str, out: Path, procs: list[str] | None
                   file=log, flush=True)
             if c["status"] != "done":
                 break
-            # written into the drive as the CAN command writes them (RESULTS)
+            # written into the drive as the CAN command writes them (RESULTS);
+            # a value outside the parameter's range (the drive refuses it:
+            # over CAN the PARAM_REQ's rejection stops the run) is reported
+            # and left out, and the run goes on
             for res in results_of(name):
                 rec["named"][res.name] = c["result"][res.index]
                 if res.param is not None:
                     v = c["result"][res.index]
-                    rec["written"][res.param] = (ctrl[res.param] + v) if res.relative else v
+                    v = (ctrl[res.param] + v) if res.relative else v
+                    lo, hi = _RANGE[res.param]
+                    if lo <= v <= hi:
+                        rec["written"][res.param] = v
+                    else:
+                        rec.setdefault("refused", {})[res.param] = v
+                        print(f"    {res.param} = {v:.6g} outside [{lo:g}, {hi:g}]: not written",
+                              file=log, flush=True)
             if name == "fmap":
                 lam = pf.get("lambda_m", 0.0)
                 c["pole_pairs"] = pf.get("pole_pairs", ctrl["pole_pairs"])
@@ -280,9 +327,8 @@ ACCEPTANCE: dict[str, list[str]] = {
 
 #: the cheap subset CI runs (tests/python/test_commission_loop.py)
 ACCEPTANCE_CI: dict[str, list[str]] = {
-    "rubino2020_spm": ["tests/python/test_rubino2020.py::" + t for t in (
-        "test_torque_step_deadbeat", "test_torque_reversal", "test_torque_bandwidth_1500hz",
-        "test_speed_control_0_to_1200")],
+    "rubino2020_spm": ["tests/python/test_rubino2020.py::test_torque_step_deadbeat",
+                       "tests/python/test_rubino2020.py::test_torque_reversal"],
     "syr_1k1": ["tests/python/test_varatharajan2022.py::test_speed_step_mtpa_fw_mtpv"],
     "fabbri2022_t51": ["tests/python/test_fabbri2022.py::test_closed_loop_on_the_ivd_position"],
 }

@@ -50,6 +50,7 @@ pytestmark = pytest.mark.skipif(not REAL_SIL.exists(), reason="fluxdrive-sil not
 FULL = os.environ.get("FD_COMMISSION_LOOP_FULL") == "1"
 
 R = "tests/python/test_rubino2020.py::"
+V = "tests/python/test_varatharajan2022.py::"
 #: found on the commissioned values (the paper's limit stays; the value
 #: that makes the difference named)
 XFAIL = {
@@ -62,6 +63,20 @@ XFAIL = {
     R + "test_torque_step_deadbeat_32khz":
         "the encoder offset identified (-0.37 deg electrical): the first beat 0.348 of the step "
         "against the model's 0.412 - 0.05",
+    # FULL: the syr_1k1 runs whose gains come from the map's incremental
+    # inductances (a, b of the decoupled DFVC): a 9 x 5 grid at 1.22 A steps
+    # does not give them (docs/commissioning.md; 17 x 9 is closer, not within)
+    V + "test_bandwidth_uniform_with_proposed_gains_16khz":
+        "the identified 9 x 5 map's incremental inductances set (a, b): the loops' bandwidth "
+        "leaves +-10 % of Omega",
+    V + "test_bandwidth_uniform_with_proposed_gains_5khz":
+        "the identified 9 x 5 map's incremental inductances set (a, b): Omega 21 % off at "
+        "5 kHz, 300 rpm, light load",
+    V + "test_state_of_the_art_gains_shift_the_poles":
+        "the ratio predicted from the identified map, 0.158 off the paper's (limit 0.15)",
+    V + "test_sine_torque_online_mtpa":
+        "the online MTPA on the identified map: the adapted flux (k_A 240) 5.8 % off the true "
+        "map's at the torque (limit 2 %)",
 }
 
 

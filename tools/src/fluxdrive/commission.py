@@ -380,6 +380,10 @@ def add_parser(sub) -> None:
     p.add_argument("--accept", nargs="?", const="ci", choices=("ci", "all"), help="with "
                    "--sil-preset: then run the preset's paper acceptance tests with "
                    "FLUXDRIVE_PARAMS=the file (ci: the cheap subset, all: every one on the machine)")
+    p.add_argument("--markdown", metavar="MD", help="with --sil-preset: write the per-machine "
+                   "tables (value, true, identified, error) between MD's markers")
+    p.add_argument("--check-markdown", metavar="MD", help="with --sil-preset: fail if MD's "
+                   "tables are not what --markdown writes")
     p.add_argument("--out", default="commission.json", help="parameter file (default commission.json)")
     p.add_argument("--no-write", action="store_true", help="do not load the results into the drive")
     p.add_argument("--then-speed", type=float, metavar="RPM", help="then, on the values loaded: "

@@ -223,7 +223,9 @@ def test_blank_drive_to_speed_control_in_one_command(tmp_path):
     on those values, the tracking printed. Short: offset, rs, ldq (the
     current loop's values) on rubino2020_spm (FOC speed mode), 1 s of step:
     no fault, 90 % of the step reached, the final speed within 2 % (the
-    command's --speed-tol), the file with the values the step ran on."""
+    command's --speed-tol), the file with the values the step ran on.
+    Broken on purpose (L_d, L_q written 30 times the identified): the step
+    faults (position) and this fails."""
     import re
     import subprocess
     import sys

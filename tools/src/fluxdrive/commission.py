@@ -266,10 +266,58 @@ def report(records: list[dict], truth: dict[str, float] | None, out=sys.stdout) 
         print(f"{rec['proc']:<10} {'status':<14} {rec['status']:>12} ({rec['duration']:.2f} s)", file=out)
 
 
+def speed_step(drv, rpm: float, duration: float = 1.5, law: str | None = None,
+               period: float = 0.02, out=None) -> dict:
+    """After the commissioning, on the values it loaded: speed mode, enable,
+    a step to `rpm`, the speed sampled every `period` s for `duration` s
+    (the drive's own time, TM_SPEED's stamp where the SIL gives it), then
+    disabled. Prints the tracking (reference, speed, error) and returns
+    {t, ref, speed, faults, final_rpm, error, t_90}: error the mean over the
+    last fifth against the reference, t_90 the time to 90 % of the step."""
+    out = out or sys.stdout
+    if law is not None:
+        drv.set_law(law)
+    drv.set_mode("speed")
+    drv.set_speed(0.0)
+    drv.enable()
+    drv.set_speed(rpm)
+    t_host0 = time.monotonic()
+    t_frame0 = drv.frame_time("TM_SPEED")
+    ts, ref, sp = [], [], []
+    faults: list[str] = []
+    while time.monotonic() - t_host0 < duration:
+        v = drv.read_telemetry(1.0, ("TM_SPEED",))
+        ft = drv.frame_time("TM_SPEED")
+        ts.append(ft - t_frame0 if ft is not None and t_frame0 is not None
+                  else time.monotonic() - t_host0)
+        ref.append(float(rpm))
+        sp.append(float(v["speed_rpm"]))
+        time.sleep(period)
+    st = drv.status()
+    faults = st["fault_names"]
+    drv.disable()
+    n = max(1, len(sp) // 5)
+    final = sum(sp[-n:]) / n
+    err = (final - rpm) / rpm if rpm else final
+    t90 = next((t for t, s_ in zip(ts, sp) if abs(s_) >= 0.9 * abs(rpm)), float("nan"))
+    print(f"\nspeed step 0 -> {rpm:g} rpm on the commissioned values:", file=out)
+    print(f"{'t [s]':>8} {'ref [rpm]':>10} {'speed [rpm]':>12} {'error [rpm]':>12}", file=out)
+    step = max(1, len(ts) // 15)
+    for k in list(range(0, len(ts), step)) + ([len(ts) - 1] if (len(ts) - 1) % step else []):
+        print(f"{ts[k]:8.3f} {ref[k]:10.1f} {sp[k]:12.2f} {sp[k] - ref[k]:12.2f}", file=out)
+    print(f"final {final:.2f} rpm (error {100 * err:+.2f} %), 90 % of the step at "
+          f"{t90:.3f} s, faults: {', '.join(faults) or 'none'}", file=out)
+    return {"t": ts, "ref": ref, "speed": sp, "faults": faults, "final_rpm": final, "error": err,
+            "t_90": t90}
+
+
 def main(args: argparse.Namespace) -> int:
     from fluxdrive.can.drive import Drive, open_bus
     from fluxdrive.sil import locate_sil
 
+    if args.sil_preset:  # offline, in the SIL (fluxdrive.commission_sil)
+        from fluxdrive import commission_sil
+        return commission_sil.main(args)
     available = params.ident_procs()
     procs = args.procs or default_procs(available)
     unknown = [p for p in procs if p not in available]
@@ -293,8 +341,13 @@ def main(args: argparse.Namespace) -> int:
         with Drive(node=args.node, bus=bus, reply_timeout=args.reply_timeout, retries=args.retries) as drv:
             drv.heartbeat(args.heartbeat)  # keeps the command timeout away while they run
             records = commission(drv, procs, write=not args.no_write, timeout=args.timeout)
+            ok = all(r["status"] in ("done", "refused") for r in records) and \
+                len(records) == len(procs)
+            tracking = None
+            if args.then_speed is not None and ok:  # from a blank drive to speed control
+                tracking = speed_step(drv, args.then_speed, args.speed_time, args.law)
+                ok = not tracking["faults"] and abs(tracking["error"]) <= args.speed_tol
         bus.shutdown()
-        ok = all(r["status"] in ("done", "refused") for r in records) and len(records) == len(procs)
         pf = parameter_file(records)
         Path(args.out).write_text(json.dumps(pf, indent=1) + "\n", encoding="utf-8")
         print()
@@ -319,8 +372,28 @@ def add_parser(sub) -> None:
                    "--realtime and report the plant's truth beside each value")
     p.add_argument("--sil-bin", metavar="PATH", help="the fluxdrive-sil to start (default: "
                    "$FLUXDRIVE_SIL, else build/host-release)")
+    p.add_argument("--sil-preset", metavar="PRESET", help="commission a preset offline in the SIL "
+                   "(each procedure a SIL run, the results so far over the drive; 'all': every "
+                   "preset set up in fluxdrive.commission_sil) and write the parameter file")
+    p.add_argument("--durations", action="store_true", help="with --sil-preset: print each "
+                   "procedure's SIL time (t1 - t0) and the total per preset")
+    p.add_argument("--accept", nargs="?", const="ci", choices=("ci", "all"), help="with "
+                   "--sil-preset: then run the preset's paper acceptance tests with "
+                   "FLUXDRIVE_PARAMS=the file (ci: the cheap subset, all: every one on the machine)")
+    p.add_argument("--markdown", metavar="MD", help="with --sil-preset: write the per-machine "
+                   "tables (value, true, identified, error) between MD's markers")
+    p.add_argument("--check-markdown", metavar="MD", help="with --sil-preset: fail if MD's "
+                   "tables are not what --markdown writes")
     p.add_argument("--out", default="commission.json", help="parameter file (default commission.json)")
     p.add_argument("--no-write", action="store_true", help="do not load the results into the drive")
+    p.add_argument("--then-speed", type=float, metavar="RPM", help="then, on the values loaded: "
+                   "speed mode, enable, a step to RPM, print the speed tracking, disable (exit "
+                   "status 1 on a fault or a final speed off by more than --speed-tol)")
+    p.add_argument("--speed-time", type=float, default=1.5, help="the speed step's length [s] "
+                   "(default 1.5)")
+    p.add_argument("--speed-tol", type=float, default=0.02, help="final speed's tolerance, "
+                   "relative (default 0.02)")
+    p.add_argument("--law", help="the law for the speed step (default: the drive's)")
     p.add_argument("--timeout", type=float, default=120.0, help="per procedure [s] (default 120)")
     p.add_argument("--heartbeat", type=float, default=0.05, help="HOST_HB period [s] (default 0.05)")
     p.add_argument("--reply-timeout", type=float, default=1.0, help="per request [s] (default 1)")

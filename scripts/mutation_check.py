@@ -322,6 +322,8 @@ class Runner:
                 junit.unlink()
             env = dict(os.environ)
             env["FLUXDRIVE_SIL"] = str(self.src / SIL_REL)
+            # the map tool the runner calls for .npz / .csv maps (the copy has no .venv)
+            env["FLUXDRIVE_PYTHON"] = self.python
             env["PYTHONPATH"] = os.pathsep.join([str(self.src / "tools" / "src"),
                                                  env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
             env.pop("FLUXDRIVE_RUBINO_SCENARIOS", None)

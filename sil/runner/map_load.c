@@ -78,20 +78,30 @@ static int convert(const char *src, int pole_pairs, char *tmp, size_t tmpn, char
   snprintf(cmd, sizeof cmd, "'%s' -m fluxdrive map convert '%s' -o '%s'%s 2>&1", python(), src, tmp,
            pp);
   FILE *p = popen(cmd, "r");
+  /* the output's last 511 bytes (a line at a time; lines longer than the
+   * buffer are cut): the tool's message is at its end */
   char out[512] = "";
   size_t got = 0;
-  if (p != NULL) {
-    got = fread(out, 1, sizeof out - 1, p);
+  char line[512];
+  while (p != NULL && fgets(line, sizeof line, p) != NULL) {
+    const size_t n = strlen(line);
+    if (got + n > sizeof out - 1) {
+      got = 0;
+    }
+    memcpy(out + got, line, n);
+    got += n;
   }
   out[got] = '\0';
   const int rc = p != NULL ? pclose(p) : -1;
   if (rc != 0) {
-    char *nl = strchr(out, '\n');
-    if (nl != NULL) {
-      *nl = '\0';
+    /* the tool's message is its last line (a traceback's is the exception) */
+    while (got > 0 && (out[got - 1] == '\n' || out[got - 1] == ' ')) {
+      out[--got] = '\0';
     }
+    const char *nl = strrchr(out, '\n');
+    const char *msg = nl != NULL ? nl + 1 : out;
     snprintf(err, errlen, "%s: the map tool refused it: %s", src,
-             got > 0 ? out : "(no message; is the tools venv installed? scripts/setup.sh)");
+             got > 0 ? msg : "(no message; is the tools venv installed? scripts/setup.sh)");
     remove(tmp);
     return -1;
   }

@@ -262,6 +262,7 @@ FD_COLD static int rs_step(proc_state_t *st, const proc_setup_t *su, const proc_
   out->v_ab = (ab_t){sc.c * v.d - sc.s * v.q, sc.s * v.d + sc.c * v.q};
   /* the swing's turning points (proc_swing.c): along 0 and pi the voltage
    * across the current is the back-EMF of the rotor's swing alone */
+  /* mut: rs_swing_window */
   proc_swing_step(&r->swing, v.q, c->ts);
   const uint32_t n_swing = rs_periods(PROC_RS_SWING, c->ts);
   /* a level's window begins at a turning point after the settling (or

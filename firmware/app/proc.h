@@ -194,6 +194,16 @@ static inline float proc_ident_align_angle(uint32_t n, uint32_t n_first, uint32_
   return k < n_turn ? 0.5f * FRAMES_PI * (1.0f - (float)k / (float)n_turn) : 0.0f;
 }
 
+/* The free rotor's swing about a DC current (proc_swing.c): the voltage
+ * across the current, filtered, and its turning points (its sign changes),
+ * where a window over which the swing's back-EMF averages out begins and
+ * ends. */
+typedef struct {
+  float v;     /* the voltage across the current, filtered [V] */
+  int8_t sign; /* its sign (0: none yet) */
+  bool turned; /* it changed sign this period: a turning point */
+} proc_swing_t;
+
 /* proc_rs.c: R_s and v_err(i) (issue 25 a). Levels of each sign, at most: */
 #define PROC_RS_LEVELS_MAX 12u
 typedef struct {
@@ -208,6 +218,8 @@ typedef struct {
   float v_prev;                        /* the axis' voltage asked last period [V] */
   float acc_v, acc_i;                  /* the level's sums */
   uint32_t acc_n;                      /* ... of this many periods */
+  proc_swing_t swing;                  /* the swing's turning points (proc_swing.c) */
+  bool open;                           /* the level's window has begun (at a turning point) */
   float i_peak;                        /* the largest measured current amplitude [A] */
   float lv_i[2u * PROC_RS_LEVELS_MAX]; /* the levels' mean current, positive then negative [A] */
   float lv_v[2u * PROC_RS_LEVELS_MAX]; /* ... and commanded voltage [V] */
@@ -415,6 +427,12 @@ const char *proc_start_refusal(const proc_setup_t *su, const char **field);
 
 /* proc_align.c: the alignment's timing for cfg (also the tests'). */
 void proc_align_timing(const drive_config_t *cfg, proc_align_timing_t *t);
+
+/* proc_swing.c: reset before the first period; step once a period with
+ * the voltage across the current asked the period before [V] and the
+ * period ts [s]: sets turned at the swing's turning points. */
+void proc_swing_reset(proc_swing_t *w);
+void proc_swing_step(proc_swing_t *w, float v_y, float ts);
 
 /* proc_poles.c: the encoder identifications' test current (id_i_test, 0:
  * 0.3 i_max, at most i_max) [A], their speed bound (id_speed_max, 0: 0.3

@@ -45,6 +45,9 @@
 #define PROC_RS_TRIP 1.2f   /* a measured current above this times the limit fails it */
 #define PROC_RS_RAMP 0.005f /* a level change is ramped over this [s] */
 #define PROC_RS_TURN 0.2f   /* the turn to theta = pi takes this [s] */
+/* the longest wait for the swing's turning point (proc_swing.c), a half
+ * swing: a swing slower than 2 Hz is averaged over whatever window [s] */
+#define PROC_RS_SWING 0.25f
 /* the knee: the lowest level from which every level above lies within
  * PROC_RS_KNEE_TOL of its sign's plateau (of |V_0|) */
 #define PROC_RS_KNEE_TOL 0.05f
@@ -108,6 +111,8 @@ FD_COLD static void rs_init(proc_state_t *st, const proc_setup_t *su) {
   r->acc_v = 0.0f;
   r->acc_i = 0.0f;
   r->acc_n = 0u;
+  proc_swing_reset(&r->swing);
+  r->open = false;
   r->i_peak = 0.0f;
   r->last = -1;
   for (unsigned k = 0; k < 2u * PROC_RS_LEVELS_MAX; ++k) {
@@ -255,16 +260,31 @@ FD_COLD static int rs_step(proc_state_t *st, const proc_setup_t *su, const proc_
   const dq_t v =
       current_ctrl_update(&r->cc, (dq_t){r->i_ref, 0.0f}, (dq_t){i_x, i_y}, 0.0f, in->v_max);
   out->v_ab = (ab_t){sc.c * v.d - sc.s * v.q, sc.s * v.d + sc.c * v.q};
-  if (measure && r->n >= n_settle) {
+  /* the swing's turning points (proc_swing.c): along 0 and pi the voltage
+   * across the current is the back-EMF of the rotor's swing alone */
+  /* mut: rs_swing_window */
+  proc_swing_step(&r->swing, v.q, c->ts);
+  const uint32_t n_swing = rs_periods(PROC_RS_SWING, c->ts);
+  /* a level's window begins at a turning point after the settling (or
+   * when none came within PROC_RS_SWING) ... */
+  if (measure && !r->open && r->n >= n_settle && (r->swing.turned || r->n >= n_settle + n_swing)) {
+    r->open = true;
+  }
+  if (r->open) {
     /* the sample reflects the voltage asked the period before */
     r->acc_v += r->v_prev;
     r->acc_i += i_x;
     ++r->acc_n;
   }
   r->v_prev = v.d;
-  if (++r->n < n_phase) {
+  ++r->n;
+  /* ... and ends at one after id_rs_avg (at most PROC_RS_SWING later):
+   * the swing's flux along the current is the same at both ends (1) */
+  if (measure ? !(r->open && r->acc_n >= n_avg && (r->swing.turned || r->acc_n >= n_avg + n_swing))
+              : r->n < n_phase) {
     return PROC_RUNNING;
   }
+  r->open = false;
   if (measure) { /* the level's means, stored top first per sign */
     const unsigned s = r->phase <= n ? 0u : 1u;
     const unsigned k = s == 0u ? r->phase - 1u : r->phase - ph_turn(n) - 1u;

@@ -68,9 +68,9 @@ export PYTHONPATH="$src/tools/src${PYTHONPATH:+:$PYTHONPATH}"
 # the Kalman filter on speed, angle and load torque under FOC, from
 # standstill to 500 rpm: agreement, the issue's goals per call (KF: predict
 # + update <= 360, RLS <= 220; measured 158 and 146) and for the whole ISR:
-# issue 24 point 8's software mean < 2600 (measured 2319) and, with the
+# issue 24 point 8's software mean < 2600 (measured 2322) and, with the
 # core's trigonometry on the STM32G474's CORDIC co-processor, < 2300, the
-# issue's target (measured 2254: docs/benchmarks.md, "Sensorless chain:
+# issue's target (measured 2257: docs/benchmarks.md, "Sensorless chain:
 # Kalman filter, EKF, RLS"); then the EKF (<= 790; measured 251)
 "$python" -m fluxdrive pil "$src/sil/scenarios/pil_ivd_kf_rls.json" --law foc --isrs all \
   --functions --check-call kf_mech_predict=100 --check-call kf_mech_update=260 \

@@ -314,10 +314,7 @@ FD_COLD static bool configure_live(drive_t *drv, const drive_config_t *cfg) {
   speed_ctrl_cfg_t scfg;
   speed_cfg_from(&scfg, &drv->cfg);
   /* new gains and limits; the integral and the ramp carry on */
-  drv->speed.cfg = scfg;
-  drv->speed.cfg.torque_max = fabsf(scfg.torque_max);
-  drv->speed.pi.kp = scfg.kp;
-  drv->speed.pi.ki = scfg.ki;
+  speed_ctrl_retune(&drv->speed, &scfg);
   /* the torque the law has, within a lowered torque_max at once */
   const float tm = drv->speed.cfg.torque_max;
   drv->speed_torque = fd_clampf(drv->speed_torque, -tm, tm);

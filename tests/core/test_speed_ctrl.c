@@ -168,12 +168,37 @@ static void test_bumpless_reset(void **state) {
   ASSERT_NEAR(sc.pi.integ, 20.0, 0.0);
 }
 
+/* A live retune (speed_ctrl_retune): new gains, |torque_max|, the
+ * feed-forward's 1 / ts; the integral and the ramp carry on. */
+static void test_retune_keeps_state(void **state) {
+  (void)state;
+  speed_ctrl_t sc = make(100.0, 100.0, 20.0);
+  speed_ctrl_reset(&sc, 50.0f, 4.2f);
+  (void)speed_ctrl_update(&sc, 60.0f, 50.0f, -20.0f, 20.0f);
+  const float integ = sc.pi.integ;
+  const float ramp = sc.w_ref_ramped;
+  speed_ctrl_cfg_t cfg = {0.0f, 0.0f, (float)(2.0 * TS), 100.0f, -15.0f, (float)J};
+  speed_ctrl_design(&cfg, (float)J, 50.0f);
+  speed_ctrl_retune(&sc, &cfg);
+  ASSERT_NEAR(sc.pi.integ, integ, 0.0);
+  ASSERT_NEAR(sc.w_ref_ramped, ramp, 0.0);
+  ASSERT_NEAR(sc.cfg.torque_max, 15.0, 0.0);
+  ASSERT_NEAR(sc.pi.kp, cfg.kp, 0.0);
+  ASSERT_NEAR(sc.pi.ki, cfg.ki, 0.0);
+  ASSERT_NEAR(sc.inv_ts, 1.0 / (2.0 * TS), 1e-3);
+  /* on the ramp (100 rad/s^2 over 2 ms: 0.2 rad/s a call) at zero speed
+   * error the output is the integral plus J times the ramp's acceleration */
+  const float w = sc.w_ref_ramped + 0.2f;
+  const float t = speed_ctrl_update(&sc, 1e3f, w, -15.0f, 15.0f);
+  ASSERT_NEAR(t, integ + J * 100.0, 1e-3);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_design),         cmocka_unit_test(test_slew_exact),
       cmocka_unit_test(test_load_rejection), cmocka_unit_test(test_torque_limits),
       cmocka_unit_test(test_fig18_ramp),     cmocka_unit_test(test_saturated_accel_no_windup),
-      cmocka_unit_test(test_bumpless_reset),
+      cmocka_unit_test(test_bumpless_reset), cmocka_unit_test(test_retune_keeps_state),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

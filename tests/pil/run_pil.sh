@@ -55,10 +55,10 @@ export PYTHONPATH="$src/tools/src${PYTHONPATH:+:$PYTHONPATH}"
 # Issue 24 point 8's board target for the three star-point sources: the
 # estimated board worst case (PIL worst ISR, board HAL and ISR wrapper, the
 # core's trigonometry on the G474's CORDIC: `fluxdrive pil --board-elf`,
-# docs/pil.md) at most 45 % of the budget: met by DFC-IVD (--check-board 45;
-# measured 44 %), not yet by IVD + KF + RLS and the EKF (46.5 % and 46.9 %,
-# their worst the run's first law period; --check-board 47 holds them from
-# growing: docs/benchmarks.md, "Sensorless chain")
+# docs/pil.md) at most 45 % of the budget, checked on all three
+# (--check-board 45; measured DFC-IVD 42.1 %, IVD + KF + RLS 44.5 %, the
+# EKF 44.9 %, their worst the speed loop's ISRs: docs/benchmarks.md,
+# "Sensorless chain")
 "$python" -m fluxdrive pil "$src/sil/scenarios/pil_dfc_ivd.json" --law foc --isrs all \
   --functions --check-call dfc_ivd_step=90 --check-board 45 \
   --board-elf "$build/cross/boards/stm32g4/fluxdrive-g474.elf" --sil "$sil" \
@@ -68,18 +68,18 @@ export PYTHONPATH="$src/tools/src${PYTHONPATH:+:$PYTHONPATH}"
 # the Kalman filter on speed, angle and load torque under FOC, from
 # standstill to 500 rpm: agreement, the issue's goals per call (KF: predict
 # + update <= 360, RLS <= 220; measured 158 and 146) and for the whole ISR:
-# issue 24 point 8's software mean < 2600 (measured 2319) and, with the
+# issue 24 point 8's software mean < 2600 (measured 2322) and, with the
 # core's trigonometry on the STM32G474's CORDIC co-processor, < 2300, the
-# issue's target (measured 2254: docs/benchmarks.md, "Sensorless chain:
+# issue's target (measured 2257: docs/benchmarks.md, "Sensorless chain:
 # Kalman filter, EKF, RLS"); then the EKF (<= 790; measured 251)
 "$python" -m fluxdrive pil "$src/sil/scenarios/pil_ivd_kf_rls.json" --law foc --isrs all \
   --functions --check-call kf_mech_predict=100 --check-call kf_mech_update=260 \
-  --check-call rls_ab_update=220 --check-mean 2600 --check-mean-cordic 2300 --check-board 47 \
+  --check-call rls_ab_update=220 --check-mean 2600 --check-mean-cordic 2300 --check-board 45 \
   --board-elf "$build/cross/boards/stm32g4/fluxdrive-g474.elf" --sil "$sil" \
   --elf "$build/cross/pil/fluxdrive-pil.elf" --out "$build/work" \
   --markdown "$build/benchmarks-kf.md"
 "$python" -m fluxdrive pil "$src/sil/scenarios/pil_ekf.json" --law foc --isrs all \
   --functions --check-call kf_mech_predict=100 --check-call kf_mech_update_ekf=690 \
-  --check-board 47 --board-elf "$build/cross/boards/stm32g4/fluxdrive-g474.elf" \
+  --check-board 45 --board-elf "$build/cross/boards/stm32g4/fluxdrive-g474.elf" \
   --sil "$sil" --elf "$build/cross/pil/fluxdrive-pil.elf" --out "$build/work" \
   --markdown "$build/benchmarks-ekf.md"

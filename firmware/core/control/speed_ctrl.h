@@ -23,9 +23,13 @@ typedef struct {
   speed_ctrl_cfg_t cfg;
   pi_ctrl_t pi;
   float w_ref_ramped; /* slew-limited speed reference [rad/s] */
+  float inv_ts;       /* 1 / cfg.ts: the feed-forward's derivative without a division */
 } speed_ctrl_t;
 
 void speed_ctrl_init(speed_ctrl_t *sc, const speed_ctrl_cfg_t *cfg);
+/* New gains and limits while running (a LIVE parameter): the integral and
+ * the ramp carry on. */
+void speed_ctrl_retune(speed_ctrl_t *sc, const speed_ctrl_cfg_t *cfg);
 /* Bumpless start from the measured speed and the torque in force. */
 void speed_ctrl_reset(speed_ctrl_t *sc, float w_meas, float torque_now);
 /* Gains from inertia J and desired bandwidth wb (PI zero at wb/4). */

@@ -39,16 +39,7 @@ void pi_ctrl_reset(pi_ctrl_t *pi, float integ) {
 /* NaN limits are ignored (previous kept); crossed limits collapse to their
  * mean so that the output is still well defined. Infinite limits are fine. */
 void pi_ctrl_set_limits(pi_ctrl_t *pi, float out_min, float out_max) {
-  if (isnan(out_min) || isnan(out_max)) {
-    return;
-  }
-  if (out_min > out_max) {
-    const float mid = 0.5f * (out_min + out_max);
-    out_min = mid;
-    out_max = mid;
-  }
-  pi->out_min = out_min;
-  pi->out_max = out_max;
+  pi_ctrl_limits_in(pi, out_min, out_max);
 }
 
 float pi_ctrl_update(pi_ctrl_t *pi, float err, float ff) {

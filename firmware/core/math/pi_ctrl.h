@@ -10,6 +10,8 @@
 #ifndef FD_MATH_PI_CTRL_H
 #define FD_MATH_PI_CTRL_H
 
+#include <math.h>
+
 #include "math/fd_math.h"
 
 /* -Os would call the step from every update: inline, once per caller */
@@ -37,6 +39,23 @@ float pi_ctrl_update(pi_ctrl_t *pi, float err, float ff);
 
 PI_CTRL_INLINE float pi_ctrl_clamp(float x, float lo, float hi) {
   return (x > hi) ? hi : ((x < lo) ? lo : x);
+}
+
+/* The rules of pi_ctrl_set_limits, in line for a caller that sets the
+ * limits before every step (the speed loop, speed_ctrl_update): NaN
+ * limits are ignored (the previous kept); crossed limits collapse to
+ * their mean. */
+PI_CTRL_INLINE void pi_ctrl_limits_in(pi_ctrl_t *pi, float out_min, float out_max) {
+  if (isnan(out_min) || isnan(out_max)) {
+    return;
+  }
+  if (out_min > out_max) {
+    const float mid = 0.5f * (out_min + out_max);
+    out_min = mid;
+    out_max = mid;
+  }
+  pi->out_min = out_min;
+  pi->out_max = out_max;
 }
 
 /* The step of pi_ctrl_update against the limits out_min <= out_max (not

@@ -198,6 +198,14 @@ static inline const plant_cur_cache_t *plant_machine_cur(plant_t *pl) {
   }
   return &pl->aux.cur;
 }
+/* plant_brief_t of the present state, i_abc its cached true currents. */
+static inline void plant_brief_of(const plant_t *pl, const double i_abc[3], plant_brief_t *out) {
+  out->i_abc[0] = i_abc[0];
+  out->i_abc[1] = i_abc[1];
+  out->i_abc[2] = i_abc[2];
+  out->omega_m = pl->omega_m;
+  out->v_dc = pl->v_dc;
+}
 /* c, s: cos and sin of pole_pairs * x[X_TH] */
 void plant_machine_zero_phase_current_cs(const plant_t *pl, double *x, int leg, double c, double s);
 

@@ -140,6 +140,9 @@ typedef struct {
   bool trip_posted;            /* inject.trip_at done (once per run, resets included) */
   bool cm_written;             /* inject.cm_scale_*: a value written, cm_last holds it */
   float cm_last[2];
+  /* the plant's true values at the last sil_sample: the state the ISR and
+   * the run's metrics see (the plant does not move before sil_advance) */
+  plant_brief_t br;
 } sil_ctx_t;
 
 /* Plant, HAL and drive from the scenario; 0 or -1 with the message. */

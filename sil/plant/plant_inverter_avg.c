@@ -244,7 +244,7 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
   for (int j = 0; j < 3; j++) {
     k.d[j] = duty[j];
     /* both compares evaluated (`&`, not `&&`): no branch per leg */
-    k.kd[j] = (duty[j] > 0.0) & (duty[j] < 1.0) ? kdt : 0.0;
+    k.kd[j] = ((duty[j] > 0.0) & (duty[j] < 1.0)) ? kdt : 0.0;
   }
   k.imposed = p->mech.mode == PLANT_MECH_IMPOSED;
   k.ideal = p->dclink.kind == PLANT_DC_IDEAL;

@@ -301,12 +301,7 @@ static inline double torque_of(const plant_t *pl, const plant_cur_cache_t *c) {
 }
 
 void plant_get_brief(plant_t *pl, plant_brief_t *out) {
-  const plant_cur_cache_t *c = plant_machine_cur(pl);
-  out->i_abc[0] = c->i_abc[0];
-  out->i_abc[1] = c->i_abc[1];
-  out->i_abc[2] = c->i_abc[2];
-  out->omega_m = pl->omega_m;
-  out->v_dc = pl->v_dc;
+  plant_brief_of(pl, plant_machine_cur(pl)->i_abc, out);
 }
 
 double plant_get_torque(plant_t *pl) {

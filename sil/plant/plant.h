@@ -401,6 +401,9 @@ void plant_aniso_load(const plant_machine_t *m, double i_q, double *phi_a, doubl
 void plant_star_gain(const plant_t *pl, double theta_e, double i_q, double g[3]);
 /* Sensor readings at the present plant time (the carrier valley). */
 void plant_sample(plant_t *pl, plant_adc_t *out);
+/* The same, and plant_get_brief() of the same state into br: the currents'
+ * cache checked once (the runner's sample and its metrics, every period). */
+void plant_sample_brief(plant_t *pl, plant_adc_t *out, plant_brief_t *br);
 void plant_get_state(const plant_t *pl, plant_state_t *out);
 /* Whether the average model integrates the period averages of the phase
  * voltages, the DC-link current, the torque and the rotor-frame currents

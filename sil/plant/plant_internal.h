@@ -198,6 +198,14 @@ static inline const plant_cur_cache_t *plant_machine_cur(plant_t *pl) {
   }
   return &pl->aux.cur;
 }
+/* plant_brief_t of the present state, i_abc its cached true currents. */
+static inline void plant_brief_of(const plant_t *pl, const double i_abc[3], plant_brief_t *out) {
+  out->i_abc[0] = i_abc[0];
+  out->i_abc[1] = i_abc[1];
+  out->i_abc[2] = i_abc[2];
+  out->omega_m = pl->omega_m;
+  out->v_dc = pl->v_dc;
+}
 /* c, s: cos and sin of pole_pairs * x[X_TH] */
 void plant_machine_zero_phase_current_cs(const plant_t *pl, double *x, int leg, double c, double s);
 
@@ -205,6 +213,12 @@ void plant_machine_zero_phase_current_cs(const plant_t *pl, double *x, int leg, 
 int plant_inverter_check(const plant_inverter_t *inv, double ts, const char **field);
 void plant_inverter_init(plant_t *pl);
 void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, double cs_end[2]);
+/* Not inlined into plant_step_pattern (the release runner's link-time
+ * inliner would): the average model's usual period then runs without the
+ * switching model's stack frame and register saves. */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
 void plant_inverter_sw_period(plant_t *pl, const double on[3], const double off[3], bool gates_on,
                               double *x, double cs_end[2]);
 

@@ -240,9 +240,11 @@ void plant_inverter_avg_period(plant_t *pl, const double duty[3], double *x, dou
   k.inv_c = pl->aux.inv_c;
   k.g_chop = pl->aux.g_chop;
   k.one_way = pl->aux.one_way;
+  const double kdt = pl->aux.kdt;
   for (int j = 0; j < 3; j++) {
     k.d[j] = duty[j];
-    k.kd[j] = duty[j] > 0.0 && duty[j] < 1.0 ? pl->aux.kdt : 0.0;
+    /* both compares evaluated (`&`, not `&&`): no branch per leg */
+    k.kd[j] = ((duty[j] > 0.0) & (duty[j] < 1.0)) ? kdt : 0.0;
   }
   k.imposed = p->mech.mode == PLANT_MECH_IMPOSED;
   k.ideal = p->dclink.kind == PLANT_DC_IDEAL;

@@ -184,7 +184,10 @@ static double adc_round(double x, double lsb, double code_min, double code_max, 
   return (code - code_off) * lsb;
 }
 
-void plant_sample(plant_t *pl, plant_adc_t *out) {
+/* The sensors, and the true values of the same state (br, when not NULL)
+ * from the same current cache: one freshness check for both. */
+static inline __attribute__((always_inline)) void sample_of(plant_t *pl, plant_adc_t *out,
+                                                            plant_brief_t *br) {
   const plant_sensors_t *s = &pl->p.sensors;
   const plant_aux_t *a = &pl->aux;
   const double code_max = a->adc_code_max;
@@ -198,6 +201,9 @@ void plant_sample(plant_t *pl, plant_adc_t *out) {
     n[3] = rng_normal(a, &pl->rng);
   }
   const double *i_abc = plant_machine_cur(pl)->i_abc;
+  if (br != NULL) {
+    plant_brief_of(pl, i_abc, br);
+  }
   const double ilsb = a->adc_ilsb;
   for (int k = 0; k < 3; k++) {
     const double raw = a->adc_gain[k] * i_abc[k] + s->offset_error[k] + s->i_noise * n[k];
@@ -215,4 +221,10 @@ void plant_sample(plant_t *pl, plant_adc_t *out) {
   } else {
     out->enc_angle = pl->theta_m;
   }
+}
+void plant_sample(plant_t *pl, plant_adc_t *out) {
+  sample_of(pl, out, NULL);
+}
+void plant_sample_brief(plant_t *pl, plant_adc_t *out, plant_brief_t *br) {
+  sample_of(pl, out, br);
 }

@@ -162,16 +162,23 @@ int sil_setup(sil_ctx_t *x, const scenario_t *sc, char *err, size_t errlen) {
   const sil_enc_faults_t *ef = &sc->encoder_faults;
   x->enc_faults_on =
       ef->frozen.n > 0 || ef->reversed.n > 0 || ef->jitter > 0.0 || ef->missing > 0.0;
+  x->rare = sc->encoder_invalid.n > 0 || x->enc_faults_on || sc->current_faults.n > 0 ||
+            sc->isr_stall.n > 0 || sc->isr_overrun.n > 0 || sc->gate_driver.n > 0 ||
+            sc->power_faults || sc->hw_trip > 0.0;
   return 0;
 }
 
 void sil_sample(sil_ctx_t *x, const scenario_t *sc, double t) {
   plant_adc_t adc;
-  plant_sample(&x->plant, &adc);
+  plant_sample_brief(&x->plant, &adc, &x->br);
   if (!(t < x->enc_err_end)) {
     x->enc_err = profile_eval_span(&sc->encoder_error, t, &x->enc_err_end);
   }
-  to_hal_sample(&adc, x, x->enc_err, !injected(&sc->encoder_invalid, t), &x->hal.sample);
+  to_hal_sample(&adc, x, x->enc_err, true, &x->hal.sample);
+  if (!x->rare) {
+    return;
+  }
+  x->hal.sample.enc_valid = !injected(&sc->encoder_invalid, t);
   if (x->enc_faults_on) {
     const sil_enc_faults_t *ef = &sc->encoder_faults;
     const int cpr = sc->plant.sensors.encoder_cpr;
@@ -220,12 +227,35 @@ static void set_power_faults(sil_ctx_t *x, const scenario_t *sc, double t) {
   (void)plant_set_power_faults(&x->plant, &f);
 }
 
-void sil_advance(sil_ctx_t *x, const scenario_t *sc, double t) {
+/* The injections before the plant's period (x->rare only): nFAULT, the
+ * power-stage faults in force. */
+static void advance_faults_before(sil_ctx_t *x, const scenario_t *sc, double t) {
   if (injected(&sc->gate_driver, t)) {
     hw_break(x, HAL_BREAK_GATE_DRIVER); /* nFAULT: gates off at once, latched */
   }
   if (sc->power_faults) {
     set_power_faults(x, sc, t);
+  }
+}
+/* The hardware's reactions after it (x->rare only): the desaturation
+ * detection, the overcurrent comparator. */
+static void advance_faults_after(sil_ctx_t *x, const scenario_t *sc) {
+  if (sc->power_faults && plant_take_desat(&x->plant)) {
+    hw_break(x, HAL_BREAK_GATE_DRIVER); /* desaturation: the driver's nFAULT */
+  }
+  /* hardware comparator: gates off in hardware, latched */
+  if (sc->hw_trip > 0.0 && (x->hal.gates_on || x->hal.asc)) {
+    plant_brief_t br;
+    plant_get_brief(&x->plant, &br);
+    if (fabs(br.i_abc[0]) > sc->hw_trip || fabs(br.i_abc[1]) > sc->hw_trip ||
+        fabs(br.i_abc[2]) > sc->hw_trip) {
+      hw_break(x, HAL_BREAK_OVERCURRENT);
+    }
+  }
+}
+void sil_advance(sil_ctx_t *x, const scenario_t *sc, double t) {
+  if (x->rare) {
+    advance_faults_before(x, sc, t);
   }
   if (!(t < x->v_src_end)) {
     x->v_src = profile_eval_span(&sc->v_source, t, &x->v_src_end);
@@ -241,8 +271,10 @@ void sil_advance(sil_ctx_t *x, const scenario_t *sc, double t) {
   } else {
     plant_step_pattern(&x->plant, x->pwm_on, x->pwm_off, x->hal.gates_on);
   }
-  if (sc->power_faults && plant_take_desat(&x->plant)) {
-    hw_break(x, HAL_BREAK_GATE_DRIVER); /* desaturation: the driver's nFAULT */
+  if (x->rare) {
+    /* the desaturation at once; the comparator sees the period's end state
+     * (nothing between reads the flag or the gates: the same order) */
+    advance_faults_after(x, sc);
   }
   double v[PLANT_STAR_MAX];
   x->star_got = plant_star_read(&x->plant, v);
@@ -264,15 +296,6 @@ void sil_advance(sil_ctx_t *x, const scenario_t *sc, double t) {
     x->star_t[k] = next->t_star_req[k];
   }
   x->star_tv = next->test_vector;
-  /* hardware comparator: gates off in hardware, latched */
-  if (sc->hw_trip > 0.0 && (x->hal.gates_on || x->hal.asc)) {
-    plant_brief_t br;
-    plant_get_brief(&x->plant, &br);
-    if (fabs(br.i_abc[0]) > sc->hw_trip || fabs(br.i_abc[1]) > sc->hw_trip ||
-        fabs(br.i_abc[2]) > sc->hw_trip) {
-      hw_break(x, HAL_BREAK_OVERCURRENT);
-    }
-  }
 }
 
 int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs, void *user,
@@ -318,7 +341,6 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
   sil_commission_init(&res->commission, &sc->commission);
 
   plant_state_t st;
-  plant_brief_t br; /* what the metrics need: cheaper than plant_state_t */
   const double t_start = wall_now();
   uint64_t k = 0;
   unsigned slow_left = 0u; /* periods to the next main-loop period (k % slow_div == 0) */
@@ -364,8 +386,9 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
     /* 2. ISR (unless the interrupt is stuck) */
     const bool hw_in = x.hal.hw_tripped;
     const uint32_t hw_src = x.hal.hw_source;
-    if (!injected(&sc->isr_stall, t)) {
-      x.isr_late = injected(&sc->isr_overrun, t); /* it ends after the next valley */
+    if (!(x.rare && injected(&sc->isr_stall, t))) {
+      /* it ends after the next valley */
+      x.isr_late = x.rare && injected(&sc->isr_overrun, t);
       if (x.isr_late) {
         x.pwm_before = x.hal.pwm;
       }
@@ -384,7 +407,7 @@ int sil_run_ex(const scenario_t *sc, const sil_opts_t *opts, sil_observer_fn obs
       }
     }
     /* 3. observe */
-    plant_get_brief(&x.plant, &br);
+    const plant_brief_t br = x.br; /* the state sampled at t (sil_sample) */
     for (int j = 0; j < 3; ++j) {
       double a = fabs(br.i_abc[j]);
       if (a > res->max_phase_current) {

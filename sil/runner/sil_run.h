@@ -135,11 +135,18 @@ typedef struct {
   sil_adc_state_t adc_faults;  /* the current-ADC faults' memory */
   sil_enc_state_t enc_faults;  /* the encoder faults' memory */
   bool enc_faults_on;          /* any encoder fault in the scenario (sil_setup) */
-  bool isr_late;               /* ISR k overran: its pattern misses t_{k+1} */
-  hal_pwm_t pwm_before;        /* then: the pattern written before it */
-  bool trip_posted;            /* inject.trip_at done (once per run, resets included) */
-  bool cm_written;             /* inject.cm_scale_*: a value written, cm_last holds it */
+  /* any injection the sample or the advance checks every period (encoder
+   * invalid or faults, current faults, ISR stall or overrun, gate driver,
+   * power faults, the hardware comparator): sil_setup; without, one test */
+  bool rare;
+  bool isr_late;        /* ISR k overran: its pattern misses t_{k+1} */
+  hal_pwm_t pwm_before; /* then: the pattern written before it */
+  bool trip_posted;     /* inject.trip_at done (once per run, resets included) */
+  bool cm_written;      /* inject.cm_scale_*: a value written, cm_last holds it */
   float cm_last[2];
+  /* the plant's true values at the last sil_sample: the state the ISR and
+   * the run's metrics see (the plant does not move before sil_advance) */
+  plant_brief_t br;
 } sil_ctx_t;
 
 /* Plant, HAL and drive from the scenario; 0 or -1 with the message. */

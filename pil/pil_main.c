@@ -4,7 +4,8 @@
  * Reads pil_in.bin (an isr_stream recorded by `fluxdrive-sil --record-isr`)
  * through semihosting, initialises the drive with the recorded
  * configuration and board, and replays the exact inputs of the SIL run: per
- * record, the main loop's command block as the ISR found it, then
+ * record, the main loop's command block and identification request as the
+ * ISR found them, then
  * drive_isr() on the recorded HAL sample set. Writes one
  * isr_stream_out_t per ISR to pil_out.bin. With ISR_STREAM_FORCE_APPLIED in
  * the header, the law's applied-voltage memory is set to the host's before
@@ -50,7 +51,7 @@ static bool force_applied;
 
 __attribute__((noinline)) static void pil_step(const isr_stream_in_t *in, isr_stream_out_t *o) {
   uint32_t seq;
-  isr_stream_cmd_get(in, &seq, &drv.req.cmd);
+  isr_stream_cmd_get(in, &seq, &drv.req.cmd, &drv.req.ident);
   drv.req.seq = seq;
   hal_pil_set_input(in);
   if (force_applied) {

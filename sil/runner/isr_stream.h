@@ -25,7 +25,7 @@
 #include "drive.h"
 
 #define ISR_STREAM_MAGIC   0x52534946u /* "FISR" */
-#define ISR_STREAM_VERSION 5u
+#define ISR_STREAM_VERSION 6u
 
 /* isr_stream_header_t.flags: the replay sets the drive's applied-voltage
  * memory (drive_t.v_applied) to the host's before each ISR, see
@@ -57,7 +57,10 @@ typedef struct {
 
 /* Everything the drive sees before and during one ISR: the HAL sample set,
  * the break input, and the main loop's command block (drive_t.req) as the
- * ISR finds it. */
+ * ISR finds it, its identification request (drive_t.req.ident) included.
+ * host_proc is the one word the image does not read: the procedure the
+ * host's drive had in force after this ISR (drive_t.proc's id, PROC_NONE:
+ * none), by which `fluxdrive pil` groups the ISRs per procedure. */
 typedef struct {
   uint32_t flags;
   uint32_t time_us; /* hal_time_us() */
@@ -84,7 +87,11 @@ typedef struct {
   uint32_t fault_count[ISR_STREAM_FAULT_WORDS];
   uint32_t enable_count;
   uint32_t clear_enable_mark;
-  uint32_t reserved[ISR_STREAM_FAULT_WORDS - 2]; /* zero */
+  uint32_t fault_total; /* drive_request_fault() calls, all bits */
+  uint32_t ident_proc;  /* drive_t.req.ident: the identification asked for (proc_id_t) */
+  uint32_t ident_count; /* and drive_cmd_identify() calls */
+  uint32_t host_proc;   /* not read by the image: the host's procedure after this ISR */
+  uint32_t reserved[ISR_STREAM_FAULT_WORDS - 6]; /* zero */
   float v_applied[2]; /* host drive_t.v_applied before this ISR (alpha, beta) */
 } isr_stream_in_t;
 
@@ -120,6 +127,8 @@ ISR_STREAM_OUT_FIELDS(ISR_OUT_AT)
 
 _Static_assert(sizeof(isr_stream_header_t) == 36, "isr_stream_header_t layout");
 _Static_assert(sizeof(isr_stream_in_t) == 240, "isr_stream_in_t layout");
+/* read by `fluxdrive pil` at this offset (pil.py HOST_PROC_AT) */
+_Static_assert(offsetof(isr_stream_in_t, host_proc) == 188, "isr_stream_in_t.host_proc");
 _Static_assert(sizeof(isr_stream_out_t) == sizeof(uint32_t) * (size_t)ISR_OUT_FIELD_COUNT,
                "isr_stream_out_t layout: ISR_STREAM_OUT_FIELDS");
 _Static_assert(DRIVE_FAULT_COUNT <= ISR_STREAM_FAULT_WORDS, "fault counters");
@@ -202,8 +211,9 @@ static inline void isr_stream_caps_get(hal_caps_t *c, uint32_t *counts,
   memcpy(&c->v_full_scale, &w[12], sizeof(float));
 }
 
-/* The command block and back. */
-static inline void isr_stream_cmd_put(uint32_t req_seq, const drive_cmd_t *c, isr_stream_in_t *in) {
+/* The command block and its identification request, and back. */
+static inline void isr_stream_cmd_put(uint32_t req_seq, const drive_cmd_t *c,
+                                      const drive_ident_req_t *ident, isr_stream_in_t *in) {
   in->req_seq = req_seq;
   in->cmd_seq = c->seq;
   in->enable = c->enable;
@@ -217,14 +227,17 @@ static inline void isr_stream_cmd_put(uint32_t req_seq, const drive_cmd_t *c, is
   in->clear_count = c->clear_count;
   in->enable_count = c->enable_count;
   in->clear_enable_mark = c->clear_enable_mark;
+  in->fault_total = c->fault_total;
+  in->ident_proc = ident->proc;
+  in->ident_count = ident->count;
   memset(in->reserved, 0, sizeof in->reserved);
   for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {
     in->fault_count[b] = c->fault_count[b];
   }
 }
 
-static inline void isr_stream_cmd_get(const isr_stream_in_t *in, uint32_t *req_seq,
-                                      drive_cmd_t *c) {
+static inline void isr_stream_cmd_get(const isr_stream_in_t *in, uint32_t *req_seq, drive_cmd_t *c,
+                                      drive_ident_req_t *ident) {
   *req_seq = in->req_seq;
   c->seq = in->cmd_seq;
   c->enable = in->enable;
@@ -238,6 +251,9 @@ static inline void isr_stream_cmd_get(const isr_stream_in_t *in, uint32_t *req_s
   c->clear_count = in->clear_count;
   c->enable_count = in->enable_count;
   c->clear_enable_mark = in->clear_enable_mark;
+  c->fault_total = in->fault_total;
+  ident->proc = in->ident_proc;
+  ident->count = in->ident_count;
   for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {
     c->fault_count[b] = in->fault_count[b];
   }

@@ -280,6 +280,10 @@ def build_parser() -> argparse.ArgumentParser:
                    "this flat cycles/instruction (the report uses the cycle model)")
     p.add_argument("--functions", action="store_true",
                    help="also list the mean instructions and cycles per function")
+    p.add_argument("--procs", action="store_true",
+                   help="also group the ISRs by the procedure the host's drive had in force "
+                   "(offsets, identification ...), each reported and checked like a law; a "
+                   "run without law ISRs then reports its procedures only")
     p.add_argument("--free-running", action="store_true",
                    help="do not force the applied voltage (docs/pil.md)")
     p.add_argument("--timeout", type=float, default=600.0, help="per QEMU run [s]")

@@ -13,6 +13,9 @@ Per scenario and control law:
    line, streamed through a FIFO and counted per ISR (from drive_isr's entry
    to the first line back in its caller pil_step, callees included) and per
    function, and priced with the Cortex-M4 model (cm4_cycles).
+4. With ``--procs`` the ISRs are also grouped by the procedure the host's
+   drive had in force (the stream's ``host_proc``: offsets, identification
+   procedures, alignment ...), each group reported and checked like a law.
 
 Without ``--elf`` / ``$FLUXDRIVE_PIL_ELF`` and ``--sil`` / ``$FLUXDRIVE_SIL``
 the default image and runner of the repo are used, and built first when
@@ -82,12 +85,16 @@ HEADER = np.dtype(
         ("flags", "<u4"),
     ]
 )
-MAGIC, VERSION, FORCE_APPLIED = 0x52534946, 5, 1
+MAGIC, VERSION, FORCE_APPLIED = 0x52534946, 6, 1
 # the output record's fields, named after the signals they carry
 # (sil/runner/isr_stream.h ISR_STREAM_OUT_FIELDS, `fluxdrive signals`)
 OUT = np.dtype(pil_out())
 DUTIES = ("duty_a", "duty_b", "duty_c")
 IN_SIZE = 240
+#: Byte offset of isr_stream_in_t.host_proc (isr_stream.h asserts it): the
+#: procedure the host's drive had in force after the ISR (proc_id_t; the
+#: table's length, PROC_NONE, for none).
+HOST_PROC_AT = 188
 
 #: Blocks of the per-function share: the first pattern that a function name
 #: starts with (or equals) names its block.
@@ -141,6 +148,9 @@ BLOCKS = [
     ("libm classify/min/max/floor (newlib)", ("__fpclassifyf", "fmaxf", "fminf", "floorf",
                                               "fabsf", "scalbnf", "copysignf")),
     ("libc memset/memcpy", ("memset", "memcpy")),
+    # the procedures (proc.h: offsets, alignment, identification; FD_COLD)
+    # and the identification's estimators (core/estimation/ident_*)
+    ("procedures (proc_*, ident_*)", ("proc_", "ident_")),
     # roundf: the replay HAL's timer model (hal_pattern.h) rounds the edges;
     # called by hal_pwm_write only (cm4_cycles.stand_ins checks the image)
     ("PIL replay HAL (stands in for the register HAL)", ("hal_", "roundf")),
@@ -156,6 +166,12 @@ def block_of(func: str) -> str:
 
 
 # ------------------------------------------------------------------ files
+def host_procs(body: np.ndarray) -> np.ndarray:
+    """Per record, the host's procedure after the ISR (isr_stream_in_t.host_proc)."""
+    raw = np.frombuffer(body["in"].tobytes(), np.uint8).reshape(len(body), IN_SIZE)
+    return raw[:, HOST_PROC_AT:HOST_PROC_AT + 4].copy().view("<u4").ravel()
+
+
 def read_record(path: Path) -> tuple[bytes, np.ndarray, np.ndarray]:
     """(header+config bytes, input records as raw bytes rows, host outputs)."""
     data = path.read_bytes()
@@ -451,11 +467,39 @@ def _mean_by(run: list[int], per_isr: list[dict[str, int]]) -> tuple[dict, dict]
     return blocks, {f: v / len(run) for f, v in funcs.items()}
 
 
-def law_counts(tr: TraceResult, host: np.ndarray,
-               stand_ins: frozenset = frozenset(cm4_cycles.BOARD_HAL)) -> Counts:
+def law_isrs(tr: TraceResult, host: np.ndarray) -> list[int]:
+    """The traced ISRs that ran the control law (state RUN before and after)."""
     n = min(len(tr.counts), len(host))
     st = host["state"][:n]
-    run = [j for j in range(1, n) if st[j] == RUN and st[j - 1] == RUN]
+    return [j for j in range(1, n) if st[j] == RUN and st[j - 1] == RUN]
+
+
+def proc_isrs(tr: TraceResult, host_proc: np.ndarray, names: list[str]) -> dict[str, list[int]]:
+    """The traced ISRs per procedure, in the order the procedures first ran:
+    an ISR belongs to the procedure in force before it (its step ran, and
+    its end and the next one's start when it ended), or, when none was,
+    to the one in force after it (the ISR that took the request and began
+    the first). ``host_proc``: per ISR, the host's procedure after it
+    (isr_stream_in_t.host_proc); ``names``: the table's, by id."""
+    n = min(len(tr.counts), len(host_proc))
+    out: dict[str, list[int]] = {}
+    before = len(names)  # PROC_NONE: none after drive_init
+    for j in range(n):
+        after = int(host_proc[j])
+        p = before if before < len(names) else after
+        if p < len(names):
+            out.setdefault(names[p], []).append(j)
+        before = after
+    return out
+
+
+def law_counts(tr: TraceResult, host: np.ndarray,
+               stand_ins: frozenset = frozenset(cm4_cycles.BOARD_HAL),
+               run: list[int] | None = None) -> Counts:
+    """Counts over ``run`` (default: the law ISRs, law_isrs)."""
+    n = min(len(tr.counts), len(host))
+    if run is None:
+        run = law_isrs(tr, host)
     if not run:
         raise FluxdriveError("no ISR ran the control law in the traced window "
                              "(raise --isrs beyond the offset calibration)", exit_code=1)
@@ -495,6 +539,7 @@ class PilRun:
     counts: Counts
     trace_exact: bool  # traced replay's outputs == untraced replay's
     budget: int = BUDGET_CYCLES  # cycles per ISR at the scenario's PWM frequency
+    proc: str | None = None  # the procedure whose ISRs these are (--procs), None: the law's
 
 
 def build_default(root: Path, steps: tuple[list[str], ...], what: str) -> None:
@@ -569,8 +614,11 @@ def scenario_with_law(src: Path, law: str | None, dst: Path) -> str:
 
 def run_one(runner: Path, elf: Path, scenario: Path, law: str | None, isrs: int,
             workdir: Path, force: bool, timeout: float, tab: dict | None = None,
-            stand_ins: frozenset = frozenset(cm4_cycles.BOARD_HAL)) -> PilRun:
-    """One scenario and law; ``isrs`` ISRs traced (0: all)."""
+            stand_ins: frozenset = frozenset(cm4_cycles.BOARD_HAL),
+            procs: bool = False) -> list[PilRun]:
+    """One scenario and law; ``isrs`` ISRs traced (0: all). The law's run,
+    and with ``procs`` one per procedure that ran (proc_isrs); without
+    ``procs`` or with law ISRs traced, the law's first."""
     workdir = workdir.resolve()  # QEMU runs in it and gets the FIFO's path
     workdir.mkdir(parents=True, exist_ok=True)
     scen = workdir / "scenario.json"
@@ -593,8 +641,21 @@ def run_one(runner: Path, elf: Path, scenario: Path, law: str | None, isrs: int,
     if len(tr.counts) != n:
         raise FluxdriveError(f"trace shows {len(tr.counts)} ISRs, replayed {n}", exit_code=1)
     exact = traced_out.tobytes() == pil_out[:n].tobytes()
-    return PilRun(scenario.stem, law_name, agreement, law_counts(tr, host, stand_ins), exact,
-                  budget_cycles(scenario_pwm_hz(scen)))
+    budget = budget_cycles(scenario_pwm_hz(scen))
+    runs = []
+    if not procs or law_isrs(tr, host):
+        runs.append(PilRun(scenario.stem, law_name, agreement, law_counts(tr, host, stand_ins),
+                           exact, budget))
+    if procs:
+        names = list(params.proc_ids())
+        groups = proc_isrs(tr, host_procs(body), names)
+        if not groups and not runs:
+            raise FluxdriveError("no ISR ran the law or a procedure in the traced window",
+                                 exit_code=1)
+        for name, js in groups.items():
+            runs.append(PilRun(scenario.stem, law_name, agreement,
+                               law_counts(tr, host, stand_ins, js), exact, budget, name))
+    return runs
 
 
 # ---------------------------------------------------------------- report
@@ -654,7 +715,7 @@ def format_report(runs: list[PilRun], isrs: int, cpi: float | None = None,
     for r in runs:
         a, c = r.agreement, r.counts
         bud = r.budget  # this run's: the scenario's PWM frequency
-        lines.append(f"== {r.scenario} / {r.law}")
+        lines.append(f"== {r.scenario} / {r.law}" + (f" / procedure {r.proc}" if r.proc else ""))
         lines.append(
             f"agreement over {a.isrs} ISRs: max |duty dev| {a.max_duty_dev:.3g} at ISR "
             f"{a.max_dev_isr} (tolerance {DUTY_TOL:g}), {a.duty_bad} duty / {a.gates_bad} gate / "
@@ -662,7 +723,8 @@ def format_report(runs: list[PilRun], isrs: int, cpi: float | None = None,
             f"{'OK' if a.ok else 'FAIL'}"
         )
         lines.append(
-            f"instructions per ISR over {c.isrs} law ISRs ({traced_text(isrs, a.isrs)}): mean "
+            f"instructions per ISR over {c.isrs} {'ISRs of the procedure' if r.proc else 'law ISRs'}"
+            f" ({traced_text(isrs, a.isrs)}): mean "
             f"{c.mean:.0f}, worst {c.worst} (ISR {c.worst_isr}); traced outputs identical to "
             f"untraced: {r.trace_exact}"
         )
@@ -740,7 +802,7 @@ def format_markdown(runs: list[PilRun], isrs: int, cpi: float | None, build: str
     for r in runs:
         c, a = r.counts, r.agreement
         out.append(
-            f"| {r.scenario} | {r.law} | {c.isrs} | {c.mean:.0f} | {c.worst} | "
+            f"| {r.scenario} | {_law_label(r)} | {c.isrs} | {c.mean:.0f} | {c.worst} | "
             f"{c.cycles_mean:.0f} | {c.cycles_worst} | {c.cpi:.2f} | "
             f"{_pct(c.cycles_mean, r.budget)} | {_pct(c.cycles_worst, r.budget)} |"
             + (f" {_pct(c.worst * cpi, r.budget)} |" if cpi else "")
@@ -769,7 +831,7 @@ def format_markdown(runs: list[PilRun], isrs: int, cpi: float | None, build: str
             bc = board_estimate_cordic(r.counts, board)
             cc = (f"{bc[0]:.0f} ({_pct(bc[0], r.budget)}) | {bc[1]:.0f} "
                   f"({_pct(bc[1], r.budget)})" if bc is not None else "- | -")
-            out.append(f"| {r.scenario} | {r.law} | {bt:.0f} ({_pct(bt, r.budget)}) | "
+            out.append(f"| {r.scenario} | {_law_label(r)} | {bt:.0f} ({_pct(bt, r.budget)}) | "
                        f"{bw:.0f} ({_pct(bw, r.budget)}) | {cc} |")
         out.append("")
     out.append("Share of the mean per block (instructions per ISR, % of the mean; estimated "
@@ -777,7 +839,7 @@ def format_markdown(runs: list[PilRun], isrs: int, cpi: float | None, build: str
     out.append("")
     for r in runs:
         c = r.counts
-        out.append(f"* {r.scenario} / {r.law}: " + "; ".join(
+        out.append(f"* {r.scenario} / {_law_label(r)}: " + "; ".join(
             f"{b} {v:.0f} ({100 * v / c.mean:.0f} %, {c.block_cycles.get(b, 0.0):.0f} cyc)"
             for b, v in sorted(c.blocks.items(), key=lambda kv: -kv[1]) if v >= 0.5))
     out.append("")
@@ -852,12 +914,14 @@ def main(args) -> int:
         for law in laws:
             t0 = time.monotonic()
             wd = out_dir / f"{sc.stem}-{law or 'scenario'}"
-            r = run_one(runner, elf, sc, law, args.isrs, wd, not args.free_running,
-                        args.timeout, dict(tab), hal)
-            runs.append(r)
-            print(format_report([r], args.isrs, cpi, board, args.functions), flush=True)
+            rr = run_one(runner, elf, sc, law, args.isrs, wd, not args.free_running,
+                         args.timeout, dict(tab), hal, getattr(args, "procs", False))
+            runs += rr
+            print(format_report(rr, args.isrs, cpi, board, args.functions), flush=True)
             print(f"  ({time.monotonic() - t0:.1f} s, files in {wd})", flush=True)
     build = "MinSizeRel -Os, -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard"
+    if getattr(args, "procs", False):
+        print(format_proc_table(runs, board))
     md = format_markdown(runs, args.isrs, cpi, build, board)
     if args.markdown:
         update_markdown(Path(args.markdown), md)
@@ -872,7 +936,7 @@ def main(args) -> int:
             ok = bc is not None and bc[1] <= lim / 100.0 * r.budget
             got = "not measured (needs --board-elf)" if bc is None else \
                 f"{bc[1]:.0f} estimated cycles = {100 * bc[1] / r.budget:.1f} % of {r.budget}"
-            print(f"{'check' if ok else 'FAIL'}: {r.scenario}/{r.law}: board worst case with the "
+            print(f"{'check' if ok else 'FAIL'}: {_name(r)}: board worst case with the "
                   f"trigonometry on the CORDIC co-processor {got}, limit {lim:g} %")
             rc |= 0 if ok else 1
     lim = getattr(args, "check_mean_cordic", None)
@@ -882,10 +946,39 @@ def main(args) -> int:
             ok = tc is not None and tc < lim
             got = "not measured (needs --board-elf and --functions)" if tc is None else \
                 f"{tc:.0f} instructions"
-            print(f"{'check' if ok else 'FAIL'}: {r.scenario}/{r.law}: mean with the trigonometry "
+            print(f"{'check' if ok else 'FAIL'}: {_name(r)}: mean with the trigonometry "
                   f"on the CORDIC co-processor {got}, limit {lim}")
             rc |= 0 if ok else 1
     return rc
+
+
+def _law_label(r: PilRun) -> str:
+    """The law, or for a procedure's ISRs (--procs) the procedure."""
+    return f"{r.law}, procedure {r.proc}" if r.proc else r.law
+
+
+def _name(r: PilRun) -> str:
+    return f"{r.scenario}/{r.law}" + (f"/{r.proc}" if r.proc else "")
+
+
+def format_proc_table(runs: list[PilRun], board: cm4_cycles.BoardBound | None) -> str:
+    """The procedures' ISR cost (--procs): per procedure and scenario, its
+    ISRs, instructions mean and worst, estimated cycles worst, and the
+    board worst case (the CORDIC estimate, as --check-board) in % of the
+    budget."""
+    lines = ["procedure ISR cost (PIL; board worst: estimated cycles, trigonometry on the "
+             "CORDIC, % of the budget)",
+             f"  {'procedure':10s} {'scenario':24s} {'ISRs':>7s} {'mean':>6s} {'worst':>6s} "
+             f"{'cyc worst':>9s} {'board worst':>11s}"]
+    for r in runs:
+        if not r.proc:
+            continue
+        c = r.counts
+        bc = board_estimate_cordic(c, board) if board is not None else None
+        bw = f"{100 * bc[1] / r.budget:10.1f}%" if bc is not None else f"{'-':>11s}"
+        lines.append(f"  {r.proc:10s} {r.scenario:24s} {c.isrs:7d} {c.mean:6.0f} {c.worst:6d} "
+                     f"{c.cycles_worst:9d} {bw}")
+    return "\n".join(lines)
 
 
 def parse_call_limits(items: list[str] | None) -> dict[str, float]:
@@ -915,7 +1008,7 @@ def check_runs(runs: list[PilRun], worst_instr: int | None, worst_pct: float | N
     rc = 0
     limits = parse_call_limits(call_limits)
     for r in runs:
-        name = f"{r.scenario}/{r.law}"
+        name = f"{r.scenario}/{r.law}" + (f"/{r.proc}" if r.proc else "")
         for f, lim in limits.items():
             k, v = r.counts.calls.get(f, (0.0, float("inf")))
             ok = k > 0 and v <= lim
@@ -938,7 +1031,7 @@ def check_runs(runs: list[PilRun], worst_instr: int | None, worst_pct: float | N
             print(f"{'check' if ok else 'FAIL'}: {name}: worst case {r.counts.worst} instructions "
                   f"(ISR {r.counts.worst_isr}), limit {worst_all}")
             rc |= 0 if ok else 1
-        if r.law != "db_dfvc":
+        if r.law != "db_dfvc" or r.proc:
             continue
         c = r.counts
         if worst_instr:

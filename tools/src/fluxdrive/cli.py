@@ -284,6 +284,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also group the ISRs by the procedure the host's drive had in force "
                    "(offsets, identification ...), each reported and checked like a law; a "
                    "run without law ISRs then reports its procedures only")
+    p.add_argument("--proc-limit", action="append", default=[], metavar="PROC=MEAN,WORST,PCT",
+                   help="with --procs: check PROC's ISRs against these (mean and worst "
+                   "instructions, board worst %% of the budget) in place of --check-mean, "
+                   "--check-worst-all and --check-board (repeatable; a guard for a procedure "
+                   "not yet within those, docs/pil.md)")
     p.add_argument("--free-running", action="store_true",
                    help="do not force the applied voltage (docs/pil.md)")
     p.add_argument("--timeout", type=float, default=600.0, help="per QEMU run [s]")

@@ -99,6 +99,16 @@ HOST_PROC_AT = 188
 #: Blocks of the per-function share: the first pattern that a function name
 #: starts with (or equals) names its block.
 BLOCKS = [
+    # the procedures (proc.h: offsets, alignment, held start, identification;
+    # FD_COLD, in flash on the board): each row's static functions
+    # (proc_<name>.c) and the identification's estimators (core/estimation/
+    # ident_*); enc_ and flux_ named exactly (the encoder source, the flux
+    # observer share the prefixes)
+    ("procedures (proc_*.c rows, ident_*)",
+     ("proc_", "ident_", "offset_", "align_", "hold_", "rs_", "ldq_", "fmap_", "poles_",
+      "star_", "mech_", "enc_step", "enc_init", "enc_publish", "enc_target", "flux_step",
+      "flux_init", "flux_publish", "flux_acc", "flux_lambda", "pulse", "pulse_periods",
+      "zero_current")),
     # protect_: the protections, owned parts of the drive (firmware/app/protect)
     ("drive (ISR body, commands, protections, offsets)", ("drive_", "protect_",
                                                           "hal_pwm_centred")),
@@ -148,9 +158,6 @@ BLOCKS = [
     ("libm classify/min/max/floor (newlib)", ("__fpclassifyf", "fmaxf", "fminf", "floorf",
                                               "fabsf", "scalbnf", "copysignf")),
     ("libc memset/memcpy", ("memset", "memcpy")),
-    # the procedures (proc.h: offsets, alignment, identification; FD_COLD)
-    # and the identification's estimators (core/estimation/ident_*)
-    ("procedures (proc_*, ident_*)", ("proc_", "ident_")),
     # roundf: the replay HAL's timer model (hal_pattern.h) rounds the edges;
     # called by hal_pwm_write only (cm4_cycles.stand_ins checks the image)
     ("PIL replay HAL (stands in for the register HAL)", ("hal_", "roundf")),
@@ -889,6 +896,10 @@ def main(args) -> int:
         bad = [x for x in laws if x not in LAWS]
         if bad:
             raise FluxdriveError(f"unknown law {bad[0]!r}; use {', '.join(LAWS)}")
+    try:
+        guards = parse_proc_limits(getattr(args, "proc_limit", None))
+    except ValueError as exc:
+        raise FluxdriveError(str(exc)) from None
     runner = locate_runner(args.sil)
     elf = locate_elf(args.elf)
     # absolute: QEMU runs with its working directory in here
@@ -926,19 +937,18 @@ def main(args) -> int:
     if args.markdown:
         update_markdown(Path(args.markdown), md)
         print(f"markdown: {args.markdown} (section '{SECTION.lstrip('# ')}')")
-    rc = check_runs(runs, args.check_worst, getattr(args, "check_cycles", None),
+    plain = [r for r in runs if r.proc not in guards]
+    rc = check_runs(plain, args.check_worst, getattr(args, "check_cycles", None),
                     getattr(args, "check_mean", None), getattr(args, "check_call", None),
                     getattr(args, "check_worst_all", None))
-    lim = getattr(args, "check_board", None)
-    if lim:
-        for r in runs:
-            bc = board_estimate_cordic(r.counts, board) if board is not None else None
-            ok = bc is not None and bc[1] <= lim / 100.0 * r.budget
-            got = "not measured (needs --board-elf)" if bc is None else \
-                f"{bc[1]:.0f} estimated cycles = {100 * bc[1] / r.budget:.1f} % of {r.budget}"
-            print(f"{'check' if ok else 'FAIL'}: {_name(r)}: board worst case with the "
-                  f"trigonometry on the CORDIC co-processor {got}, limit {lim:g} %")
-            rc |= 0 if ok else 1
+    rc |= check_board(plain, getattr(args, "check_board", None), board)
+    for name, (mean, worst, pct) in guards.items():
+        mine = [r for r in runs if r.proc == name]
+        if not mine:
+            print(f"FAIL: --proc-limit {name}: the procedure did not run in the traced window")
+            rc = 1
+        rc |= check_runs(mine, None, None, mean, None, worst)
+        rc |= check_board(mine, pct, board)
     lim = getattr(args, "check_mean_cordic", None)
     if lim:
         for r in runs:
@@ -950,6 +960,42 @@ def main(args) -> int:
                   f"on the CORDIC co-processor {got}, limit {lim}")
             rc |= 0 if ok else 1
     return rc
+
+
+def check_board(runs: list[PilRun], lim: float | None,
+                board: cm4_cycles.BoardBound | None) -> int:
+    """--check-board: each run's board worst case with the trigonometry on
+    the CORDIC at most ``lim`` % of its budget. Prints; 1 on failure."""
+    rc = 0
+    if not lim:
+        return rc
+    for r in runs:
+        bc = board_estimate_cordic(r.counts, board) if board is not None else None
+        ok = bc is not None and bc[1] <= lim / 100.0 * r.budget
+        got = "not measured (needs --board-elf)" if bc is None else \
+            f"{bc[1]:.0f} estimated cycles = {100 * bc[1] / r.budget:.1f} % of {r.budget}"
+        print(f"{'check' if ok else 'FAIL'}: {_name(r)}: board worst case with the "
+              f"trigonometry on the CORDIC co-processor {got}, limit {lim:g} %")
+        rc |= 0 if ok else 1
+    return rc
+
+
+def parse_proc_limits(items: list[str] | None) -> dict[str, tuple[int, int, float]]:
+    """--proc-limit PROC=MEAN,WORST,PCT items as {PROC: (MEAN, WORST, PCT)}:
+    that procedure's ISRs checked against these (mean and worst instructions,
+    board worst % of the budget) in place of --check-mean, --check-worst-all
+    and --check-board. ValueError names a bad one."""
+    out = {}
+    for it in items or []:
+        name, sep, rest = it.partition("=")
+        try:
+            m, w, p = (float(x) for x in rest.split(","))
+        except ValueError:
+            m = w = p = -1.0
+        if not sep or not name or min(m, w, p) <= 0:
+            raise ValueError(f"--proc-limit {it!r}: expected PROC=MEAN,WORST,PCT, each > 0")
+        out[name] = (int(m), int(w), p)
+    return out
 
 
 def _law_label(r: PilRun) -> str:

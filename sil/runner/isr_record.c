@@ -7,8 +7,9 @@
  * between ISRs: after ISR k it still holds what ISR k read; its
  * identification request req.ident too) and the drive's applied-voltage
  * memory before the ISR (drive_t.v_applied after ISR k-1). Besides, the
- * procedure the drive has in force after the ISR (host_proc: the tool's
- * grouping per procedure, not an input).
+ * procedure the drive has in force after the ISR and its phase
+ * (host_proc, host_phase: the tool's grouping per procedure and its
+ * sample, not inputs).
  */
 #include "isr_record.h"
 
@@ -93,6 +94,7 @@ void isr_record_observer(void *user, const sil_step_t *st) {
   in->t_enc = s->t_enc;
   isr_stream_cmd_put(drv->req.seq, &drv->req.cmd, &drv->req.ident, in);
   in->host_proc = drv->proc != NULL ? (uint32_t)drv->proc->id : (uint32_t)PROC_NONE;
+  in->host_phase = drv->tm.proc.phase;
   in->v_applied[0] = r->prev_v_applied[0];
   in->v_applied[1] = r->prev_v_applied[1];
   r->prev_v_applied[0] = drv->v_applied.alpha;

@@ -31,6 +31,14 @@
  * memory (drive_t.v_applied) to the host's before each ISR, see
  * docs/pil.md ("Why the applied voltage is forced"). */
 #define ISR_STREAM_FORCE_APPLIED (1u << 0)
+/* The replay's RAM state (its .data and .bss: the drive, the replay HAL,
+ * the configuration) in a file pil_snap.bin, so that a traced replay can
+ * start at a record other than the first (`fluxdrive pil --sample`): LOAD
+ * takes the state from it in place of drive_init (the file's records are
+ * the ones that follow that state), SAVE writes it after the last record.
+ * Set by `fluxdrive pil` in the copy it gives the image (docs/pil.md). */
+#define ISR_STREAM_SNAP_LOAD (1u << 1)
+#define ISR_STREAM_SNAP_SAVE (1u << 2)
 
 /* isr_stream_in_t.flags */
 #define ISR_IN_ENC_VALID   (1u << 0) /* hal_sample_t.enc_valid */
@@ -52,15 +60,16 @@ typedef struct {
   uint32_t in_size;     /* sizeof(isr_stream_in_t) */
   uint32_t out_size;    /* sizeof(isr_stream_out_t) */
   uint32_t count;       /* records */
-  uint32_t flags;       /* ISR_STREAM_FORCE_APPLIED (set by the PIL runner) */
+  uint32_t flags;       /* ISR_STREAM_FORCE_APPLIED, _SNAP_* (set by the PIL runner) */
 } isr_stream_header_t;
 
 /* Everything the drive sees before and during one ISR: the HAL sample set,
  * the break input, and the main loop's command block (drive_t.req) as the
  * ISR finds it, its identification request (drive_t.req.ident) included.
- * host_proc is the one word the image does not read: the procedure the
- * host's drive had in force after this ISR (drive_t.proc's id, PROC_NONE:
- * none), by which `fluxdrive pil` groups the ISRs per procedure. */
+ * host_proc and host_phase are the words the image does not read: the
+ * procedure the host's drive had in force after this ISR (drive_t.proc's
+ * id, PROC_NONE: none) and its phase (the procedure telemetry's), by which
+ * `fluxdrive pil` groups the ISRs per procedure and places its sample. */
 typedef struct {
   uint32_t flags;
   uint32_t time_us; /* hal_time_us() */
@@ -91,7 +100,8 @@ typedef struct {
   uint32_t ident_proc;  /* drive_t.req.ident: the identification asked for (proc_id_t) */
   uint32_t ident_count; /* and drive_cmd_identify() calls */
   uint32_t host_proc;   /* not read by the image: the host's procedure after this ISR */
-  uint32_t reserved[ISR_STREAM_FAULT_WORDS - 6]; /* zero */
+  uint32_t host_phase;  /* nor this: its phase (drive_t.tm.proc.phase) */
+  uint32_t reserved[ISR_STREAM_FAULT_WORDS - 7]; /* zero */
   float v_applied[2]; /* host drive_t.v_applied before this ISR (alpha, beta) */
 } isr_stream_in_t;
 
@@ -127,8 +137,9 @@ ISR_STREAM_OUT_FIELDS(ISR_OUT_AT)
 
 _Static_assert(sizeof(isr_stream_header_t) == 36, "isr_stream_header_t layout");
 _Static_assert(sizeof(isr_stream_in_t) == 240, "isr_stream_in_t layout");
-/* read by `fluxdrive pil` at this offset (pil.py HOST_PROC_AT) */
+/* read by `fluxdrive pil` at these offsets (pil.py HOST_PROC_AT) */
 _Static_assert(offsetof(isr_stream_in_t, host_proc) == 188, "isr_stream_in_t.host_proc");
+_Static_assert(offsetof(isr_stream_in_t, host_phase) == 192, "isr_stream_in_t.host_phase");
 _Static_assert(sizeof(isr_stream_out_t) == sizeof(uint32_t) * (size_t)ISR_OUT_FIELD_COUNT,
                "isr_stream_out_t layout: ISR_STREAM_OUT_FIELDS");
 _Static_assert(DRIVE_FAULT_COUNT <= ISR_STREAM_FAULT_WORDS, "fault counters");

@@ -284,6 +284,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also group the ISRs by the procedure the host's drive had in force "
                    "(offsets, identification ...), each reported and checked like a law; a "
                    "run without law ISRs then reports its procedures only")
+    p.add_argument("--sample", type=_positive_int, metavar="W",
+                   help="with --procs: trace, in place of the first --isrs ISRs, windows: of "
+                   "each procedure's run its first and last W ISRs and W around each change "
+                   "of its phase (the replay's state carried into each window through "
+                   "pil_snap.bin; every ISR is still replayed and compared)")
     p.add_argument("--proc-limit", action="append", default=[], metavar="PROC=MEAN,WORST,PCT",
                    help="with --procs: check PROC's ISRs against these (mean and worst "
                    "instructions, board worst %% of the budget) in place of --check-mean, "

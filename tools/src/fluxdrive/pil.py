@@ -86,6 +86,8 @@ HEADER = np.dtype(
     ]
 )
 MAGIC, VERSION, FORCE_APPLIED = 0x52534946, 6, 1
+#: header flags: the replay's RAM state from / to pil_snap.bin (isr_stream.h)
+SNAP_LOAD, SNAP_SAVE = 2, 4
 # the output record's fields, named after the signals they carry
 # (sil/runner/isr_stream.h ISR_STREAM_OUT_FIELDS, `fluxdrive signals`)
 OUT = np.dtype(pil_out())
@@ -95,6 +97,7 @@ IN_SIZE = 240
 #: procedure the host's drive had in force after the ISR (proc_id_t; the
 #: table's length, PROC_NONE, for none).
 HOST_PROC_AT = 188
+HOST_PHASE_AT = 192  # isr_stream_in_t.host_phase: its phase (the procedure telemetry's)
 
 #: Blocks of the per-function share: the first pattern that a function name
 #: starts with (or equals) names its block.
@@ -173,10 +176,47 @@ def block_of(func: str) -> str:
 
 
 # ------------------------------------------------------------------ files
-def host_procs(body: np.ndarray) -> np.ndarray:
-    """Per record, the host's procedure after the ISR (isr_stream_in_t.host_proc)."""
+def host_procs(body: np.ndarray, at: int = HOST_PROC_AT) -> np.ndarray:
+    """Per record, the host's procedure after the ISR (isr_stream_in_t.host_proc;
+    ``at`` = HOST_PHASE_AT: its phase)."""
     raw = np.frombuffer(body["in"].tobytes(), np.uint8).reshape(len(body), IN_SIZE)
-    return raw[:, HOST_PROC_AT:HOST_PROC_AT + 4].copy().view("<u4").ravel()
+    return raw[:, at:at + 4].copy().view("<u4").ravel()
+
+
+def sample_windows(host_proc: np.ndarray, host_phase: np.ndarray, names: list[str],
+                   w: int) -> list[tuple[int, int]]:
+    """The ISRs --sample W traces, as merged windows [a, b): of every run of
+    a procedure (proc_isrs' attribution) its first and last W ISRs and W
+    around each change of its phase (where its fits and hand-overs run)."""
+    n = len(host_proc)
+    owner = np.full(n, -1)
+    before = len(names)
+    for j in range(n):
+        after = int(host_proc[j])
+        p = before if before < len(names) else after
+        owner[j] = p if p < len(names) else -1
+        before = after
+    win = []
+    j = 0
+    while j < n:
+        if owner[j] < 0:
+            j += 1
+            continue
+        k = j
+        while k + 1 < n and owner[k + 1] == owner[j]:
+            k += 1
+        win += [(j, j + w), (k + 1 - w, k + 1)]
+        for i in range(j + 1, k + 1):
+            if host_phase[i] != host_phase[i - 1]:
+                win.append((i - w // 2, i + w - w // 2))
+        j = k + 1
+    out: list[list[int]] = []
+    for a, b in sorted((max(a, 0), min(b, n)) for a, b in win):
+        if out and a <= out[-1][1]:
+            out[-1][1] = max(out[-1][1], b)
+        else:
+            out.append([a, b])
+    return [(a, b) for a, b in out]
 
 
 def read_record(path: Path) -> tuple[bytes, np.ndarray, np.ndarray]:
@@ -196,14 +236,16 @@ def read_record(path: Path) -> tuple[bytes, np.ndarray, np.ndarray]:
     return data[:start], body, body["out"]
 
 
-def write_pil_input(path: Path, head: bytes, body: np.ndarray, n: int, force: bool) -> None:
+def write_pil_input(path: Path, head: bytes, body: np.ndarray, n: int, force: bool,
+                    start: int = 0, snap: int = 0) -> None:
+    """pil_in.bin of records [start, n); ``snap``: SNAP_LOAD | SNAP_SAVE."""
     h = np.frombuffer(head, HEADER, count=1).copy()
-    h["count"] = n
-    h["flags"] = FORCE_APPLIED if force else 0
+    h["count"] = n - start
+    h["flags"] = (FORCE_APPLIED if force else 0) | snap
     with open(path, "wb") as f:
         f.write(h.tobytes())
         f.write(head[HEADER.itemsize:])
-        f.write(body[:n].tobytes())
+        f.write(body[start:n].tobytes())
 
 
 # ------------------------------------------------------------------- qemu
@@ -478,7 +520,8 @@ def law_isrs(tr: TraceResult, host: np.ndarray) -> list[int]:
     """The traced ISRs that ran the control law (state RUN before and after)."""
     n = min(len(tr.counts), len(host))
     st = host["state"][:n]
-    return [j for j in range(1, n) if st[j] == RUN and st[j - 1] == RUN]
+    return [j for j in range(1, n) if st[j] == RUN and st[j - 1] == RUN
+            and tr.counts[j] is not None]
 
 
 def proc_isrs(tr: TraceResult, host_proc: np.ndarray, names: list[str]) -> dict[str, list[int]]:
@@ -494,7 +537,7 @@ def proc_isrs(tr: TraceResult, host_proc: np.ndarray, names: list[str]) -> dict[
     for j in range(n):
         after = int(host_proc[j])
         p = before if before < len(names) else after
-        if p < len(names):
+        if p < len(names) and tr.counts[j] is not None:  # None: not traced (--sample)
             out.setdefault(names[p], []).append(j)
         before = after
     return out
@@ -547,6 +590,7 @@ class PilRun:
     trace_exact: bool  # traced replay's outputs == untraced replay's
     budget: int = BUDGET_CYCLES  # cycles per ISR at the scenario's PWM frequency
     proc: str | None = None  # the procedure whose ISRs these are (--procs), None: the law's
+    traced: int | None = None  # ISRs traced in --sample's windows (None: a prefix, --isrs)
 
 
 def build_default(root: Path, steps: tuple[list[str], ...], what: str) -> None:
@@ -619,10 +663,42 @@ def scenario_with_law(src: Path, law: str | None, dst: Path) -> str:
     return str(ctrl.get("law", "foc"))
 
 
+def trace_windows(elf: Path, workdir: Path, head: bytes, body: np.ndarray, force: bool,
+                  timeout: float, tab: dict | None, windows: list[tuple[int, int]],
+                  untraced: np.ndarray) -> tuple[TraceResult, bool]:
+    """Traces the ISRs of ``windows`` only: the records before each window
+    replayed untraced up to it (from the previous window's state), its state
+    saved (pil_snap.bin), the window traced from that state. The per-ISR
+    lists have an entry per record, None where not traced; True when every
+    window's outputs equal the untraced replay's."""
+    n = len(body)
+    tr = TraceResult(counts=[None] * n, funcs=[None] * n, cycles=[None] * n,
+                     func_cycles=[None] * n, calls=[None] * n)
+    exact, pos = True, 0
+    (workdir / "pil_snap.bin").unlink(missing_ok=True)
+    for a, b in windows:
+        if a > pos:  # the gap, untraced, from the state at pos to the state at a
+            write_pil_input(workdir / "pil_in.bin", head, body, a, force, pos,
+                            SNAP_SAVE | (SNAP_LOAD if pos else 0))
+            run_qemu(elf, workdir, timeout)
+        write_pil_input(workdir / "pil_in.bin", head, body, b, force, a,
+                        SNAP_SAVE | (SNAP_LOAD if a else 0))
+        w, out = run_qemu_trace(elf, workdir, timeout, tab)
+        if len(w.counts) != b - a:
+            raise FluxdriveError(f"trace shows {len(w.counts)} ISRs, replayed {b - a}",
+                                 exit_code=1)
+        exact &= out.tobytes() == untraced[a:b].tobytes()
+        for name in ("counts", "funcs", "cycles", "func_cycles", "calls"):
+            getattr(tr, name)[a:b] = getattr(w, name)
+        tr.unknown_pcs |= w.unknown_pcs
+        pos = b
+    return tr, exact
+
+
 def run_one(runner: Path, elf: Path, scenario: Path, law: str | None, isrs: int,
             workdir: Path, force: bool, timeout: float, tab: dict | None = None,
             stand_ins: frozenset = frozenset(cm4_cycles.BOARD_HAL),
-            procs: bool = False) -> list[PilRun]:
+            procs: bool = False, sample: int = 0) -> list[PilRun]:
     """One scenario and law; ``isrs`` ISRs traced (0: all). The law's run,
     and with ``procs`` one per procedure that ran (proc_isrs); without
     ``procs`` or with law ISRs traced, the law's first."""
@@ -642,26 +718,37 @@ def run_one(runner: Path, elf: Path, scenario: Path, law: str | None, isrs: int,
     pil_out = run_qemu(elf, workdir, timeout)
     agreement = compare(host, pil_out)
 
-    n = len(body) if isrs <= 0 else min(isrs, len(body))
-    write_pil_input(workdir / "pil_in.bin", head, body, n, force)
-    tr, traced_out = run_qemu_trace(elf, workdir, timeout, tab)
-    if len(tr.counts) != n:
-        raise FluxdriveError(f"trace shows {len(tr.counts)} ISRs, replayed {n}", exit_code=1)
-    exact = traced_out.tobytes() == pil_out[:n].tobytes()
+    names = list(params.proc_ids())
+    traced = None
+    if sample > 0:
+        windows = sample_windows(host_procs(body), host_procs(body, HOST_PHASE_AT), names,
+                                 sample)
+        if not windows:
+            raise FluxdriveError("--sample: no procedure ran in this scenario", exit_code=1)
+        tr, exact = trace_windows(elf, workdir, head, body, force, timeout, tab, windows,
+                                  pil_out)
+        traced = sum(b - a for a, b in windows)
+    else:
+        n = len(body) if isrs <= 0 else min(isrs, len(body))
+        write_pil_input(workdir / "pil_in.bin", head, body, n, force)
+        tr, traced_out = run_qemu_trace(elf, workdir, timeout, tab)
+        if len(tr.counts) != n:
+            raise FluxdriveError(f"trace shows {len(tr.counts)} ISRs, replayed {n}", exit_code=1)
+        exact = traced_out.tobytes() == pil_out[:n].tobytes()
     budget = budget_cycles(scenario_pwm_hz(scen))
     runs = []
     if not procs or law_isrs(tr, host):
         runs.append(PilRun(scenario.stem, law_name, agreement, law_counts(tr, host, stand_ins),
-                           exact, budget))
+                           exact, budget, traced=traced))
     if procs:
-        names = list(params.proc_ids())
         groups = proc_isrs(tr, host_procs(body), names)
         if not groups and not runs:
             raise FluxdriveError("no ISR ran the law or a procedure in the traced window",
                                  exit_code=1)
         for name, js in groups.items():
             runs.append(PilRun(scenario.stem, law_name, agreement,
-                               law_counts(tr, host, stand_ins, js), exact, budget, name))
+                               law_counts(tr, host, stand_ins, js), exact, budget, name,
+                               traced))
     return runs
 
 
@@ -710,7 +797,9 @@ def trig_on_cordic(c: Counts, board: cm4_cycles.BoardBound) -> float | None:
     return c.mean - sw + hw
 
 
-def traced_text(isrs: int, total: int) -> str:
+def traced_text(isrs: int, total: int, sampled: int | None = None) -> str:
+    if sampled is not None:
+        return f"{sampled} of {total} ISRs traced: --sample's windows"
     if isrs <= 0 or isrs >= total:
         return f"all {total} ISRs traced"
     return f"first {isrs} of {total} ISRs traced"
@@ -731,7 +820,7 @@ def format_report(runs: list[PilRun], isrs: int, cpi: float | None = None,
         )
         lines.append(
             f"instructions per ISR over {c.isrs} {'ISRs of the procedure' if r.proc else 'law ISRs'}"
-            f" ({traced_text(isrs, a.isrs)}): mean "
+            f" ({traced_text(isrs, a.isrs, r.traced)}): mean "
             f"{c.mean:.0f}, worst {c.worst} (ISR {c.worst_isr}); traced outputs identical to "
             f"untraced: {r.trace_exact}"
         )
@@ -926,7 +1015,8 @@ def main(args) -> int:
             t0 = time.monotonic()
             wd = out_dir / f"{sc.stem}-{law or 'scenario'}"
             rr = run_one(runner, elf, sc, law, args.isrs, wd, not args.free_running,
-                         args.timeout, dict(tab), hal, getattr(args, "procs", False))
+                         args.timeout, dict(tab), hal, getattr(args, "procs", False),
+                         getattr(args, "sample", 0) or 0)
             runs += rr
             print(format_report(rr, args.isrs, cpi, board, args.functions), flush=True)
             print(f"  ({time.monotonic() - t0:.1f} s, files in {wd})", flush=True)

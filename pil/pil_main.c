@@ -4,14 +4,22 @@
  * Reads pil_in.bin (an isr_stream recorded by `fluxdrive-sil --record-isr`)
  * through semihosting, initialises the drive with the recorded
  * configuration and board, and replays the exact inputs of the SIL run: per
- * record, the main loop's command block as the ISR found it, then
+ * record, the main loop's command block and identification request as the
+ * ISR found them, then
  * drive_isr() on the recorded HAL sample set. Writes one
  * isr_stream_out_t per ISR to pil_out.bin. With ISR_STREAM_FORCE_APPLIED in
  * the header, the law's applied-voltage memory is set to the host's before
  * each ISR (outside the counted ISR; docs/pil.md explains why).
  *
+ * With ISR_STREAM_SNAP_LOAD the state comes from pil_snap.bin (a replay of
+ * the records before these, SNAP_SAVE) in place of drive_init; with
+ * SNAP_SAVE it is written there after the last record: the whole .data and
+ * .bss (the drive, the replay HAL, the configuration and the map; the
+ * image has no other state), so a traced replay starts anywhere in a run.
+ *
  * Exit status: 0 done, 2 input file, 3 stream format, 4 drive_init
- * rejected the configuration, 5 output file, 70 fault exception.
+ * rejected the configuration, 5 output file, 6 snapshot file, 70 fault
+ * exception.
  *
  * Instruction counting (`fluxdrive pil`): drive_isr() is called only from
  * pil_step(), so an ISR spans the trace lines from drive_isr's entry to the
@@ -38,6 +46,24 @@ static drive_t drv;
 static record_t rec[CHUNK];
 static isr_stream_out_t out[CHUNK];
 
+/* the image's RAM state (mps2_an386.ld: .data, then .bss) */
+extern uint32_t _sdata, _ebss;
+
+static size_t snap_bytes(void) {
+  return (size_t)((uintptr_t)&_ebss - (uintptr_t)&_sdata);
+}
+
+/* Reads (load) or writes the RAM state from or to pil_snap.bin: 0, or -1. */
+static int snap(bool load) {
+  const int32_t f = sh_open("pil_snap.bin", load ? "rb" : "wb");
+  if (f < 0) {
+    return -1;
+  }
+  const int r = load ? sh_read(f, &_sdata, snap_bytes()) : sh_write(f, &_sdata, snap_bytes());
+  sh_close(f);
+  return r;
+}
+
 static int fail(int code, const char *msg) {
   sh_puts("fluxdrive-pil: ");
   sh_puts(msg);
@@ -50,7 +76,7 @@ static bool force_applied;
 
 __attribute__((noinline)) static void pil_step(const isr_stream_in_t *in, isr_stream_out_t *o) {
   uint32_t seq;
-  isr_stream_cmd_get(in, &seq, &drv.req.cmd);
+  isr_stream_cmd_get(in, &seq, &drv.req.cmd, &drv.req.ident);
   drv.req.seq = seq;
   hal_pil_set_input(in);
   if (force_applied) {
@@ -103,13 +129,22 @@ int main(void) {
   hal_caps_t caps;
   uint32_t counts;
   isr_stream_caps_get(&caps, &counts, cwords);
-  hal_pil_set_caps(&caps, counts);
-  drive_config_err_t err;
-  if (drive_init(&drv, &cfg, &err) != 0) {
-    sh_puts(err.field);
-    sh_puts(": ");
-    sh_puts(err.reason);
-    return fail(4, ": drive_init rejected the recorded configuration");
+  if ((h.flags & ISR_STREAM_SNAP_LOAD) != 0u) {
+    /* the state after the records before these (the same configuration:
+     * the words and the map read above are restored as they were) */
+    if (snap(true) != 0) {
+      return fail(6, "cannot read pil_snap.bin");
+    }
+    force_applied = (h.flags & ISR_STREAM_FORCE_APPLIED) != 0u; /* this file's */
+  } else {
+    hal_pil_set_caps(&caps, counts);
+    drive_config_err_t err;
+    if (drive_init(&drv, &cfg, &err) != 0) {
+      sh_puts(err.field);
+      sh_puts(": ");
+      sh_puts(err.reason);
+      return fail(4, ": drive_init rejected the recorded configuration");
+    }
   }
   const int32_t fout = sh_open("pil_out.bin", "wb");
   if (fout < 0) {
@@ -132,5 +167,8 @@ int main(void) {
   }
   sh_close(fout);
   sh_close(fin);
+  if ((h.flags & ISR_STREAM_SNAP_SAVE) != 0u && snap(false) != 0) {
+    return fail(6, "cannot write pil_snap.bin");
+  }
   return 0;
 }

@@ -162,10 +162,11 @@ FD_COLD static int poles_step(proc_state_t *st, const proc_setup_t *su, const pr
     }
   } else if (p->phase == PH_TURN) {
     /* theta_v = 2 pi N (x - sin(2 pi x) / 2 pi), x = t / t_turn: from rest
-     * to rest, the acceleration a raised sine */
+     * to rest, the acceleration a raised sine (the core's sine, not libm's:
+     * the PIL's duties equal the host's, docs/pil.md) */
     const float x = (float)p->n / (float)n_turn;
-    p->theta_v =
-        2.0f * FRAMES_PI * PROC_POLES_TURNS * (x - sinf(2.0f * FRAMES_PI * x) / (2.0f * FRAMES_PI));
+    const float s2 = frames_sincos(2.0f * FRAMES_PI * x).s;
+    p->theta_v = 2.0f * FRAMES_PI * PROC_POLES_TURNS * (x - s2 / (2.0f * FRAMES_PI));
     if (p->n >= n_turn) {
       p->theta_v = 2.0f * FRAMES_PI * PROC_POLES_TURNS;
       p->n = 0u;

@@ -4,8 +4,12 @@
  * Everything the ISR reads is recorded as it found it: the HAL sample set
  * (the runner filled it before the ISR), the break input (sil_step_t
  * .hw_tripped), the command block drive_t.req (only the main loop writes it,
- * between ISRs: after ISR k it still holds what ISR k read) and the drive's
- * applied-voltage memory before the ISR (drive_t.v_applied after ISR k-1).
+ * between ISRs: after ISR k it still holds what ISR k read; its
+ * identification request req.ident too) and the drive's applied-voltage
+ * memory before the ISR (drive_t.v_applied after ISR k-1). Besides, the
+ * procedure the drive has in force after the ISR and its phase
+ * (host_proc, host_phase: the tool's grouping per procedure and its
+ * sample, not inputs).
  */
 #include "isr_record.h"
 
@@ -88,7 +92,9 @@ void isr_record_observer(void *user, const sil_step_t *st) {
   in->test_vector = s->test_vector;
   in->enc_angle = s->enc_angle;
   in->t_enc = s->t_enc;
-  isr_stream_cmd_put(drv->req.seq, &drv->req.cmd, in);
+  isr_stream_cmd_put(drv->req.seq, &drv->req.cmd, &drv->req.ident, in);
+  in->host_proc = drv->proc != NULL ? (uint32_t)drv->proc->id : (uint32_t)PROC_NONE;
+  in->host_phase = drv->tm.proc.phase;
   in->v_applied[0] = r->prev_v_applied[0];
   in->v_applied[1] = r->prev_v_applied[1];
   r->prev_v_applied[0] = drv->v_applied.alpha;

@@ -25,12 +25,20 @@
 #include "drive.h"
 
 #define ISR_STREAM_MAGIC   0x52534946u /* "FISR" */
-#define ISR_STREAM_VERSION 5u
+#define ISR_STREAM_VERSION 6u
 
 /* isr_stream_header_t.flags: the replay sets the drive's applied-voltage
  * memory (drive_t.v_applied) to the host's before each ISR, see
  * docs/pil.md ("Why the applied voltage is forced"). */
 #define ISR_STREAM_FORCE_APPLIED (1u << 0)
+/* The replay's RAM state (its .data and .bss: the drive, the replay HAL,
+ * the configuration) in a file pil_snap.bin, so that a traced replay can
+ * start at a record other than the first (`fluxdrive pil --sample`): LOAD
+ * takes the state from it in place of drive_init (the file's records are
+ * the ones that follow that state), SAVE writes it after the last record.
+ * Set by `fluxdrive pil` in the copy it gives the image (docs/pil.md). */
+#define ISR_STREAM_SNAP_LOAD (1u << 1)
+#define ISR_STREAM_SNAP_SAVE (1u << 2)
 
 /* isr_stream_in_t.flags */
 #define ISR_IN_ENC_VALID   (1u << 0) /* hal_sample_t.enc_valid */
@@ -52,12 +60,16 @@ typedef struct {
   uint32_t in_size;     /* sizeof(isr_stream_in_t) */
   uint32_t out_size;    /* sizeof(isr_stream_out_t) */
   uint32_t count;       /* records */
-  uint32_t flags;       /* ISR_STREAM_FORCE_APPLIED (set by the PIL runner) */
+  uint32_t flags;       /* ISR_STREAM_FORCE_APPLIED, _SNAP_* (set by the PIL runner) */
 } isr_stream_header_t;
 
 /* Everything the drive sees before and during one ISR: the HAL sample set,
  * the break input, and the main loop's command block (drive_t.req) as the
- * ISR finds it. */
+ * ISR finds it, its identification request (drive_t.req.ident) included.
+ * host_proc and host_phase are the words the image does not read: the
+ * procedure the host's drive had in force after this ISR (drive_t.proc's
+ * id, PROC_NONE: none) and its phase (the procedure telemetry's), by which
+ * `fluxdrive pil` groups the ISRs per procedure and places its sample. */
 typedef struct {
   uint32_t flags;
   uint32_t time_us; /* hal_time_us() */
@@ -84,7 +96,12 @@ typedef struct {
   uint32_t fault_count[ISR_STREAM_FAULT_WORDS];
   uint32_t enable_count;
   uint32_t clear_enable_mark;
-  uint32_t reserved[ISR_STREAM_FAULT_WORDS - 2]; /* zero */
+  uint32_t fault_total; /* drive_request_fault() calls, all bits */
+  uint32_t ident_proc;  /* drive_t.req.ident: the identification asked for (proc_id_t) */
+  uint32_t ident_count; /* and drive_cmd_identify() calls */
+  uint32_t host_proc;   /* not read by the image: the host's procedure after this ISR */
+  uint32_t host_phase;  /* nor this: its phase (drive_t.tm.proc.phase) */
+  uint32_t reserved[ISR_STREAM_FAULT_WORDS - 7]; /* zero */
   float v_applied[2]; /* host drive_t.v_applied before this ISR (alpha, beta) */
 } isr_stream_in_t;
 
@@ -120,6 +137,9 @@ ISR_STREAM_OUT_FIELDS(ISR_OUT_AT)
 
 _Static_assert(sizeof(isr_stream_header_t) == 36, "isr_stream_header_t layout");
 _Static_assert(sizeof(isr_stream_in_t) == 240, "isr_stream_in_t layout");
+/* read by `fluxdrive pil` at these offsets (pil.py HOST_PROC_AT) */
+_Static_assert(offsetof(isr_stream_in_t, host_proc) == 188, "isr_stream_in_t.host_proc");
+_Static_assert(offsetof(isr_stream_in_t, host_phase) == 192, "isr_stream_in_t.host_phase");
 _Static_assert(sizeof(isr_stream_out_t) == sizeof(uint32_t) * (size_t)ISR_OUT_FIELD_COUNT,
                "isr_stream_out_t layout: ISR_STREAM_OUT_FIELDS");
 _Static_assert(DRIVE_FAULT_COUNT <= ISR_STREAM_FAULT_WORDS, "fault counters");
@@ -202,8 +222,9 @@ static inline void isr_stream_caps_get(hal_caps_t *c, uint32_t *counts,
   memcpy(&c->v_full_scale, &w[12], sizeof(float));
 }
 
-/* The command block and back. */
-static inline void isr_stream_cmd_put(uint32_t req_seq, const drive_cmd_t *c, isr_stream_in_t *in) {
+/* The command block and its identification request, and back. */
+static inline void isr_stream_cmd_put(uint32_t req_seq, const drive_cmd_t *c,
+                                      const drive_ident_req_t *ident, isr_stream_in_t *in) {
   in->req_seq = req_seq;
   in->cmd_seq = c->seq;
   in->enable = c->enable;
@@ -217,14 +238,17 @@ static inline void isr_stream_cmd_put(uint32_t req_seq, const drive_cmd_t *c, is
   in->clear_count = c->clear_count;
   in->enable_count = c->enable_count;
   in->clear_enable_mark = c->clear_enable_mark;
+  in->fault_total = c->fault_total;
+  in->ident_proc = ident->proc;
+  in->ident_count = ident->count;
   memset(in->reserved, 0, sizeof in->reserved);
   for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {
     in->fault_count[b] = c->fault_count[b];
   }
 }
 
-static inline void isr_stream_cmd_get(const isr_stream_in_t *in, uint32_t *req_seq,
-                                      drive_cmd_t *c) {
+static inline void isr_stream_cmd_get(const isr_stream_in_t *in, uint32_t *req_seq, drive_cmd_t *c,
+                                      drive_ident_req_t *ident) {
   *req_seq = in->req_seq;
   c->seq = in->cmd_seq;
   c->enable = in->enable;
@@ -238,6 +262,9 @@ static inline void isr_stream_cmd_get(const isr_stream_in_t *in, uint32_t *req_s
   c->clear_count = in->clear_count;
   c->enable_count = in->enable_count;
   c->clear_enable_mark = in->clear_enable_mark;
+  c->fault_total = in->fault_total;
+  ident->proc = in->ident_proc;
+  ident->count = in->ident_count;
   for (unsigned b = 0; b < (unsigned)DRIVE_FAULT_COUNT; ++b) {
     c->fault_count[b] = in->fault_count[b];
   }

@@ -219,3 +219,41 @@ def test_functions_listed_on_request() -> None:
     assert lines[k + 1].split()[-1] == "drive_isr" and "672.0" in lines[k + 1]
     assert lines[k + 2].split()[-1] == "dfvc_step"
     assert build_parser().parse_args(["pil", "s.json", "--functions"]).functions
+
+
+def test_procs_grouped_by_the_host_procedure(capsys) -> None:
+    """--procs (issue 25: each procedure's ISR cost): an ISR belongs to the
+    procedure in force before it, or, when none was, to the one after it
+    (the ISR that took the request); host_proc is read from the input
+    record at HOST_PROC_AT; the checks name the procedure."""
+    names = ["offset", "align", "hold", "rs"]
+    none = len(names)
+    tr = pil.TraceResult(counts=[1] * 9)
+    # after each ISR: idle, offset (start), offset, rs (offsets done), rs, idle (rs done), idle ...
+    after = [none, 0, 0, 3, 3, none, none, 0, none]
+    g = pil.proc_isrs(tr, after, names)
+    assert g == {"offset": [1, 2, 3, 7, 8], "rs": [4, 5]}
+    assert list(g) == ["offset", "rs"]  # in the order they first ran
+    rec = pil.np.zeros(3, pil.np.dtype([("in", f"V{pil.IN_SIZE}"), ("out", pil.OUT)]))
+    raw = bytearray(rec.tobytes())
+    for k, p in enumerate((none, 0, 3)):
+        at = k * rec.dtype.itemsize + pil.HOST_PROC_AT
+        raw[at:at + 4] = p.to_bytes(4, "little")
+    body = pil.np.frombuffer(bytes(raw), rec.dtype)
+    assert list(pil.host_procs(body)) == [none, 0, 3]
+    r = run_with("foc", 2400, 9000)
+    r.proc = "rs"
+    assert pil.check_runs([r], None, None, 2000, worst_all=2300) == 1
+    out = capsys.readouterr().out
+    assert "FAIL: scen/foc/rs: mean 2300 instructions, limit 2000" in out
+    assert "rs" in pil.format_proc_table([r], None)
+    assert build_parser().parse_args(["pil", "s.json", "--procs"]).procs
+
+
+def test_proc_limit_parsed() -> None:
+    assert pil.parse_proc_limits(["ldq=2000,4600,85"]) == {"ldq": (2000, 4600, 85.0)}
+    for bad in ("ldq", "ldq=1,2", "=1,2,3", "ldq=0,1,2"):
+        with pytest.raises(ValueError):
+            pil.parse_proc_limits([bad])
+    a = build_parser().parse_args(["pil", "s.json", "--procs", "--proc-limit", "star=2400,3300,55"])
+    assert a.proc_limit == ["star=2400,3300,55"]

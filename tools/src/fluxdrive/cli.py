@@ -280,6 +280,20 @@ def build_parser() -> argparse.ArgumentParser:
                    "this flat cycles/instruction (the report uses the cycle model)")
     p.add_argument("--functions", action="store_true",
                    help="also list the mean instructions and cycles per function")
+    p.add_argument("--procs", action="store_true",
+                   help="also group the ISRs by the procedure the host's drive had in force "
+                   "(offsets, identification ...), each reported and checked like a law; a "
+                   "run without law ISRs then reports its procedures only")
+    p.add_argument("--sample", type=_positive_int, metavar="W",
+                   help="with --procs: trace, in place of the first --isrs ISRs, windows: of "
+                   "each procedure's run its first and last W ISRs and W around each change "
+                   "of its phase (the replay's state carried into each window through "
+                   "pil_snap.bin; every ISR is still replayed and compared)")
+    p.add_argument("--proc-limit", action="append", default=[], metavar="PROC=MEAN,WORST,PCT",
+                   help="with --procs: check PROC's ISRs against these (mean and worst "
+                   "instructions, board worst %% of the budget) in place of --check-mean, "
+                   "--check-worst-all and --check-board (repeatable; a guard for a procedure "
+                   "not yet within those, docs/pil.md)")
     p.add_argument("--free-running", action="store_true",
                    help="do not force the applied voltage (docs/pil.md)")
     p.add_argument("--timeout", type=float, default=600.0, help="per QEMU run [s]")

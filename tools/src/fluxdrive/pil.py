@@ -13,6 +13,9 @@ Per scenario and control law:
    line, streamed through a FIFO and counted per ISR (from drive_isr's entry
    to the first line back in its caller pil_step, callees included) and per
    function, and priced with the Cortex-M4 model (cm4_cycles).
+4. With ``--procs`` the ISRs are also grouped by the procedure the host's
+   drive had in force (the stream's ``host_proc``: offsets, identification
+   procedures, alignment ...), each group reported and checked like a law.
 
 Without ``--elf`` / ``$FLUXDRIVE_PIL_ELF`` and ``--sil`` / ``$FLUXDRIVE_SIL``
 the default image and runner of the repo are used, and built first when
@@ -82,16 +85,33 @@ HEADER = np.dtype(
         ("flags", "<u4"),
     ]
 )
-MAGIC, VERSION, FORCE_APPLIED = 0x52534946, 5, 1
+MAGIC, VERSION, FORCE_APPLIED = 0x52534946, 6, 1
+#: header flags: the replay's RAM state from / to pil_snap.bin (isr_stream.h)
+SNAP_LOAD, SNAP_SAVE = 2, 4
 # the output record's fields, named after the signals they carry
 # (sil/runner/isr_stream.h ISR_STREAM_OUT_FIELDS, `fluxdrive signals`)
 OUT = np.dtype(pil_out())
 DUTIES = ("duty_a", "duty_b", "duty_c")
 IN_SIZE = 240
+#: Byte offset of isr_stream_in_t.host_proc (isr_stream.h asserts it): the
+#: procedure the host's drive had in force after the ISR (proc_id_t; the
+#: table's length, PROC_NONE, for none).
+HOST_PROC_AT = 188
+HOST_PHASE_AT = 192  # isr_stream_in_t.host_phase: its phase (the procedure telemetry's)
 
 #: Blocks of the per-function share: the first pattern that a function name
 #: starts with (or equals) names its block.
 BLOCKS = [
+    # the procedures (proc.h: offsets, alignment, held start, identification;
+    # FD_COLD, in flash on the board): each row's static functions
+    # (proc_<name>.c) and the identification's estimators (core/estimation/
+    # ident_*); enc_ and flux_ named exactly (the encoder source, the flux
+    # observer share the prefixes)
+    ("procedures (proc_*.c rows, ident_*)",
+     ("proc_", "ident_", "offset_", "align_", "hold_", "rs_", "ldq_", "fmap_", "poles_",
+      "star_", "mech_", "enc_step", "enc_init", "enc_publish", "enc_target", "flux_step",
+      "flux_init", "flux_publish", "flux_acc", "flux_lambda", "pulse", "pulse_periods",
+      "zero_current")),
     # protect_: the protections, owned parts of the drive (firmware/app/protect)
     ("drive (ISR body, commands, protections, offsets)", ("drive_", "protect_",
                                                           "hal_pwm_centred")),
@@ -156,6 +176,49 @@ def block_of(func: str) -> str:
 
 
 # ------------------------------------------------------------------ files
+def host_procs(body: np.ndarray, at: int = HOST_PROC_AT) -> np.ndarray:
+    """Per record, the host's procedure after the ISR (isr_stream_in_t.host_proc;
+    ``at`` = HOST_PHASE_AT: its phase)."""
+    raw = np.frombuffer(body["in"].tobytes(), np.uint8).reshape(len(body), IN_SIZE)
+    return raw[:, at:at + 4].copy().view("<u4").ravel()
+
+
+def sample_windows(host_proc: np.ndarray, host_phase: np.ndarray, names: list[str],
+                   w: int) -> list[tuple[int, int]]:
+    """The ISRs --sample W traces, as merged windows [a, b): of every run of
+    a procedure (proc_isrs' attribution) its first and last W ISRs and W
+    around each change of its phase (where its fits and hand-overs run)."""
+    n = len(host_proc)
+    owner = np.full(n, -1)
+    before = len(names)
+    for j in range(n):
+        after = int(host_proc[j])
+        p = before if before < len(names) else after
+        owner[j] = p if p < len(names) else -1
+        before = after
+    win = []
+    j = 0
+    while j < n:
+        if owner[j] < 0:
+            j += 1
+            continue
+        k = j
+        while k + 1 < n and owner[k + 1] == owner[j]:
+            k += 1
+        win += [(j, j + w), (k + 1 - w, k + 1)]
+        for i in range(j + 1, k + 1):
+            if host_phase[i] != host_phase[i - 1]:
+                win.append((i - w // 2, i + w - w // 2))
+        j = k + 1
+    out: list[list[int]] = []
+    for a, b in sorted((max(a, 0), min(b, n)) for a, b in win):
+        if out and a <= out[-1][1]:
+            out[-1][1] = max(out[-1][1], b)
+        else:
+            out.append([a, b])
+    return [(a, b) for a, b in out]
+
+
 def read_record(path: Path) -> tuple[bytes, np.ndarray, np.ndarray]:
     """(header+config bytes, input records as raw bytes rows, host outputs)."""
     data = path.read_bytes()
@@ -173,14 +236,16 @@ def read_record(path: Path) -> tuple[bytes, np.ndarray, np.ndarray]:
     return data[:start], body, body["out"]
 
 
-def write_pil_input(path: Path, head: bytes, body: np.ndarray, n: int, force: bool) -> None:
+def write_pil_input(path: Path, head: bytes, body: np.ndarray, n: int, force: bool,
+                    start: int = 0, snap: int = 0) -> None:
+    """pil_in.bin of records [start, n); ``snap``: SNAP_LOAD | SNAP_SAVE."""
     h = np.frombuffer(head, HEADER, count=1).copy()
-    h["count"] = n
-    h["flags"] = FORCE_APPLIED if force else 0
+    h["count"] = n - start
+    h["flags"] = (FORCE_APPLIED if force else 0) | snap
     with open(path, "wb") as f:
         f.write(h.tobytes())
         f.write(head[HEADER.itemsize:])
-        f.write(body[:n].tobytes())
+        f.write(body[start:n].tobytes())
 
 
 # ------------------------------------------------------------------- qemu
@@ -451,11 +516,40 @@ def _mean_by(run: list[int], per_isr: list[dict[str, int]]) -> tuple[dict, dict]
     return blocks, {f: v / len(run) for f, v in funcs.items()}
 
 
-def law_counts(tr: TraceResult, host: np.ndarray,
-               stand_ins: frozenset = frozenset(cm4_cycles.BOARD_HAL)) -> Counts:
+def law_isrs(tr: TraceResult, host: np.ndarray) -> list[int]:
+    """The traced ISRs that ran the control law (state RUN before and after)."""
     n = min(len(tr.counts), len(host))
     st = host["state"][:n]
-    run = [j for j in range(1, n) if st[j] == RUN and st[j - 1] == RUN]
+    return [j for j in range(1, n) if st[j] == RUN and st[j - 1] == RUN
+            and tr.counts[j] is not None]
+
+
+def proc_isrs(tr: TraceResult, host_proc: np.ndarray, names: list[str]) -> dict[str, list[int]]:
+    """The traced ISRs per procedure, in the order the procedures first ran:
+    an ISR belongs to the procedure in force before it (its step ran, and
+    its end and the next one's start when it ended), or, when none was,
+    to the one in force after it (the ISR that took the request and began
+    the first). ``host_proc``: per ISR, the host's procedure after it
+    (isr_stream_in_t.host_proc); ``names``: the table's, by id."""
+    n = min(len(tr.counts), len(host_proc))
+    out: dict[str, list[int]] = {}
+    before = len(names)  # PROC_NONE: none after drive_init
+    for j in range(n):
+        after = int(host_proc[j])
+        p = before if before < len(names) else after
+        if p < len(names) and tr.counts[j] is not None:  # None: not traced (--sample)
+            out.setdefault(names[p], []).append(j)
+        before = after
+    return out
+
+
+def law_counts(tr: TraceResult, host: np.ndarray,
+               stand_ins: frozenset = frozenset(cm4_cycles.BOARD_HAL),
+               run: list[int] | None = None) -> Counts:
+    """Counts over ``run`` (default: the law ISRs, law_isrs)."""
+    n = min(len(tr.counts), len(host))
+    if run is None:
+        run = law_isrs(tr, host)
     if not run:
         raise FluxdriveError("no ISR ran the control law in the traced window "
                              "(raise --isrs beyond the offset calibration)", exit_code=1)
@@ -495,6 +589,8 @@ class PilRun:
     counts: Counts
     trace_exact: bool  # traced replay's outputs == untraced replay's
     budget: int = BUDGET_CYCLES  # cycles per ISR at the scenario's PWM frequency
+    proc: str | None = None  # the procedure whose ISRs these are (--procs), None: the law's
+    traced: int | None = None  # ISRs traced in --sample's windows (None: a prefix, --isrs)
 
 
 def build_default(root: Path, steps: tuple[list[str], ...], what: str) -> None:
@@ -567,10 +663,45 @@ def scenario_with_law(src: Path, law: str | None, dst: Path) -> str:
     return str(ctrl.get("law", "foc"))
 
 
+def trace_windows(elf: Path, workdir: Path, head: bytes, body: np.ndarray, force: bool,
+                  timeout: float, tab: dict | None, windows: list[tuple[int, int]],
+                  untraced: np.ndarray) -> tuple[TraceResult, bool]:
+    """Traces the ISRs of ``windows`` only: the records before each window
+    replayed untraced up to it (from the previous window's state), its state
+    saved (pil_snap.bin), the window traced from that state. The per-ISR
+    lists have an entry per record, None where not traced; True when every
+    window's outputs equal the untraced replay's."""
+    n = len(body)
+    tr = TraceResult(counts=[None] * n, funcs=[None] * n, cycles=[None] * n,
+                     func_cycles=[None] * n, calls=[None] * n)
+    exact, pos = True, 0
+    (workdir / "pil_snap.bin").unlink(missing_ok=True)
+    for a, b in windows:
+        if a > pos:  # the gap, untraced, from the state at pos to the state at a
+            write_pil_input(workdir / "pil_in.bin", head, body, a, force, pos,
+                            SNAP_SAVE | (SNAP_LOAD if pos else 0))
+            run_qemu(elf, workdir, timeout)
+        write_pil_input(workdir / "pil_in.bin", head, body, b, force, a,
+                        SNAP_SAVE | (SNAP_LOAD if a else 0))
+        w, out = run_qemu_trace(elf, workdir, timeout, tab)
+        if len(w.counts) != b - a:
+            raise FluxdriveError(f"trace shows {len(w.counts)} ISRs, replayed {b - a}",
+                                 exit_code=1)
+        exact &= out.tobytes() == untraced[a:b].tobytes()
+        for name in ("counts", "funcs", "cycles", "func_cycles", "calls"):
+            getattr(tr, name)[a:b] = getattr(w, name)
+        tr.unknown_pcs |= w.unknown_pcs
+        pos = b
+    return tr, exact
+
+
 def run_one(runner: Path, elf: Path, scenario: Path, law: str | None, isrs: int,
             workdir: Path, force: bool, timeout: float, tab: dict | None = None,
-            stand_ins: frozenset = frozenset(cm4_cycles.BOARD_HAL)) -> PilRun:
-    """One scenario and law; ``isrs`` ISRs traced (0: all)."""
+            stand_ins: frozenset = frozenset(cm4_cycles.BOARD_HAL),
+            procs: bool = False, sample: int = 0) -> list[PilRun]:
+    """One scenario and law; ``isrs`` ISRs traced (0: all). The law's run,
+    and with ``procs`` one per procedure that ran (proc_isrs); without
+    ``procs`` or with law ISRs traced, the law's first."""
     workdir = workdir.resolve()  # QEMU runs in it and gets the FIFO's path
     workdir.mkdir(parents=True, exist_ok=True)
     scen = workdir / "scenario.json"
@@ -587,14 +718,38 @@ def run_one(runner: Path, elf: Path, scenario: Path, law: str | None, isrs: int,
     pil_out = run_qemu(elf, workdir, timeout)
     agreement = compare(host, pil_out)
 
-    n = len(body) if isrs <= 0 else min(isrs, len(body))
-    write_pil_input(workdir / "pil_in.bin", head, body, n, force)
-    tr, traced_out = run_qemu_trace(elf, workdir, timeout, tab)
-    if len(tr.counts) != n:
-        raise FluxdriveError(f"trace shows {len(tr.counts)} ISRs, replayed {n}", exit_code=1)
-    exact = traced_out.tobytes() == pil_out[:n].tobytes()
-    return PilRun(scenario.stem, law_name, agreement, law_counts(tr, host, stand_ins), exact,
-                  budget_cycles(scenario_pwm_hz(scen)))
+    names = list(params.proc_ids())
+    traced = None
+    if sample > 0:
+        windows = sample_windows(host_procs(body), host_procs(body, HOST_PHASE_AT), names,
+                                 sample)
+        if not windows:
+            raise FluxdriveError("--sample: no procedure ran in this scenario", exit_code=1)
+        tr, exact = trace_windows(elf, workdir, head, body, force, timeout, tab, windows,
+                                  pil_out)
+        traced = sum(b - a for a, b in windows)
+    else:
+        n = len(body) if isrs <= 0 else min(isrs, len(body))
+        write_pil_input(workdir / "pil_in.bin", head, body, n, force)
+        tr, traced_out = run_qemu_trace(elf, workdir, timeout, tab)
+        if len(tr.counts) != n:
+            raise FluxdriveError(f"trace shows {len(tr.counts)} ISRs, replayed {n}", exit_code=1)
+        exact = traced_out.tobytes() == pil_out[:n].tobytes()
+    budget = budget_cycles(scenario_pwm_hz(scen))
+    runs = []
+    if not procs or law_isrs(tr, host):
+        runs.append(PilRun(scenario.stem, law_name, agreement, law_counts(tr, host, stand_ins),
+                           exact, budget, traced=traced))
+    if procs:
+        groups = proc_isrs(tr, host_procs(body), names)
+        if not groups and not runs:
+            raise FluxdriveError("no ISR ran the law or a procedure in the traced window",
+                                 exit_code=1)
+        for name, js in groups.items():
+            runs.append(PilRun(scenario.stem, law_name, agreement,
+                               law_counts(tr, host, stand_ins, js), exact, budget, name,
+                               traced))
+    return runs
 
 
 # ---------------------------------------------------------------- report
@@ -642,7 +797,9 @@ def trig_on_cordic(c: Counts, board: cm4_cycles.BoardBound) -> float | None:
     return c.mean - sw + hw
 
 
-def traced_text(isrs: int, total: int) -> str:
+def traced_text(isrs: int, total: int, sampled: int | None = None) -> str:
+    if sampled is not None:
+        return f"{sampled} of {total} ISRs traced: --sample's windows"
     if isrs <= 0 or isrs >= total:
         return f"all {total} ISRs traced"
     return f"first {isrs} of {total} ISRs traced"
@@ -654,7 +811,7 @@ def format_report(runs: list[PilRun], isrs: int, cpi: float | None = None,
     for r in runs:
         a, c = r.agreement, r.counts
         bud = r.budget  # this run's: the scenario's PWM frequency
-        lines.append(f"== {r.scenario} / {r.law}")
+        lines.append(f"== {r.scenario} / {r.law}" + (f" / procedure {r.proc}" if r.proc else ""))
         lines.append(
             f"agreement over {a.isrs} ISRs: max |duty dev| {a.max_duty_dev:.3g} at ISR "
             f"{a.max_dev_isr} (tolerance {DUTY_TOL:g}), {a.duty_bad} duty / {a.gates_bad} gate / "
@@ -662,7 +819,8 @@ def format_report(runs: list[PilRun], isrs: int, cpi: float | None = None,
             f"{'OK' if a.ok else 'FAIL'}"
         )
         lines.append(
-            f"instructions per ISR over {c.isrs} law ISRs ({traced_text(isrs, a.isrs)}): mean "
+            f"instructions per ISR over {c.isrs} {'ISRs of the procedure' if r.proc else 'law ISRs'}"
+            f" ({traced_text(isrs, a.isrs, r.traced)}): mean "
             f"{c.mean:.0f}, worst {c.worst} (ISR {c.worst_isr}); traced outputs identical to "
             f"untraced: {r.trace_exact}"
         )
@@ -740,7 +898,7 @@ def format_markdown(runs: list[PilRun], isrs: int, cpi: float | None, build: str
     for r in runs:
         c, a = r.counts, r.agreement
         out.append(
-            f"| {r.scenario} | {r.law} | {c.isrs} | {c.mean:.0f} | {c.worst} | "
+            f"| {r.scenario} | {_law_label(r)} | {c.isrs} | {c.mean:.0f} | {c.worst} | "
             f"{c.cycles_mean:.0f} | {c.cycles_worst} | {c.cpi:.2f} | "
             f"{_pct(c.cycles_mean, r.budget)} | {_pct(c.cycles_worst, r.budget)} |"
             + (f" {_pct(c.worst * cpi, r.budget)} |" if cpi else "")
@@ -769,7 +927,7 @@ def format_markdown(runs: list[PilRun], isrs: int, cpi: float | None, build: str
             bc = board_estimate_cordic(r.counts, board)
             cc = (f"{bc[0]:.0f} ({_pct(bc[0], r.budget)}) | {bc[1]:.0f} "
                   f"({_pct(bc[1], r.budget)})" if bc is not None else "- | -")
-            out.append(f"| {r.scenario} | {r.law} | {bt:.0f} ({_pct(bt, r.budget)}) | "
+            out.append(f"| {r.scenario} | {_law_label(r)} | {bt:.0f} ({_pct(bt, r.budget)}) | "
                        f"{bw:.0f} ({_pct(bw, r.budget)}) | {cc} |")
         out.append("")
     out.append("Share of the mean per block (instructions per ISR, % of the mean; estimated "
@@ -777,7 +935,7 @@ def format_markdown(runs: list[PilRun], isrs: int, cpi: float | None, build: str
     out.append("")
     for r in runs:
         c = r.counts
-        out.append(f"* {r.scenario} / {r.law}: " + "; ".join(
+        out.append(f"* {r.scenario} / {_law_label(r)}: " + "; ".join(
             f"{b} {v:.0f} ({100 * v / c.mean:.0f} %, {c.block_cycles.get(b, 0.0):.0f} cyc)"
             for b, v in sorted(c.blocks.items(), key=lambda kv: -kv[1]) if v >= 0.5))
     out.append("")
@@ -827,6 +985,10 @@ def main(args) -> int:
         bad = [x for x in laws if x not in LAWS]
         if bad:
             raise FluxdriveError(f"unknown law {bad[0]!r}; use {', '.join(LAWS)}")
+    try:
+        guards = parse_proc_limits(getattr(args, "proc_limit", None))
+    except ValueError as exc:
+        raise FluxdriveError(str(exc)) from None
     runner = locate_runner(args.sil)
     elf = locate_elf(args.elf)
     # absolute: QEMU runs with its working directory in here
@@ -852,29 +1014,31 @@ def main(args) -> int:
         for law in laws:
             t0 = time.monotonic()
             wd = out_dir / f"{sc.stem}-{law or 'scenario'}"
-            r = run_one(runner, elf, sc, law, args.isrs, wd, not args.free_running,
-                        args.timeout, dict(tab), hal)
-            runs.append(r)
-            print(format_report([r], args.isrs, cpi, board, args.functions), flush=True)
+            rr = run_one(runner, elf, sc, law, args.isrs, wd, not args.free_running,
+                         args.timeout, dict(tab), hal, getattr(args, "procs", False),
+                         getattr(args, "sample", 0) or 0)
+            runs += rr
+            print(format_report(rr, args.isrs, cpi, board, args.functions), flush=True)
             print(f"  ({time.monotonic() - t0:.1f} s, files in {wd})", flush=True)
     build = "MinSizeRel -Os, -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard"
+    if getattr(args, "procs", False):
+        print(format_proc_table(runs, board))
     md = format_markdown(runs, args.isrs, cpi, build, board)
     if args.markdown:
         update_markdown(Path(args.markdown), md)
         print(f"markdown: {args.markdown} (section '{SECTION.lstrip('# ')}')")
-    rc = check_runs(runs, args.check_worst, getattr(args, "check_cycles", None),
+    plain = [r for r in runs if r.proc not in guards]
+    rc = check_runs(plain, args.check_worst, getattr(args, "check_cycles", None),
                     getattr(args, "check_mean", None), getattr(args, "check_call", None),
                     getattr(args, "check_worst_all", None))
-    lim = getattr(args, "check_board", None)
-    if lim:
-        for r in runs:
-            bc = board_estimate_cordic(r.counts, board) if board is not None else None
-            ok = bc is not None and bc[1] <= lim / 100.0 * r.budget
-            got = "not measured (needs --board-elf)" if bc is None else \
-                f"{bc[1]:.0f} estimated cycles = {100 * bc[1] / r.budget:.1f} % of {r.budget}"
-            print(f"{'check' if ok else 'FAIL'}: {r.scenario}/{r.law}: board worst case with the "
-                  f"trigonometry on the CORDIC co-processor {got}, limit {lim:g} %")
-            rc |= 0 if ok else 1
+    rc |= check_board(plain, getattr(args, "check_board", None), board)
+    for name, (mean, worst, pct) in guards.items():
+        mine = [r for r in runs if r.proc == name]
+        if not mine:
+            print(f"FAIL: --proc-limit {name}: the procedure did not run in the traced window")
+            rc = 1
+        rc |= check_runs(mine, None, None, mean, None, worst)
+        rc |= check_board(mine, pct, board)
     lim = getattr(args, "check_mean_cordic", None)
     if lim:
         for r in runs:
@@ -882,10 +1046,75 @@ def main(args) -> int:
             ok = tc is not None and tc < lim
             got = "not measured (needs --board-elf and --functions)" if tc is None else \
                 f"{tc:.0f} instructions"
-            print(f"{'check' if ok else 'FAIL'}: {r.scenario}/{r.law}: mean with the trigonometry "
+            print(f"{'check' if ok else 'FAIL'}: {_name(r)}: mean with the trigonometry "
                   f"on the CORDIC co-processor {got}, limit {lim}")
             rc |= 0 if ok else 1
     return rc
+
+
+def check_board(runs: list[PilRun], lim: float | None,
+                board: cm4_cycles.BoardBound | None) -> int:
+    """--check-board: each run's board worst case with the trigonometry on
+    the CORDIC at most ``lim`` % of its budget. Prints; 1 on failure."""
+    rc = 0
+    if not lim:
+        return rc
+    for r in runs:
+        bc = board_estimate_cordic(r.counts, board) if board is not None else None
+        ok = bc is not None and bc[1] <= lim / 100.0 * r.budget
+        got = "not measured (needs --board-elf)" if bc is None else \
+            f"{bc[1]:.0f} estimated cycles = {100 * bc[1] / r.budget:.1f} % of {r.budget}"
+        print(f"{'check' if ok else 'FAIL'}: {_name(r)}: board worst case with the "
+              f"trigonometry on the CORDIC co-processor {got}, limit {lim:g} %")
+        rc |= 0 if ok else 1
+    return rc
+
+
+def parse_proc_limits(items: list[str] | None) -> dict[str, tuple[int, int, float]]:
+    """--proc-limit PROC=MEAN,WORST,PCT items as {PROC: (MEAN, WORST, PCT)}:
+    that procedure's ISRs checked against these (mean and worst instructions,
+    board worst % of the budget) in place of --check-mean, --check-worst-all
+    and --check-board. ValueError names a bad one."""
+    out = {}
+    for it in items or []:
+        name, sep, rest = it.partition("=")
+        try:
+            m, w, p = (float(x) for x in rest.split(","))
+        except ValueError:
+            m = w = p = -1.0
+        if not sep or not name or min(m, w, p) <= 0:
+            raise ValueError(f"--proc-limit {it!r}: expected PROC=MEAN,WORST,PCT, each > 0")
+        out[name] = (int(m), int(w), p)
+    return out
+
+
+def _law_label(r: PilRun) -> str:
+    """The law, or for a procedure's ISRs (--procs) the procedure."""
+    return f"{r.law}, procedure {r.proc}" if r.proc else r.law
+
+
+def _name(r: PilRun) -> str:
+    return f"{r.scenario}/{r.law}" + (f"/{r.proc}" if r.proc else "")
+
+
+def format_proc_table(runs: list[PilRun], board: cm4_cycles.BoardBound | None) -> str:
+    """The procedures' ISR cost (--procs): per procedure and scenario, its
+    ISRs, instructions mean and worst, estimated cycles worst, and the
+    board worst case (the CORDIC estimate, as --check-board) in % of the
+    budget."""
+    lines = ["procedure ISR cost (PIL; board worst: estimated cycles, trigonometry on the "
+             "CORDIC, % of the budget)",
+             f"  {'procedure':10s} {'scenario':24s} {'ISRs':>7s} {'mean':>6s} {'worst':>6s} "
+             f"{'cyc worst':>9s} {'board worst':>11s}"]
+    for r in runs:
+        if not r.proc:
+            continue
+        c = r.counts
+        bc = board_estimate_cordic(c, board) if board is not None else None
+        bw = f"{100 * bc[1] / r.budget:10.1f}%" if bc is not None else f"{'-':>11s}"
+        lines.append(f"  {r.proc:10s} {r.scenario:24s} {c.isrs:7d} {c.mean:6.0f} {c.worst:6d} "
+                     f"{c.cycles_worst:9d} {bw}")
+    return "\n".join(lines)
 
 
 def parse_call_limits(items: list[str] | None) -> dict[str, float]:
@@ -915,7 +1144,7 @@ def check_runs(runs: list[PilRun], worst_instr: int | None, worst_pct: float | N
     rc = 0
     limits = parse_call_limits(call_limits)
     for r in runs:
-        name = f"{r.scenario}/{r.law}"
+        name = f"{r.scenario}/{r.law}" + (f"/{r.proc}" if r.proc else "")
         for f, lim in limits.items():
             k, v = r.counts.calls.get(f, (0.0, float("inf")))
             ok = k > 0 and v <= lim
@@ -938,7 +1167,7 @@ def check_runs(runs: list[PilRun], worst_instr: int | None, worst_pct: float | N
             print(f"{'check' if ok else 'FAIL'}: {name}: worst case {r.counts.worst} instructions "
                   f"(ISR {r.counts.worst_isr}), limit {worst_all}")
             rc |= 0 if ok else 1
-        if r.law != "db_dfvc":
+        if r.law != "db_dfvc" or r.proc:
             continue
         c = r.counts
         if worst_instr:

@@ -249,6 +249,18 @@ typedef struct {
   float ripple[2];              /* their current ripple, peak to peak [A] */
   float cross[2];               /* the other axis' ripple over this axis' [-] */
   float o_lo, o_hi;             /* the other axis' current range under the injection [A] */
+  /* the least squares of (5) of an axis measured, a few of the wave's
+   * positions a period over the periods after it (proc_ldq.c,
+   * ldq_solve_step; on w, which q's trials leave alone): d's during q's
+   * trials, q's before done */
+  uint32_t sns;   /* ... over this many waves */
+  float g[6];     /* the normal equations' matrix (00 01 02 11 12 22) */
+  float h[3];     /* ... their right-hand side */
+  float mw;       /* the wave's mean [A] */
+  float v_hs;     /* the injection's amplitude of the axis solved [V] */
+  uint8_t sj;     /* positions summed so far */
+  uint8_t s_axis; /* the axis solved */
+  bool solving;   /* a least squares in progress */
 } proc_ldq_t;
 /* The flux maps' state (proc_fmap.c): the point, its half cycle and
  * segment, the integrals of (1) and their averages (2), the sums (3). */

@@ -97,7 +97,9 @@ FD_COLD static const char *ldq_check(const proc_setup_t *su, const char **field)
 }
 
 FD_COLD static void ldq_reset_sums(proc_ldq_t *q) {
-  for (unsigned j = 0; j < 2u * PROC_LDQ_M_MAX; ++j) {
+  /* the wave of an axis being solved is kept (q's trials leave it alone;
+   * the measurement that follows them clears it once the solve is done) */
+  for (unsigned j = 0; j < 2u * PROC_LDQ_M_MAX && !q->solving; ++j) {
     q->w[j] = 0.0f;
   }
   q->sn = 0u;
@@ -122,6 +124,7 @@ FD_COLD static void ldq_init(proc_state_t *st, const proc_setup_t *su) {
   q->l[0] = q->l[1] = 0.0f;
   q->ripple[0] = q->ripple[1] = 0.0f;
   q->cross[0] = q->cross[1] = 0.0f;
+  q->solving = false; /* before the sums: they keep a wave being solved */
   ldq_reset_sums(q);
 }
 
@@ -134,50 +137,78 @@ FD_COLD static float ldq_v_first(const drive_config_t *c, uint8_t axis, float ib
 
 /* The least squares of (5) on the averaged wave w_j (2m positions,
  * cyclic: w_{j+1} on w_j, u_j and u_{j-1}, centred by the constant c),
- * then (6) with beta = beta_1 + beta_2: L [H], 0 when it has no solution. */
-FD_COLD static float ldq_solve(const proc_ldq_t *q, uint32_t m, float v_h, float ts) {
+ * spread over the periods after the measurement so that no ISR carries
+ * it whole (the PIL's worst ISR of ldq: 4477 instructions in one period
+ * before): ldq_solve_begin (the wave's mean), ldq_solve_step
+ * (PROC_LDQ_SOLVE positions a period into the normal equations),
+ * ldq_solve_end (Cramer's rule, then (6)). */
+#define PROC_LDQ_SOLVE 8u
+
+FD_COLD static void ldq_solve_begin(proc_ldq_t *q, uint32_t m) {
   const uint32_t n2 = 2u * m;
-  if (q->sn == 0u || !(v_h > 0.0f)) {
-    return 0.0f;
-  }
   float mw = 0.0f;
   for (uint32_t j = 0; j < n2; ++j) {
     mw += q->w[j];
   }
-  mw /= (float)n2 * (float)q->sn;
-  /* the normal equations G p = h of the regressors (x, u_j, u_{j-1}),
-   * scaled by v_h (u = +-1) for their conditioning */
-  float g[3][3] = {{0.0f}};
-  float h[3] = {0.0f, 0.0f, 0.0f};
-  for (uint32_t j = 0; j < n2; ++j) {
-    const float r[3] = {q->w[j] / (float)q->sn - mw, (j < m) ? 1.0f : -1.0f,
-                        (((j + n2 - 1u) % n2) < m) ? 1.0f : -1.0f};
-    const float y = q->w[(j + 1u) % n2] / (float)q->sn - mw;
-    for (unsigned a = 0; a < 3u; ++a) {
-      for (unsigned b = 0; b < 3u; ++b) {
-        g[a][b] += r[a] * r[b];
-      }
-      h[a] += r[a] * y;
-    }
+  q->sns = q->sn;
+  q->s_axis = q->axis;
+  q->v_hs = q->v_h;
+  q->mw = q->sn > 0u ? mw / ((float)n2 * (float)q->sn) : 0.0f;
+  for (unsigned a = 0; a < 6u; ++a) {
+    q->g[a] = 0.0f;
   }
-  /* Cramer's rule */
-  const float det = g[0][0] * (g[1][1] * g[2][2] - g[1][2] * g[2][1]) -
-                    g[0][1] * (g[1][0] * g[2][2] - g[1][2] * g[2][0]) +
-                    g[0][2] * (g[1][0] * g[2][1] - g[1][1] * g[2][0]);
+  q->h[0] = q->h[1] = q->h[2] = 0.0f;
+  q->sj = 0u;
+  q->solving = true;
+}
+
+/* The normal equations G p = h of the regressors (x, u_j, u_{j-1}),
+ * scaled by v_h (u = +-1) for their conditioning: PROC_LDQ_SOLVE more
+ * positions; true when all 2m are in. */
+FD_COLD static bool ldq_solve_step(proc_ldq_t *q, uint32_t m) {
+  const uint32_t n2 = 2u * m;
+  const float inv_sn = q->sns > 0u ? 1.0f / (float)q->sns : 0.0f;
+  for (uint32_t c = 0; c < PROC_LDQ_SOLVE && q->sj < n2; ++c, ++q->sj) {
+    const uint32_t j = q->sj;
+    const float r0 = q->w[j] * inv_sn - q->mw;
+    const float r1 = (j < m) ? 1.0f : -1.0f;
+    const float r2 = (((j + n2 - 1u) % n2) < m) ? 1.0f : -1.0f;
+    const float y = q->w[(j + 1u) % n2] * inv_sn - q->mw;
+    q->g[0] += r0 * r0;
+    q->g[1] += r0 * r1;
+    q->g[2] += r0 * r2;
+    q->g[3] += r1 * r1;
+    q->g[4] += r1 * r2;
+    q->g[5] += r2 * r2;
+    q->h[0] += r0 * y;
+    q->h[1] += r1 * y;
+    q->h[2] += r2 * y;
+  }
+  return q->sj >= n2;
+}
+
+/* Cramer's rule on G p = h, then (6) with beta = beta_1 + beta_2: L [H],
+ * 0 when it has no solution. */
+FD_COLD static float ldq_solve_end(const proc_ldq_t *q, float v_h, float ts) {
+  if (q->sns == 0u || !(v_h > 0.0f)) {
+    return 0.0f;
+  }
+  const float g00 = q->g[0], g01 = q->g[1], g02 = q->g[2];
+  const float g11 = q->g[3], g12 = q->g[4], g22 = q->g[5];
+  const float h0 = q->h[0], h1 = q->h[1], h2 = q->h[2];
+  const float det =
+      g00 * (g11 * g22 - g12 * g12) - g01 * (g01 * g22 - g12 * g02) + g02 * (g01 * g12 - g11 * g02);
   if (!(fabsf(det) > 0.0f)) {
     return 0.0f;
   }
   const float alpha =
-      (h[0] * (g[1][1] * g[2][2] - g[1][2] * g[2][1]) -
-       g[0][1] * (h[1] * g[2][2] - g[1][2] * h[2]) + g[0][2] * (h[1] * g[2][1] - g[1][1] * h[2])) /
+      (h0 * (g11 * g22 - g12 * g12) - g01 * (h1 * g22 - g12 * h2) + g02 * (h1 * g12 - g11 * h2)) /
       det;
-  const float b1 = (g[0][0] * (h[1] * g[2][2] - g[1][2] * h[2]) -
-                    h[0] * (g[1][0] * g[2][2] - g[1][2] * g[2][0]) +
-                    g[0][2] * (g[1][0] * h[2] - h[1] * g[2][0])) /
-                   det;
+  const float b1 =
+      (g00 * (h1 * g22 - g12 * h2) - h0 * (g01 * g22 - g12 * g02) + g02 * (g01 * h2 - h1 * g02)) /
+      det;
   const float b2 =
-      (g[0][0] * (g[1][1] * h[2] - h[1] * g[2][1]) - g[0][1] * (g[1][0] * h[2] - h[1] * g[2][0]) +
-       h[0] * (g[1][0] * g[2][1] - g[1][1] * g[2][0])) /
+      (g00 * (g11 * h2 - h1 * g12) - g01 * (g01 * h2 - h1 * g02) + h0 * (g01 * g12 - g11 * g02)) /
       det;
   const float beta = (b1 + b2) / v_h;
   if (!(beta > 0.0f) || !(alpha > 0.0f) || !isfinite(alpha)) {
@@ -187,6 +218,22 @@ FD_COLD static float ldq_solve(const proc_ldq_t *q, uint32_t m, float v_h, float
   const float x = 1.0f - alpha;
   const float gl = x > 2e-3f ? x / -logf(alpha) : 1.0f - 0.5f * x;
   return ts * gl / beta;
+}
+
+/* The least squares in progress: PROC_LDQ_SOLVE more positions; all in,
+ * the axis' inductance (6) kept, or a fault when it has no solution (no
+ * response: an open phase, or no voltage left for the injection). */
+FD_COLD static void ldq_solve_run(proc_ldq_t *q, uint32_t m, float ts, proc_out_t *out) {
+  if (!ldq_solve_step(q, m)) {
+    return;
+  }
+  q->solving = false;
+  const float l = ldq_solve_end(q, q->v_hs, ts);
+  if (!(l > 0.0f) || !isfinite(l)) {
+    out->fault = DRIVE_FAULT_CONTROL;
+    return;
+  }
+  q->l[q->s_axis] = l;
 }
 
 FD_COLD static int ldq_step(proc_state_t *st, const proc_setup_t *su, const proc_in_t *in,
@@ -244,8 +291,24 @@ FD_COLD static int ldq_step(proc_state_t *st, const proc_setup_t *su, const proc
     }
     return PROC_RUNNING;
   }
-  /* the injection along the axis: +v_h the first half period, -v_h the second */
   const uint8_t ax = q->axis;
+  if (q->solving) { /* an axis' least squares, a few positions a period */
+    ldq_solve_run(q, m, c->ts, out);
+    if (out->fault != 0u) {
+      return PROC_FAILED;
+    }
+    if (q->phase == PH_Q) { /* q's, the last: the bias held meanwhile (within v_max) */
+      const float vm = sqrtf(q->v_hold[0] * q->v_hold[0] + q->v_hold[1] * q->v_hold[1]);
+      const float sc = vm > in->v_max ? in->v_max / vm : 1.0f;
+      out->v_ab = (ab_t){sc * q->v_hold[0], sc * q->v_hold[1]};
+      if (!q->solving) {
+        q->phase = PH_DONE;
+        out->v_ab = (ab_t){0.0f, 0.0f};
+      }
+      return PROC_RUNNING;
+    }
+  }
+  /* the injection along the axis: +v_h the first half period, -v_h the second */
   const float i_x = ax == 0u ? i_d : i_q;
   const float i_o = ax == 0u ? i_q : i_d;
   /* the wave starts in the middle of its positive half: the ripple is
@@ -293,31 +356,30 @@ FD_COLD static int ldq_step(proc_state_t *st, const proc_setup_t *su, const proc
     q->v_h = fminf(q->v_h * g, vh_max);
     const bool ok = (g > 0.8f && g < 1.25f) || q->tries >= PROC_LDQ_TRIES || q->v_h >= vh_max;
     if (ok) {
-      ++q->phase; /* to the measurement */
+      ++q->phase;          /* to the measurement */
+      while (q->solving) { /* d's, if not done yet (short trials): its wave is needed now */
+        ldq_solve_run(q, m, c->ts, out);
+      }
+      if (out->fault != 0u) {
+        return PROC_FAILED;
+      }
     }
     q->n = 0u;
     ldq_reset_sums(q);
     return PROC_RUNNING;
   }
   if (!trial && q->n >= n_meas) {
-    /* (5) solved, (6) */
-    const float l = ldq_solve(q, m, q->v_h, c->ts);
-    if (!(l > 0.0f) || !isfinite(l)) {
-      /* no response (an open phase) or no voltage left for the injection */
-      out->fault = DRIVE_FAULT_CONTROL;
-      return PROC_FAILED;
-    }
-    q->l[ax] = l;
+    /* (5) solved over the next periods, then (6): d's during q's trials */
+    ldq_solve_begin(q, m);
     q->ripple[ax] = q->i_hi - q->i_lo;
     q->cross[ax] = q->ripple[ax] > 0.0f ? (q->o_hi - q->o_lo) / q->ripple[ax] : 0.0f;
-    ++q->phase;
-    q->n = 0u;
-    q->tries = 0u;
-    q->axis = 1u;
-    q->v_h = ldq_v_first(c, 1u, ib);
-    ldq_reset_sums(q);
-    if (q->phase == PH_DONE) {
-      out->v_ab = (ab_t){0.0f, 0.0f};
+    if (ax == 0u) {
+      ++q->phase; /* to q's trials */
+      q->n = 0u;
+      q->tries = 0u;
+      q->axis = 1u;
+      q->v_h = ldq_v_first(c, 1u, ib);
+      ldq_reset_sums(q);
     }
   }
   return PROC_RUNNING;

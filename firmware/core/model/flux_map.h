@@ -35,6 +35,8 @@
 #define FLUX_MAP_POLES_MAX 100.0f
 #define FLUX_MAP_I_MAX     1e5f
 #define FLUX_MAP_PSI_MAX   1e3f
+/* the torque bound of the tables: 1.5 p psi i at the bounds above [N m] */
+#define FLUX_MAP_T_MAX (1.5f * FLUX_MAP_POLES_MAX * FLUX_MAP_PSI_MAX * FLUX_MAP_I_MAX)
 /* Newton steps of flux_map_current (bounded loop). */
 #define FLUX_MAP_NEWTON 6
 

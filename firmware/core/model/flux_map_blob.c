@@ -113,8 +113,12 @@ static int check_cells(const flux_map_t *m, flux_map_status_t *st) {
   return 0;
 }
 
-/* Tables: finite; MTPA current i_q >= 0; flux, torque and current
- * amplitude not decreasing along the tables (monotonic references). */
+/* Tables: finite and within the map's physical bounds (currents within
+ * FLUX_MAP_I_MAX, flux within FLUX_MAP_PSI_MAX, torque within FLUX_MAP_T_MAX:
+ * finite values near FLT_MAX would overflow the interpolation's difference,
+ * b - a, to infinity and 0 * inf to NaN; the flux-map fuzzer found one);
+ * MTPA current i_q >= 0; flux, torque and current amplitude not decreasing
+ * along the tables (monotonic references). */
 static int check_tables(const flux_map_t *m, flux_map_status_t *st) {
   float prev_flux = 0.0f, prev_amp = 0.0f, prev_t = 0.0f;
   for (uint32_t j = 0u; j < m->n_lut; ++j) {
@@ -123,7 +127,10 @@ static int check_tables(const flux_map_t *m, flux_map_status_t *st) {
     const float amp = id * id + iq * iq;
     const float z = fd_zero_if_finite(id) + fd_zero_if_finite(iq) + fd_zero_if_finite(fl) +
                     fd_zero_if_finite(t);
-    if (!(fd_isfinite(z) && iq >= 0.0f && fl >= prev_flux && amp >= prev_amp && t >= prev_t)) {
+    const int bounded = fabsf(id) <= FLUX_MAP_I_MAX && iq <= FLUX_MAP_I_MAX &&
+                        fabsf(fl) <= FLUX_MAP_PSI_MAX && fabsf(t) <= FLUX_MAP_T_MAX;
+    if (!(fd_isfinite(z) && bounded && iq >= 0.0f && fl >= prev_flux && amp >= prev_amp &&
+          t >= prev_t)) {
       return fail(st, FLUX_MAP_E_TABLES, (int)j, -1);
     }
     prev_flux = fl;
@@ -207,8 +214,8 @@ int flux_map_parse(flux_map_t *m, const uint32_t *w, uint32_t size, flux_map_sta
   p += 1u + (size_t)3u * nl;
   t.mtpv_flux_max = word_f32(p, 0u);
   t.mtpv_torque = p + 1u;
-  if (!(t.mtpa_t_max > 0.0f && t.mtpv_flux_max > 0.0f && fd_isfinite(t.mtpa_t_max) &&
-        fd_isfinite(t.mtpv_flux_max))) {
+  if (!(t.mtpa_t_max > 0.0f && t.mtpv_flux_max > 0.0f && t.mtpa_t_max <= FLUX_MAP_T_MAX &&
+        t.mtpv_flux_max <= FLUX_MAP_PSI_MAX)) {
     return fail(st, FLUX_MAP_E_TABLES, -1, -1);
   }
   t.mtpa_inv = (float)(nl - 1u) / t.mtpa_t_max;

@@ -22,15 +22,10 @@
 #include "drive.h"
 #include "hal_sil.h"
 #include "proc.h"
+#include "proc_fixture.h"
 
 typedef struct {
-  drive_config_t cfg;
-  machine_t m;
-  pos_state_t pos_st;
-  float offset[3];
-  proc_setup_t su;
-  proc_state_t st;
-  hal_sample_t s;
+  PROC_FIXTURE_FIELDS
   pos_estimate_t pos;
 } fixture_t;
 
@@ -40,13 +35,7 @@ static void fixture(pos_source_t src) {
   memset(&fx, 0, sizeof fx);
   drive_config_default(&fx.cfg);
   fx.cfg.pos_source = src;
-  const drive_config_t *c = &fx.cfg;
-  assert_int_equal(machine_init_linear(&fx.m, c->pole_pairs, c->rs, c->ld, c->lq, c->lambda_m), 0);
-  const pos_source_row_t *ps = pos_source(src);
-  ps->init(&fx.pos_st, c);
-  ps->reset(&fx.pos_st);
-  fx.su =
-      (proc_setup_t){&fx.cfg, &fx.m, ps, &fx.pos_st, fx.offset, (ps->caps & POS_CAP_GATED) != 0u};
+  proc_fixture_bind(&fx);
   fx.s.valid = true;
   fx.s.enc_valid = true;
   fx.s.v_dc = 310.0f;

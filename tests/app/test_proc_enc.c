@@ -24,6 +24,7 @@
 #include "estimation/ident_mech.h"
 #include "hal_sil.h"
 #include "proc.h"
+#include "proc_fixture.h"
 
 #define PI_F 3.14159265f
 
@@ -42,13 +43,7 @@ typedef struct {
 } model_t;
 
 typedef struct {
-  drive_config_t cfg;
-  machine_t m;
-  pos_state_t pos_st;
-  float offset[3];
-  proc_setup_t su;
-  proc_state_t st;
-  hal_sample_t s;
+  PROC_FIXTURE_FIELDS
   pos_io_t io;
   model_t md;
 } fixture_t;
@@ -112,12 +107,7 @@ static void fixture(void) {
 
 /* the parameter set as identified so far (the model's truth, or not) */
 static void setup(void) {
-  drive_config_t *c = &fx.cfg;
-  assert_int_equal(machine_init_linear(&fx.m, c->pole_pairs, c->rs, c->ld, c->lq, c->lambda_m), 0);
-  const pos_source_row_t *ps = pos_source(POS_SOURCE_ENCODER);
-  ps->init(&fx.pos_st, c);
-  ps->reset(&fx.pos_st);
-  fx.su = (proc_setup_t){c, &fx.m, ps, &fx.pos_st, fx.offset, false};
+  proc_fixture_bind(&fx);
 }
 
 /* the sample of the model now */

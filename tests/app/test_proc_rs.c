@@ -19,15 +19,10 @@
 
 #include "drive.h"
 #include "proc.h"
+#include "proc_fixture.h"
 
 typedef struct {
-  drive_config_t cfg;
-  machine_t m;
-  pos_state_t pos_st;
-  float offset[3];
-  proc_setup_t su;
-  proc_state_t st;
-  hal_sample_t s;
+  PROC_FIXTURE_FIELDS
   pos_estimate_t pos;
 } fixture_t;
 
@@ -44,12 +39,7 @@ static void fixture(float r, float l) {
   fx.cfg.ld = l * 0.7f;
   fx.cfg.lq = l * 0.7f;
   fx.cfg.id_rs_current = 8.0f;
-  const drive_config_t *c = &fx.cfg;
-  assert_int_equal(machine_init_linear(&fx.m, c->pole_pairs, c->rs, c->ld, c->lq, c->lambda_m), 0);
-  const pos_source_row_t *ps = pos_source(c->pos_source);
-  ps->init(&fx.pos_st, c);
-  ps->reset(&fx.pos_st);
-  fx.su = (proc_setup_t){&fx.cfg, &fx.m, ps, &fx.pos_st, fx.offset, false};
+  proc_fixture_bind(&fx);
   fx.s.valid = true;
   fx.s.v_dc = 48.0f;
 }

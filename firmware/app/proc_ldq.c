@@ -236,6 +236,13 @@ FD_COLD static void ldq_solve_run(proc_ldq_t *q, uint32_t m, float ts, proc_out_
   q->l[q->s_axis] = l;
 }
 
+/* The voltage (d, q at theta = 0: alpha, beta) scaled into v_max. */
+FD_COLD static ab_t ldq_within(float vd, float vq, float v_max) {
+  const float vm = sqrtf(vd * vd + vq * vq);
+  const float sc = vm > v_max ? v_max / vm : 1.0f;
+  return (ab_t){sc * vd, sc * vq};
+}
+
 FD_COLD static int ldq_step(proc_state_t *st, const proc_setup_t *su, const proc_in_t *in,
                             proc_out_t *out) {
   proc_ldq_t *q = &st->ldq;
@@ -298,9 +305,7 @@ FD_COLD static int ldq_step(proc_state_t *st, const proc_setup_t *su, const proc
       return PROC_FAILED;
     }
     if (q->phase == PH_Q) { /* q's, the last: the bias held meanwhile (within v_max) */
-      const float vm = sqrtf(q->v_hold[0] * q->v_hold[0] + q->v_hold[1] * q->v_hold[1]);
-      const float sc = vm > in->v_max ? in->v_max / vm : 1.0f;
-      out->v_ab = (ab_t){sc * q->v_hold[0], sc * q->v_hold[1]};
+      out->v_ab = ldq_within(q->v_hold[0], q->v_hold[1], in->v_max);
       if (!q->solving) {
         q->phase = PH_DONE;
         out->v_ab = (ab_t){0.0f, 0.0f};
@@ -339,9 +344,7 @@ FD_COLD static int ldq_step(proc_state_t *st, const proc_setup_t *su, const proc
   const float vd = q->v_hold[0] + (ax == 0u ? u : 0.0f);
   const float vq = q->v_hold[1] + (ax == 0u ? 0.0f : u);
   /* within v_max (the trim may have moved v_hold since vh_max) */
-  const float vm = sqrtf(vd * vd + vq * vq);
-  const float sc = vm > in->v_max ? in->v_max / vm : 1.0f;
-  out->v_ab = (ab_t){sc * vd, sc * vq};
+  out->v_ab = ldq_within(vd, vq, in->v_max);
   ++q->n;
   const uint32_t n_meas = ((uint32_t)(c->id_ldq_time / c->ts) / (2u * m) + 1u) * 2u * m;
   const float want = PROC_LDQ_RIPPLE * ib;

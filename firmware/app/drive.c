@@ -89,8 +89,9 @@ static float drive_t_out(const drive_t *drv, const drive_config_t *cfg) {
   return 1.5f * cfg->ts - drv->caps->t_i;
 }
 
-void drive_machine_copy(machine_t *dm, flux_map_t *dmap, const machine_t *m,
-                        const flux_map_t *map) {
+/* Cold (flash): a parameter set is applied with the gates off. */
+FD_COLD void drive_machine_copy(machine_t *dm, flux_map_t *dmap, const machine_t *m,
+                                const flux_map_t *map) {
   *dmap = *map;
   *dm = *m;
   dm->map = m->kind == MACHINE_FLUX_MAP ? dmap : NULL;
@@ -133,7 +134,7 @@ FD_COLD int drive_config_usable(const drive_config_t *cfg, drive_law_t law, mach
     return -1;
   }
   /* the procedures of the start this set wants (proc.h) */
-  const proc_setup_t psu = {cfg, m, ps, NULL, NULL, false};
+  const proc_setup_t psu = {cfg, m, ps, NULL, NULL, NULL, false};
   const char *why_p = proc_start_refusal(&psu, &err->field);
   if (why_p != NULL) {
     err->reason = why_p;
@@ -542,7 +543,7 @@ static void drive_monitor(drive_t *drv, const ctrl_in_t *in, const ctrl_out_t *o
  * (drive_config_validate); if it is refused all the same, the law in force
  * stays exactly as it was (ctrl_select) and the refusal trips config once
  * (no retry until another law is commanded). */
-static FD_NOINLINE void drive_select_law(drive_t *drv) {
+static FD_COLD FD_NOINLINE void drive_select_law(drive_t *drv) { /* gates off: flash */
   const int refused = ctrl_select(&drv->ctrl, drv->cmd.law);
   drive_mode_refresh(drv);
   if (refused != 0) {
@@ -638,9 +639,11 @@ static FD_NOINLINE void drive_window_sample(const drive_t *drv, float i[3], floa
 static FD_NOINLINE void drive_isum_row(drive_t *drv, bool due) {
   (void)due;
   const drive_config_t *c = &drv->cfg;
-  const protect_isum_view_t v = {drv->tm.i_abc, c->i_sum_abs, c->i_sum_rel,
-                                 (drv->caps->features & HAL_CAP_I_ABC) != 0u &&
-                                     gates_on_state(drv->state)};
+  /* the absolute bound no lower than the sensors' own noise (proc_offset.c) */
+  /* mut: isum_noise_floor_ignored */
+  const protect_isum_view_t v = {
+      drv->tm.i_abc, fd_maxf(c->i_sum_abs, drv->i_sum_noise), c->i_sum_rel,
+      (drv->caps->features & HAL_CAP_I_ABC) != 0u && gates_on_state(drv->state)};
   const uint32_t f = protect_isum_step(&drv->isum, &v);
   if (f != 0u) {
     drive_trip(drv, f);
@@ -850,8 +853,8 @@ static void drive_run(drive_t *drv, const float i[3], const hal_sample_t *s) {
 /* What a procedure sees of the drive (proc.h): the parameter set, the
  * machine, the position source and the offsets it hands its result to. */
 static proc_setup_t drive_proc_setup(drive_t *drv) {
-  return (proc_setup_t){&drv->cfg,    &drv->machine, drv->pos_src,
-                        &drv->pos_st, drv->offset,   drv->gated};
+  return (proc_setup_t){&drv->cfg,   &drv->machine,     drv->pos_src, &drv->pos_st,
+                        drv->offset, &drv->i_sum_noise, drv->gated};
 }
 
 /* The gates come on (a procedure that modulates, or the run): what the run

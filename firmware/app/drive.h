@@ -137,6 +137,9 @@ typedef struct drive_s {
 
   /* the current offsets in force (the offset procedure's, proc_offset.c) */
   float offset[3];
+  /* the current sum's noise at zero current the offset procedure measured,
+   * times its margin [A] (0: none yet): the current-sum check's floor */
+  float i_sum_noise;
 
   /* the procedure in force (proc.h: offset calibration, alignment, held
    * start, identification) and its place in its sequence; its state is

@@ -84,7 +84,7 @@
   X(109, i_sum_rel,     F32,  "",       0.2f,        0.01f,   1.0f,     LIVE, "controller.i_sum_rel",      \
     "current-sensor check: |i_a + i_b + i_c| above i_sum_rel times the largest |i_x| (and i_sum_abs) trips current_sensor") \
   X(110, i_sum_abs,     F32,  "A",      0.05f,       0.0f,    1e3f,     LIVE, "controller.i_sum_abs",      \
-    "current-sensor check: the noise floor of |i_a + i_b + i_c|")                                          \
+    "current-sensor check: the noise floor of |i_a + i_b + i_c| (raised to 6 sigma of the sum's noise the offset calibration measures)")                                          \
   X(120, asc_speed,     F32,  "",       0.9f,        0.0f,    2.0f,     LIVE, "controller.asc_speed",      \
     "safe state: active short circuit above asc_speed times the rectifier speed v_dc/(sqrt(3) psi_pm), or on overvoltage; 0: gates off only (docs/faults.md)") \
   X(121, asc_hold,      F32,  "s",      0.05f,       1e-3f,   10.0f,    LIVE, "controller.asc_hold",       \
@@ -215,7 +215,7 @@
   /* identification (issue 25; docs/commissioning.md): rs (proc_rs.c), ldq (proc_ldq.c) */                 \
   X(200, id_rs_current, F32,  "A",      0.0f,        0.0f,    1e4f,     IDLE, "controller.id_rs_current",  \
     "rs identification: the current limit (top level 0.9 of it), clamped to i_max; 0: half of i_max")   \
-  X(201, id_rs_levels,  U16,  "",       8.0f,        3.0f,    12.0f,    IDLE, "controller.id_rs_levels",   \
+  X(201, id_rs_levels,  U16,  "",       8.0f,        3.0f,    8.0f,     IDLE, "controller.id_rs_levels",   \
     "rs identification: current levels of each sign")                                                     \
   X(202, id_rs_align,   F32,  "s",      0.3f,        0.0f,    10.0f,    IDLE, "controller.id_rs_align",    \
     "rs identification: the alignment at the top level before each sign's levels (the rotor turns)")     \
@@ -241,6 +241,8 @@
     "speed loop and telemetry every slow_div ISRs")                                                         \
   X(42, dead_time,      F32,  "s",      1e-6f,       0.0f,    1e-4f,    IDLE, "inverter.dead_time",        \
     "inverter dead time, for the compensation")                                                             \
+  X(62, r_dev,          F32,  "Ohm",    0.0f,        0.0f,    1.0f,     IDLE, "inverter.r_dev",            \
+    "the power stage's device resistance in a phase's path (mean of switch and diode or synchronous rectifier; the board's datasheet), taken out of the rs identification's slope") \
   X(43, offset_samples, U16,  "",       256.0f,      1.0f,    60000.0f, IDLE, "controller.offset_samples", \
     "ISRs averaged by the current-offset calibration")                                                      \
   X(50, law,            LAW,  "",       0.0f,        0.0f,    0.0f,     RO,   "controller.law",            \

@@ -124,6 +124,7 @@ typedef struct {
   const pos_source_row_t *pos_src;
   pos_state_t *pos_st; /* the source: align / hold give it its reference */
   float *offset;       /* [3] the current offsets in force [A] (offset calibration) */
+  float *i_sum_noise;  /* the current-sum check's noise floor [A] (offset calibration) */
   bool gated;          /* the source measures through the DFC window */
 } proc_setup_t;
 
@@ -164,6 +165,7 @@ typedef struct {
 
 typedef struct {
   float acc[3];
+  float sum1, sum2; /* the current sum's samples: their sum and sum of squares */
   uint32_t n;
 } proc_offset_t;
 
@@ -200,27 +202,30 @@ static inline float proc_ident_align_angle(uint32_t n, uint32_t n_first, uint32_
  * ends. */
 typedef struct {
   float v;     /* the voltage across the current, filtered [V] */
-  int8_t sign; /* its sign (0: none yet) */
+  float v_x;   /* ... and along it [V] */
+  float i_y;   /* the damping current across it, slew-limited [A] (proc_swing_damping) */
+  int8_t sign; /* v's sign (0: none yet) */
   bool turned; /* it changed sign this period: a turning point */
 } proc_swing_t;
 
 /* proc_rs.c: R_s and v_err(i) (issue 25 a). Levels of each sign, at most: */
-#define PROC_RS_LEVELS_MAX 12u
+#define PROC_RS_LEVELS_MAX 8u
 typedef struct {
-  current_ctrl_t cc;                   /* the level's current loop (frame turned by theta) */
-  uint8_t n_levels;                    /* levels of each sign (id_rs_levels) */
-  uint8_t phase;                       /* proc_rs.c's phases */
-  int8_t last;                         /* the last level measured (-1: none) */
-  uint32_t n;                          /* periods into the phase */
-  uint32_t n_all;                      /* periods since it began */
-  float i_ref;                         /* the current reference, slew-limited [A] */
-  float theta;                         /* the current's axis [rad] */
-  float v_prev;                        /* the axis' voltage asked last period [V] */
-  float acc_v, acc_i;                  /* the level's sums */
-  uint32_t acc_n;                      /* ... of this many periods */
-  proc_swing_t swing;                  /* the swing's turning points (proc_swing.c) */
-  bool open;                           /* the level's window has begun (at a turning point) */
-  float i_peak;                        /* the largest measured current amplitude [A] */
+  current_ctrl_t cc;  /* the level's current loop (frame turned by theta) */
+  machine_t loop;     /* its machine: linear, the smaller inductance on both axes */
+  uint8_t n_levels;   /* levels of each sign (id_rs_levels) */
+  uint8_t phase;      /* proc_rs.c's phases */
+  int8_t last;        /* the last level measured (-1: none) */
+  uint32_t n;         /* periods into the phase */
+  uint32_t n_all;     /* periods since it began */
+  float i_ref;        /* the current reference, slew-limited [A] */
+  float theta;        /* the current's axis [rad] */
+  float v_prev;       /* the axis' voltage asked last period [V] */
+  float acc_v, acc_i; /* the level's sums */
+  uint32_t acc_n;     /* ... of this many periods */
+  proc_swing_t swing; /* the swing's turning points (proc_swing.c) */
+  bool open;          /* the level's window has begun (at a turning point) */
+  float i_peak;       /* the largest measured current amplitude [A] */
   float lv_i[2u * PROC_RS_LEVELS_MAX]; /* the levels' mean current, positive then negative [A] */
   float lv_v[2u * PROC_RS_LEVELS_MAX]; /* ... and commanded voltage [V] */
   float res[PROC_RESULTS];             /* the fit (proc_rs.c, rs_publish) */
@@ -237,6 +242,7 @@ typedef struct {
   uint32_t n;                   /* periods into the phase */
   uint32_t n_all;               /* periods since it began */
   float i_ref;                  /* the bias reference, slew-limited [A] */
+  proc_swing_t swing;           /* the alignment's swing, seen across the current (proc_swing.c) */
   float v_hold[2];              /* the bias' voltage (d, q) held under the injection [V] */
   float v_h;                    /* the injection's amplitude [V] */
   float i_prev;                 /* the injected axis' current last period [A] */
@@ -444,7 +450,8 @@ void proc_align_timing(const drive_config_t *cfg, proc_align_timing_t *t);
  * the voltage across the current asked the period before [V] and the
  * period ts [s]: sets turned at the swing's turning points. */
 void proc_swing_reset(proc_swing_t *w);
-void proc_swing_step(proc_swing_t *w, float v_y, float ts);
+void proc_swing_step(proc_swing_t *w, float v_x, float v_y, float ts);
+float proc_swing_damping(proc_swing_t *w, float i_x, float bound, float slew, bool on);
 
 /* proc_poles.c: the encoder identifications' test current (id_i_test, 0:
  * 0.3 i_max, at most i_max) [A], their speed bound (id_speed_max, 0: 0.3

@@ -6,6 +6,10 @@
  * id_rs_align / 2, turned to 0 in PROC_LDQ_TURN and held there for
  * id_rs_align (proc_ident_align_angle) aligns a PM rotor's d axis at
  * theta = 0 from anywhere (a reluctance rotor's high-inductance axis);
+ * over the alignment the loop damps the free rotor's swing as rs does
+ * (i_y = -v_y / R_app across the current: proc_rs.c; without it the
+ * rotor's d axis swings under the injection, and the d injection sees
+ * L_d + (L_q - L_d) <sin^2 delta>: L_d up to +15 % on drawn IPMs);
  * its voltage is then held (v_hold, trimmed once an injection
  * period on the period's mean current) and a square wave of +-v_h, a half
  * period of M PWM periods (M = 1 / (2 f_h ts), id_ldq_freq; 2 .. 16), is added
@@ -62,6 +66,7 @@
 #define PROC_LDQ_TRIES  8u     /* amplitude trials at most */
 #define PROC_LDQ_RAMP   0.005f /* the bias is ramped over this [s] */
 #define PROC_LDQ_TURN   0.2f   /* the alignment's turn from pi/2 to 0 [s] */
+#define PROC_LDQ_DAMP   0.3f   /* the alignment's damping current: at most this times i_b */
 #define PROC_LDQ_TRIM   0.25f  /* the bias voltage's trim a period, of the apparent resistance */
 
 enum { PH_ALIGN = 0, PH_D_TRY = 1, PH_D = 2, PH_Q_TRY = 3, PH_Q = 4, PH_DONE = 5 };
@@ -118,6 +123,7 @@ FD_COLD static void ldq_init(proc_state_t *st, const proc_setup_t *su) {
   q->n = 0u;
   q->n_all = 0u;
   q->i_ref = 0.0f;
+  proc_swing_reset(&q->swing);
   q->v_hold[0] = q->v_hold[1] = 0.0f;
   q->v_h = 0.0f;
   q->i_peak = 0.0f;
@@ -277,7 +283,13 @@ FD_COLD static int ldq_step(proc_state_t *st, const proc_setup_t *su, const proc
     /* the loop in the frame of the alignment's angle (proc.h) */
     const sincos_t sc = frames_sincos(proc_ident_align_angle(q->n, n_hold / 2u, n_turn));
     const dq_t i_f = {sc.c * i_d + sc.s * i_q, -sc.s * i_d + sc.c * i_q};
-    const dq_t v = current_ctrl_update(&q->cc, (dq_t){q->i_ref, 0.0f}, i_f, 0.0f, in->v_max);
+    /* the swing damped as rs does (proc_rs.c): across the current the
+     * loop follows -v_y / R_app, a resistor across the winding */
+    /* mut: ldq_swing_undamped */
+    const float damp = PROC_LDQ_DAMP * ib;
+    const float iy_ref = proc_swing_damping(&q->swing, q->i_ref, damp, slew, true);
+    const dq_t v = current_ctrl_update(&q->cc, (dq_t){q->i_ref, iy_ref}, i_f, 0.0f, in->v_max);
+    proc_swing_step(&q->swing, v.d, v.q, c->ts);
     out->v_ab = (ab_t){sc.c * v.d - sc.s * v.q, sc.s * v.d + sc.c * v.q};
     /* the bias' voltage (alpha, beta = d, q at 0): the loop's mean over
      * the last quarter (within the hold at 0) */

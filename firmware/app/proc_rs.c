@@ -17,6 +17,15 @@
  * and the measured current averaged; R_s the least-squares slope of (1)
  * with one intercept per sign over the levels above the knee, v_err(i_k) =
  * v_k - R_s i_k at each level.
+ * The devices' resistance is linear in i like R_s: with the switch's and
+ * the diode's (or synchronous rectifier's) resistances r_sw, r_d, a leg at
+ * duty e carrying i > 0 drops (e r_sw + (1 - e) r_d) i, which at
+ * standstill (e ~ 1/2) is r_dev i with r_dev = (r_sw + r_d) / 2 in every
+ * phase: the slope is R_s + r_dev, and only a figure from outside the
+ * measurement separates them (a different r_sw and r_d would show as a
+ * slope that moves with a common-mode duty; a MOSFET bridge has none). The
+ * board states r_dev (parameter r_dev, its datasheet); R_s is the slope
+ * less r_dev, and v_err then holds the devices' drop.
  *
  * Rotor: free. A DC current aligns a PM rotor's d axis with it (a
  * reluctance rotor its high-inductance axis): the procedure first holds
@@ -45,12 +54,13 @@
 #define PROC_RS_TRIP 1.2f   /* a measured current above this times the limit fails it */
 #define PROC_RS_RAMP 0.005f /* a level change is ramped over this [s] */
 #define PROC_RS_TURN 0.2f   /* the turn to theta = pi takes this [s] */
+#define PROC_RS_DAMP 0.3f   /* the swing's damping current: at most this fraction of the limit */
 /* the longest wait for the swing's turning point (proc_swing.c), a half
  * swing: a swing slower than 2 Hz is averaged over whatever window [s] */
 #define PROC_RS_SWING 0.25f
 /* the knee: the lowest level from which every level above lies within
  * PROC_RS_KNEE_TOL of its sign's plateau (of |V_0|) */
-#define PROC_RS_KNEE_TOL 0.05f
+#define PROC_RS_KNEE_TOL 0.01f
 
 /* The phase numbers (proc_telemetry_t.phase), n = id_rs_levels. */
 static inline uint8_t ph_turn(uint8_t n) {
@@ -86,7 +96,7 @@ FD_COLD static const char *rs_check(const proc_setup_t *su, const char **field) 
   }
   if (c->id_rs_levels < 3u || c->id_rs_levels > PROC_RS_LEVELS_MAX) {
     *field = "id_rs_levels";
-    return "3 .. PROC_RS_LEVELS_MAX levels";
+    return "3 .. 8 levels (PROC_RS_LEVELS_MAX: their storage)";
   }
   return NULL;
 }
@@ -99,7 +109,18 @@ FD_COLD static bool rs_wanted(const proc_setup_t *su) {
 
 FD_COLD static void rs_init(proc_state_t *st, const proc_setup_t *su) {
   proc_rs_t *r = &st->rs;
-  const current_ctrl_cfg_t ccfg = {su->machine, su->cfg->current_bw, su->cfg->ts};
+  /* The loop's frame is the current's, not the rotor's: the rotor lies
+   * anywhere on it until it has aligned, and on a salient or reluctance
+   * rotor either axis may see either inductance. Both axes get the smaller
+   * one (of a map: at zero current): the loop never faster than designed
+   * (the larger one on the low-inductance axis overshot into the trip on
+   * syr_1k1), slower where the rotor puts the larger. */
+  /* mut: rs_loop_rotor_gains */
+  const machine_ldq_t l0 = machine_inductance(su->machine, (dq_t){0.0f, 0.0f});
+  const float l_min = fminf(l0.dd, l0.qq);
+  r->loop = (machine_t){
+      MACHINE_LINEAR, su->machine->pole_pairs, su->machine->rs, l_min, l_min, 0.0f, NULL};
+  const current_ctrl_cfg_t ccfg = {&r->loop, su->cfg->current_bw, su->cfg->ts};
   current_ctrl_init(&r->cc, &ccfg);
   r->n_levels = (uint8_t)su->cfg->id_rs_levels;
   r->phase = 0u;
@@ -160,7 +181,7 @@ FD_COLD static float rs_fit(const proc_rs_t *r, uint8_t used, float c_out[2]) {
  * first line; the knee is the lowest level from which every level above
  * lies within PROC_RS_KNEE_TOL |V_0| of its sign's plateau; the fit is
  * repeated over the levels above the knee (at least 2 of each sign). */
-FD_COLD static bool rs_finish(proc_rs_t *r) {
+FD_COLD static bool rs_finish(proc_rs_t *r, float r_dev) {
   const uint8_t n = r->n_levels;
   float c[2];
   uint8_t used = (uint8_t)((n + 1u) / 2u);
@@ -190,9 +211,13 @@ FD_COLD static bool rs_finish(proc_rs_t *r) {
     }
   }
   const float i_top = 0.5f * (r->lv_i[0] - r->lv_i[n]);
-  const float v_err_top = 0.5f * ((r->lv_v[0] - rr * r->lv_i[0]) - (r->lv_v[n] - rr * r->lv_i[n]));
+  /* the winding's: the slope less the devices' resistance the board states
+   * (r_dev); their drop is the inverter's error, with the plateau */
+  /* mut: rs_device_resistance_kept */
+  const float rw = rr - r_dev;
+  const float v_err_top = 0.5f * ((r->lv_v[0] - rw * r->lv_i[0]) - (r->lv_v[n] - rw * r->lv_i[n]));
   const float knee = 0.5f * (fabsf(r->lv_i[used - 1u]) + fabsf(r->lv_i[n + used - 1u]));
-  r->res[0] = rr;
+  r->res[0] = rw;
   r->res[1] = v_err_top;
   r->res[2] = knee;
   r->res[3] = c[0];
@@ -200,7 +225,7 @@ FD_COLD static bool rs_finish(proc_rs_t *r) {
   r->res[5] = i_top;
   r->res[6] = sqrtf(e2 / (float)(2u * used));
   r->res[7] = (float)used;
-  return isfinite(rr) && rr > 0.0f && isfinite(v_err_top);
+  return isfinite(rw) && rw > 0.0f && isfinite(v_err_top);
 }
 
 FD_COLD static int rs_step(proc_state_t *st, const proc_setup_t *su, const proc_in_t *in,
@@ -235,8 +260,14 @@ FD_COLD static int rs_step(proc_state_t *st, const proc_setup_t *su, const proc_
   float target = top;
   uint32_t n_phase = n_align;
   bool measure = false;
-  if (r->phase == 0u) { /* the alignment along theta = 0 */
-    r->theta = 0.0f;
+  if (r->phase == 0u) {
+    /* the alignment: at pi/2 first, then turned to 0 (a rotor that starts
+     * where a current along 0 holds it unstably, at pi or, on a reluctance
+     * rotor, on its low-inductance axis, would leave it during the levels:
+     * proc_ident_align_angle), then held at 0 for id_rs_align */
+    /* mut: rs_align_direct */
+    r->theta = proc_ident_align_angle(r->n, n_align / 2u, n_turn);
+    n_phase = n_align / 2u + n_turn + n_align;
   } else if (r->phase <= n) { /* positive levels, top first */
     target = rs_level(c, n, (uint8_t)(r->phase - 1u));
     n_phase = n_settle + n_avg;
@@ -257,13 +288,18 @@ FD_COLD static int rs_step(proc_state_t *st, const proc_setup_t *su, const proc_
   const sincos_t sc = frames_sincos(r->theta);
   const float i_x = sc.c * in->i_ab.alpha + sc.s * in->i_ab.beta;
   const float i_y = -sc.s * in->i_ab.alpha + sc.c * in->i_ab.beta;
+  /* the swing damped (proc_swing.c) but within a level's window, at most
+   * PROC_RS_DAMP of the limit across the current */
+  /* mut: rs_swing_undamped */
+  const float damp = PROC_RS_DAMP * lim;
+  const float iy_ref = proc_swing_damping(&r->swing, r->i_ref, damp, slew, !r->open);
   const dq_t v =
-      current_ctrl_update(&r->cc, (dq_t){r->i_ref, 0.0f}, (dq_t){i_x, i_y}, 0.0f, in->v_max);
+      current_ctrl_update(&r->cc, (dq_t){r->i_ref, iy_ref}, (dq_t){i_x, i_y}, 0.0f, in->v_max);
   out->v_ab = (ab_t){sc.c * v.d - sc.s * v.q, sc.s * v.d + sc.c * v.q};
   /* the swing's turning points (proc_swing.c): along 0 and pi the voltage
    * across the current is the back-EMF of the rotor's swing alone */
   /* mut: rs_swing_window */
-  proc_swing_step(&r->swing, v.q, c->ts);
+  proc_swing_step(&r->swing, v.d, v.q, c->ts);
   const uint32_t n_swing = rs_periods(PROC_RS_SWING, c->ts);
   /* a level's window begins at a turning point after the settling (or
    * when none came within PROC_RS_SWING) ... */
@@ -279,7 +315,10 @@ FD_COLD static int rs_step(proc_state_t *st, const proc_setup_t *su, const proc_
   r->v_prev = v.d;
   ++r->n;
   /* ... and ends at one after id_rs_avg (at most PROC_RS_SWING later):
-   * the swing's flux along the current is the same at both ends (1) */
+   * the swing's flux along the current is the same at both ends (1).
+   * (Windows of whole swings, for the asymmetric swing of a reluctance
+   * rotor, and alignments that wait for the swing to calm were tried: no
+   * case of the presets and seeds 1-8 came out better, issue 25.) */
   if (measure ? !(r->open && r->acc_n >= n_avg && (r->swing.turned || r->acc_n >= n_avg + n_swing))
               : r->n < n_phase) {
     return PROC_RUNNING;
@@ -301,8 +340,10 @@ FD_COLD static int rs_step(proc_state_t *st, const proc_setup_t *su, const proc_
   r->n = 0u;
   ++r->phase;
   if (r->phase == ph_report(n)) {
-    if (!rs_finish(r)) {
-      out->fault = DRIVE_FAULT_CONTROL; /* no slope: no current, or an open phase */
+    if (!rs_finish(r, c->r_dev)) {
+      /* no slope (no current, an open phase), or none left for the winding
+       * (r_dev above the slope) */
+      out->fault = DRIVE_FAULT_CONTROL;
       return PROC_FAILED;
     }
     out->v_ab = (ab_t){0.0f, 0.0f};
@@ -318,8 +359,8 @@ FD_COLD static int rs_step(proc_state_t *st, const proc_setup_t *su, const proc_
  *  2n + 2 .. 4n + 1: the report, one level a slow period, positive levels
  *  then negative, top first: [i_k A, v_k V, v_err(i_k) = v_k - R_s i_k V,
  *  R_s Ohm]. 4n + 2 (done): the fit:
- *   0 R_s [Ohm] (slope above the knee; it includes the devices' on-state
- *     resistance, which no DC measurement separates from the winding)
+ *   0 R_s [Ohm] (the slope above the knee less r_dev, the devices'
+ *     resistance the board states: no DC measurement separates the two)
  *   1 v_err at the top level [V] (mean of both signs, odd part)
  *   2 the knee current [A] (the lowest level on the plateau)
  *   3, 4 the plateaus V_0 of the positive and negative sign [V]

@@ -534,9 +534,14 @@ static int set_pwm_frequency(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
 
 static int inverter_post(ctx_t *c, scenario_t *sc, const sk_val_t *v) {
   (void)c;
-  (void)v;
   sc->drive.ts = (float)sc->plant.ts;
   sc->drive.dead_time = (float)sc->plant.inverter.dead_time;
+  /* the board's datasheet figure: the devices' mean resistance in a
+   * phase's path at standstill (half the period each, proc_rs.c), unless
+   * the scenario states another (a datasheet's tolerance) */
+  if (!cJSON_GetObjectItemCaseSensitive(v->it, "r_dev")) {
+    sc->drive.r_dev = (float)(0.5 * (sc->plant.inverter.r_on_sw + sc->plant.inverter.r_diode));
+  }
   return 0;
 }
 

@@ -141,6 +141,9 @@
   X(K_INV_R_DIODE, .parent = K_INVERTER, .key = "r_diode", .type = SK_NUM,                         \
     RANGE(0.0, PLANT_R_DROP_MAX), AT(F64, plant.inverter.r_diode), DEF(0.0),                       \
     .doc = "its resistance [Ohm]")                                                                 \
+  X(K_INV_R_DEV, .parent = K_INVERTER, .key = "r_dev", .type = SK_NUM, PARAM("r_dev"),             \
+    AT(F32, drive.r_dev), .dflt = "(r_on_sw + r_diode) / 2",                                       \
+    .doc = "the board's stated device resistance [Ohm] (the drive's r_dev)")                      \
   /* ---- dc_link ---- */                                                                          \
   X(K_DC_LINK, .parent = K_ROOT, .key = "dc_link", .type = SK_OBJECT,                              \
     .doc = "the DC source, link capacitor, rectifier, chopper")                                    \

@@ -19,21 +19,23 @@
   machine_t m;                                                                                     \
   pos_state_t pos_st;                                                                              \
   float offset[3];                                                                                 \
+  float i_sum_noise;                                                                               \
   proc_setup_t su;                                                                                 \
   proc_state_t st;                                                                                 \
   hal_sample_t s;
 
 static inline void proc_fixture_bind_parts(drive_config_t *c, machine_t *m, pos_state_t *pos_st,
-                                           float *offset, proc_setup_t *su) {
+                                           float *offset, float *i_sum_noise, proc_setup_t *su) {
   assert_int_equal(machine_init_linear(m, c->pole_pairs, c->rs, c->ld, c->lq, c->lambda_m), 0);
   const pos_source_row_t *ps = pos_source(c->pos_source);
   ps->init(pos_st, c);
   ps->reset(pos_st);
-  *su = (proc_setup_t){c, m, ps, pos_st, offset, (ps->caps & POS_CAP_GATED) != 0u};
+  *su = (proc_setup_t){c, m, ps, pos_st, offset, i_sum_noise, (ps->caps & POS_CAP_GATED) != 0u};
 }
 
 /* fx: a fixture with PROC_FIXTURE_FIELDS */
 #define proc_fixture_bind(fx)                                                                      \
-  proc_fixture_bind_parts(&(fx)->cfg, &(fx)->m, &(fx)->pos_st, (fx)->offset, &(fx)->su)
+  proc_fixture_bind_parts(&(fx)->cfg, &(fx)->m, &(fx)->pos_st, (fx)->offset, &(fx)->i_sum_noise,   \
+                          &(fx)->su)
 
 #endif

@@ -78,7 +78,7 @@ static run_t run(float r_plant, float v_err, float i_trip_at) {
                    0);
   const model_t mdl = {cfg.ld, cfg.lq, cfg.lambda_m, 187.0f, 16.0f, 12.0f};
   const proc_row_t *row = proc_row(PROC_FMAP);
-  proc_setup_t su = {&cfg, &mach, NULL, NULL, NULL, false};
+  proc_setup_t su = {&cfg, &mach, NULL, NULL, NULL, NULL, false};
   const char *field = NULL;
   assert_null(row->check(&su, &field));
   static proc_state_t st;
@@ -182,7 +182,7 @@ static void grid_too_large_refused(void **state) {
   drive_config_default(&cfg);
   cfg.id_fmap_nd = 20u;
   cfg.id_fmap_nq = 20u;
-  proc_setup_t su = {&cfg, NULL, NULL, NULL, NULL, false};
+  proc_setup_t su = {&cfg, NULL, NULL, NULL, NULL, NULL, false};
   const char *field = NULL;
   assert_non_null(proc_row(PROC_FMAP)->check(&su, &field));
   assert_string_equal(field, "id_fmap_nd");

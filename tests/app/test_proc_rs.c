@@ -116,6 +116,34 @@ static void a_single_level_would_not_separate(void **state) {
   assert_true(fabsf(tm.result[0] / 0.5f - 1.0f) < 0.02f);
 }
 
+/* The devices' resistance (the board's r_dev) is in the slope like the
+ * winding's: R_s is the slope less r_dev, and the devices' drop goes to the
+ * voltage error; an r_dev above the slope leaves no winding and fails. */
+static void device_resistance_taken_out(void **state) {
+  (void)state;
+  const float rw = 0.05f, rdev = 0.02f; /* a low-resistance machine: r_dev 40 % of it */
+  fixture(rw, 1e-4f);
+  fx.cfg.r_dev = rdev;
+  model_t m = {rw + rdev, 1e-4f, 1e-4f, 0.4f, 0.6f, 0.02f,       0.01f,
+               0.0f,      0.0f,  99u,   0.0f, 0,    {0.0f, 0.0f}};
+  proc_telemetry_t tm;
+  unsigned points;
+  assert_int_equal(run(&m, &tm, 200000u, &points), PROC_DONE);
+  assert_true(fabsf(tm.result[0] / rw - 1.0f) < 0.02f);
+  /* the error at the top level now holds the devices' drop r_dev i along alpha */
+  const float i_top = tm.result[5];
+  const float truth =
+      (2.0f / 3.0f) * (phase_err(&m, i_top) + phase_err(&m, 0.5f * i_top)) + rdev * i_top;
+  assert_true(fabsf(tm.result[1] / truth - 1.0f) < 0.05f);
+  /* a board figure above the whole slope: no winding left */
+  fixture(rw, 1e-4f);
+  fx.cfg.r_dev = 2.0f * (rw + rdev);
+  model_t m2 = {rw + rdev, 1e-4f, 1e-4f, 0.4f, 0.6f, 0.02f,       0.01f,
+                0.0f,      0.0f,  99u,   0.0f, 0,    {0.0f, 0.0f}};
+  assert_int_equal(run(&m2, &tm, 200000u, &points), PROC_FAILED);
+  assert_int_equal(tm.fault, DRIVE_FAULT_CONTROL);
+}
+
 static void overcurrent_fails(void **state) {
   (void)state;
   fixture(0.5f, 1e-3f);
@@ -149,6 +177,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(resistance_and_voltage_error_separated),
       cmocka_unit_test(a_single_level_would_not_separate),
+      cmocka_unit_test(device_resistance_taken_out),
       cmocka_unit_test(overcurrent_fails),
       cmocka_unit_test(refuses_bad_levels_and_is_identification),
   };

@@ -77,7 +77,14 @@ def test_commission_offset_over_can(tmp_path):
         line = next(ln for ln in r.stdout.splitlines() if f"offset_{ch}" in ln)
         nums = [float(x) for x in re.findall(r"-?\d+\.?\d*(?:e[-+]?\d+)?", line.split("A", 1)[1])]
         assert nums[0] == pytest.approx(TRUE[k], abs=1e-6)
-    assert got["results"][3:] == [0.0] * 5
+    # result 3: the current sum's noise (the current-sum check's floor,
+    # proc_offset.c): three independent channels of NOISE rms and their
+    # quantisation, within 15 % (256 samples: the estimate's own spread 4.4 %)
+    lsb = 2.0 * I_FS / 2 ** ADC_BITS
+    sigma = math.sqrt(3.0 * (NOISE ** 2 + lsb ** 2 / 12.0))
+    print(f"current-sum noise: identified {got['results'][3]:.5f} A, expected {sigma:.5f} A")
+    assert 0.85 * sigma <= got["results"][3] <= 1.15 * sigma
+    assert got["results"][4:] == [0.0] * 4
     assert "[####################] 1/1 offset   done" in r.stdout  # the progress line
 
 

@@ -54,13 +54,6 @@ V = "tests/python/test_varatharajan2022.py::"
 #: found on the commissioned values (the paper's limit stays; the value
 #: that makes the difference named)
 XFAIL = {
-    R + "test_torque_step_deadbeat":
-        "on the edge: the step meets its reference at k+3 (n_ref 3 > 2) on the commissioned R_s "
-        "+0.52 %, lambda_m +0.12 %, encoder offset -0.37 deg electrical; it met it at k+2 with "
-        "lambda_m +0.11 % (the same procedures before the poles turn took the core's sine)",
-    R + "test_torque_step_pi":
-        "the identified R_s (+0.52 % with the rs swing windows, on the bench's drops) delays "
-        "the PI step's settling to 16 samples (band 12 +- 3.8)",
     R + "test_step_settles_on_the_reference":
         "the static error of the identified R_s (+0.6 %), L_d and lambda_m (+0.1 %) puts the DB "
         "step outside 0.05 N m (k+29, -0.017 N m plus the ripple)",

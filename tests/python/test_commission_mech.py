@@ -144,17 +144,14 @@ def _case(name: str) -> tuple[dict, dict]:
     return _RUNS[name]
 
 
-# Known failures (the report of issue 25's branch identmech): the drive's
-# current_sensor protection stops mech on these two; ipm:4's lambda_m (3.8
+# Known failures. spm:4 (23 pole pairs, lambda_m 0.021 Vs): the encoder's
+# offset -1.07 deg electrical and lambda_m +2.7 %. ipm:4's lambda_m (3.8
 # mVs) is 2.4 % off (L_d |i| / lambda_m = 0.34: the inductances' error).
-# ipm:5 joins the first two since poles turns its vector with the core's
-# sine instead of libm's sinf (branch pilproc: the PIL's duties must equal
-# the host's): the rotor's path differs in the last bits, and mech, which
-# passed before, is stopped the same way.
+# (spm:4, ipm:2 and ipm:5 were stopped by the current_sensor protection
+# until the offset procedure measured the sensors' noise as that check's
+# floor, proc_offset.c; ipm:2 and ipm:5 now pass.)
 _XFAIL = {
-    "spm:4": "mech stopped by the current_sensor protection",
-    "ipm:2": "mech stopped by the current_sensor protection",
-    "ipm:5": "mech stopped by the current_sensor protection",
+    "spm:4": "enc offset -1.07 deg electrical, lambda_m +2.7 % (23 pole pairs, 0.021 Vs)",
     "ipm:4": "lambda_m 2.4 % off on a 3.8 mVs machine (L_d |i| / lambda_m 0.34)",
 }
 CASES = ["preset"] + [f"{k}:{s}" for k in ("spm", "ipm") for s in SEEDS]

@@ -161,6 +161,7 @@ typedef struct {
   uint32_t n;        /* periods since it began */
   uint32_t calm_n;   /* periods the encoder's speed has stayed below w_calm */
   float phi;         /* the current's angle last period [rad] */
+  float lam;         /* the machine's lambda_m (a flux map's at zero current) [Vs] */
 } proc_align_t;
 
 typedef struct {
@@ -322,6 +323,7 @@ typedef struct {
   float acc_c, acc_s; /* the point's sums */
   uint32_t acc_n;
   float dir; /* +1, -1: the encoder counts with the vector's angle or against it */
+  float lam; /* the machine's lambda_m (a flux map's at zero current) [Vs] */
 } proc_enc_t;
 
 /* proc_flux.c: the rotor spun by the current loop on the encoder. */
@@ -444,7 +446,7 @@ bool proc_applies(proc_id_t id, const proc_setup_t *su);
 const char *proc_start_refusal(const proc_setup_t *su, const char **field);
 
 /* proc_align.c: the alignment's timing for cfg (also the tests'). */
-void proc_align_timing(const drive_config_t *cfg, proc_align_timing_t *t);
+void proc_align_timing(const drive_config_t *cfg, float lambda_m, proc_align_timing_t *t);
 
 /* proc_swing.c: reset before the first period; step once a period with
  * the voltage across the current asked the period before [V] and the

@@ -26,13 +26,14 @@
 #define PROC_ALIGN_CALM   0.01f
 #define PROC_ALIGN_SWINGS 10.0f
 
-FD_COLD void proc_align_timing(const drive_config_t *c, proc_align_timing_t *t) {
+FD_COLD void proc_align_timing(const drive_config_t *c, float lambda_m, proc_align_timing_t *t) {
   /* the rotor swings about the current's axis at w_n = p sqrt(1.5 lambda_m
-   * i_align / J) (electrical), the PM torque 1.5 p lambda_m i_q; the
+   * i_align / J) (electrical), the PM torque 1.5 p lambda_m i_q (lambda_m
+   * the machine's: a flux map's at zero current, which the parameter
+   * set's lambda_m does not hold; issue 25, ipm_sat's enc); the
    * current's angle led by -k_d omega_e damps it (theta'' = -w_n^2 (theta
    * + k_d theta'): zeta = k_d w_n / 2) */
-  const float wn2 =
-      1.5f * c->pole_pairs * c->pole_pairs * c->lambda_m * c->align_current / c->inertia;
+  const float wn2 = 1.5f * c->pole_pairs * c->pole_pairs * lambda_m * c->align_current / c->inertia;
   const float wn = wn2 > 0.0f ? sqrtf(wn2) : 0.0f;
   t->kd = wn > 0.0f ? 2.0f * PROC_ALIGN_ZETA / wn : 0.0f;
   /* settled: |omega_e| < PROC_ALIGN_CALM w_n for 2 / w_n (over a quarter
@@ -63,6 +64,7 @@ FD_COLD static void align_init(proc_state_t *st, const proc_setup_t *su) {
   a->n = 0u;
   a->calm_n = 0u;
   a->phi = 0.0f;
+  a->lam = su->machine->lambda_m;
 }
 
 FD_COLD static int align_step(proc_state_t *st, const proc_setup_t *su, const proc_in_t *in,
@@ -70,7 +72,7 @@ FD_COLD static int align_step(proc_state_t *st, const proc_setup_t *su, const pr
   proc_align_t *a = &st->align;
   const drive_config_t *c = su->cfg;
   proc_align_timing_t tmg;
-  proc_align_timing(c, &tmg);
+  proc_align_timing(c, a->lam, &tmg);
   /* mut: encoder_alignment_undamped */
   const bool enc = !su->gated && tmg.kd > 0.0f;
   const float w = in->pos->omega;

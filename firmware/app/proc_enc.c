@@ -27,6 +27,9 @@
  *  - a constant load torque (gravity, a spring) biases both passes the
  *    same way: not cancelled, the offset errs by delta (raise id_i_test:
  *    delta ~ T_L / (1.5 p lambda_m i)).
+ * The damping and the settling come from the machine's lambda_m (a flux
+ * map's at zero current, which its parameter set's lambda_m, 0, does not
+ * hold: with that 0 ipm_sat's rotor swung undamped, 23 deg off).
  * Bounds: the current i (PROC_ID_TRIP i + 5 % i_max, proc_poles.c), the
  * voltage v_max; the rotor turns one electrical turn forward and back
  * (1 / p mechanical turn).
@@ -44,9 +47,9 @@
 
 /* periods to settle, and to average, at a point: 2.5 the alignment's calm
  * span (2 / w_n, proc_align_timing), at least 0.05 s, at most 0.5 s */
-FD_COLD static uint32_t enc_n_settle(const drive_config_t *c) {
+FD_COLD static uint32_t enc_n_settle(const drive_config_t *c, float lambda_m) {
   proc_align_timing_t t;
-  proc_align_timing(c, &t);
+  proc_align_timing(c, lambda_m, &t);
   const uint32_t lo = (uint32_t)(0.05f / c->ts), hi = (uint32_t)(0.5f / c->ts);
   const uint32_t n = 5u * t.calm_need / 2u;
   return n < lo ? lo : (n > hi ? hi : n);
@@ -68,6 +71,8 @@ FD_COLD static void enc_init(proc_state_t *st, const proc_setup_t *su) {
     e->e[k] = 0.0f;
   }
   e->acc_c = e->acc_s = 0.0f;
+  /* mut: enc_timing_map_flux_ignored */
+  e->lam = su->machine->lambda_m;
   e->acc_n = 0u;
   e->dir = 0.0f;
 }
@@ -97,7 +102,7 @@ FD_COLD static int enc_step(proc_state_t *st, const proc_setup_t *su, const proc
   }
   const float th = proc_enc_unwrap(&e->u, in->s->enc_angle);
   const uint32_t n_move = (uint32_t)(PROC_ENC_MOVE / c->ts) + 1u;
-  const uint32_t n_settle = enc_n_settle(c);
+  const uint32_t n_settle = enc_n_settle(c, e->lam);
   const uint32_t n_point = n_move + 2u * n_settle; /* move, settle, average */
   const unsigned last = 2u * PROC_ENC_POINTS;
   e->n_all++;
@@ -152,7 +157,7 @@ FD_COLD static int enc_step(proc_state_t *st, const proc_setup_t *su, const proc
   }
   /* the alignment's damping: the vector led against the encoder's speed */
   proc_align_timing_t tmg;
-  proc_align_timing(c, &tmg);
+  proc_align_timing(c, e->lam, &tmg);
   const float w = e->dir * in->pos->omega; /* 0 until the direction is known */
   const float phi = e->theta_v + fd_clampf(-tmg.kd * w, -0.25f * FRAMES_PI, 0.25f * FRAMES_PI);
   const sincos_t sc = frames_sincos(frames_wrap_pi(phi));

@@ -65,9 +65,8 @@ FD_COLD static void flux_init(proc_state_t *st, const proc_setup_t *su) {
 
 /* The ramp's rate [rad/s^2 mechanical]: PROC_FLUX_ACC of the q current's
  * torque over the inertia (parameters), or id_speed in PROC_FLUX_RAMP. */
-FD_COLD static float flux_acc(const drive_config_t *c, float i) {
-  const float a_t =
-      PROC_FLUX_ACC * 1.5f * c->pole_pairs * c->lambda_m * PROC_FLUX_ID * i / c->inertia;
+FD_COLD static float flux_acc(const drive_config_t *c, float lambda_m, float i) {
+  const float a_t = PROC_FLUX_ACC * 1.5f * c->pole_pairs * lambda_m * PROC_FLUX_ID * i / c->inertia;
   const float a_min = proc_id_speed(c) / PROC_FLUX_RAMP;
   return a_t > a_min ? a_t : a_min;
 }
@@ -111,7 +110,7 @@ FD_COLD static int flux_step(proc_state_t *st, const proc_setup_t *su, const pro
   const unsigned dir_k = f->phase >= PH_BACK && f->phase < PH_STOP ? 1u : 0u;
   const unsigned ph = f->phase == PH_STOP ? PH_RAMP : f->phase - PH_BACK * dir_k;
   const float target = f->phase == PH_STOP ? 0.0f : (dir_k == 0u ? w_id : -w_id);
-  const float acc = flux_acc(c, i);
+  const float acc = flux_acc(c, su->machine->lambda_m, i);
   f->n_all++;
   f->n++;
   if (ph == PH_RAMP) {
@@ -157,8 +156,9 @@ FD_COLD static int flux_step(proc_state_t *st, const proc_setup_t *su, const pro
     out->fault = DRIVE_FAULT_LOST_CONTROL; /* the speed was not reached */
     return PROC_FAILED;
   }
-  /* the speed loop (P, the parameters' inertia and torque constant) */
-  const float kt = 1.5f * c->pole_pairs * c->lambda_m;
+  /* the speed loop (P, the parameters' inertia and the machine's torque
+   * constant: a flux map's lambda_m at zero current) */
+  const float kt = 1.5f * c->pole_pairs * su->machine->lambda_m;
   const float iq_max = PROC_FLUX_ID * i;
   const float iq =
       kt > 0.0f ? fd_clampf(c->inertia * PROC_FLUX_BW * (f->w_ref - wm) / kt, -iq_max, iq_max)

@@ -7,7 +7,7 @@
  * The same samples give the sensors' noise: the sum of the three phase
  * currents is zero in a star winding (and at zero current), so its
  * spread over the window is the sensors' noise and quantisation alone.
- * PROC_OFFSET_NOISE_K times its standard deviation becomes the
+ * PROC_OFFSET_NOISE_K (3) times its standard deviation becomes the
  * current-sum check's floor (su->i_sum_noise; protect/isum.h: the larger of
  * it and i_sum_abs): a board whose noise is above i_sum_abs would
  * otherwise trip `current_sensor` at low currents (a drawn machine's
@@ -20,7 +20,10 @@
 
 #include "math/fd_math.h"
 
-#define PROC_OFFSET_NOISE_K 6.0f /* the floor: this many standard deviations */
+/* the floor: this many standard deviations. The check's leaky count trips
+ * at 8 more samples over than under (protect/isum.h): at 3 sigma each is
+ * over with p = 0.27 %, and noise alone never gets there */
+#define PROC_OFFSET_NOISE_K 3.0f
 
 FD_COLD static void offset_init(proc_state_t *st, const proc_setup_t *su) {
   (void)su;

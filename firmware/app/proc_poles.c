@@ -99,8 +99,8 @@ FD_COLD static bool poles_overcurrent(const drive_config_t *c, ab_t i, float i_t
  * electrical acceleration, 1.5 p^2 lambda_m i / J, is p = 1's), J and
  * lambda_m the parameters' (rough values suffice), and the speed at most
  * 2 pi PROC_POLES_HZ on average; at most PROC_POLES_T_MAX. */
-FD_COLD static float poles_turn_time(const drive_config_t *c, float i) {
-  const float a = PROC_POLES_ACC * 1.5f * c->lambda_m * i / c->inertia;
+FD_COLD static float poles_turn_time(const drive_config_t *c, float lambda_m, float i) {
+  const float a = PROC_POLES_ACC * 1.5f * lambda_m * i / c->inertia;
   const float t_acc =
       a > 0.0f ? sqrtf(4.0f * FRAMES_PI * FRAMES_PI * PROC_POLES_TURNS / a) : PROC_POLES_T_MAX;
   return fminf(fmaxf(t_acc, PROC_POLES_TURNS / PROC_POLES_HZ), PROC_POLES_T_MAX);
@@ -138,7 +138,7 @@ FD_COLD static int poles_step(proc_state_t *st, const proc_setup_t *su, const pr
   }
   const float th = proc_enc_unwrap(&p->u, in->s->enc_angle);
   const uint32_t n_hold = (uint32_t)(PROC_POLES_HOLD / c->ts) + 1u;
-  const float t_turn = poles_turn_time(c, i);
+  const float t_turn = poles_turn_time(c, su->machine->lambda_m, i);
   const uint32_t n_turn = (uint32_t)(t_turn / c->ts) + 1u;
   p->n_all++;
   p->n++;

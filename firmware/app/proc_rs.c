@@ -258,8 +258,9 @@ FD_COLD static int rs_step(proc_state_t *st, const proc_setup_t *su, const proc_
   const float top = rs_level(c, n, 0u);
   /* the reference and the axis of this phase */
   float target = top;
-  uint32_t n_phase = n_align;
-  bool measure = false;
+  /* the levels' phases (either sign): settled, then averaged */
+  uint32_t n_phase = n_settle + n_avg;
+  bool measure = true;
   if (r->phase == 0u) {
     /* the alignment: at pi/2 first, then turned to 0 (a rotor that starts
      * where a current along 0 holds it unstably, at pi or, on a reluctance
@@ -268,18 +269,16 @@ FD_COLD static int rs_step(proc_state_t *st, const proc_setup_t *su, const proc_
     /* mut: rs_align_direct */
     r->theta = proc_ident_align_angle(r->n, n_align / 2u, n_turn);
     n_phase = n_align / 2u + n_turn + n_align;
+    measure = false;
   } else if (r->phase <= n) { /* positive levels, top first */
     target = rs_level(c, n, (uint8_t)(r->phase - 1u));
-    n_phase = n_settle + n_avg;
-    measure = true;
   } else if (r->phase == ph_turn(n)) { /* the turn to pi at the top level, then a wait */
     r->theta = FRAMES_PI * fminf((float)r->n / (float)n_turn, 1.0f);
     n_phase = n_turn + n_align;
+    measure = false;
   } else { /* negative levels (along theta = pi), top first */
     r->theta = FRAMES_PI;
     target = rs_level(c, n, (uint8_t)(r->phase - ph_turn(n) - 1u));
-    n_phase = n_settle + n_avg;
-    measure = true;
   }
   /* the reference, slew-limited (no step overshoot) */
   const float slew = top * c->ts / PROC_RS_RAMP;

@@ -735,7 +735,7 @@ static void alignment_sets_the_encoder_offset(void **state) {
   assert_int_equal(drv.state, DRIVE_STATE_ALIGN);
   assert_true(hal.gates_on);
   proc_align_timing_t tmg; /* the alignment procedure's (proc_align.c) */
-  proc_align_timing(&drv.cfg, &tmg);
+  proc_align_timing(&drv.cfg, drv.cfg.lambda_m, &tmg);
   const int need = (int)tmg.still_need;
   assert_true(need > (int)(0.01f / drv.cfg.ts) + 1); /* the calm outlasts align_time here */
   run_isrs(need - 2);
@@ -761,7 +761,7 @@ static void swinging_rotor_never_aligns(void **state) {
   drive_cmd_enable(&drv, true);
   const float off0 = drv.pos_st.enc.offset;
   proc_align_timing_t tmg; /* the alignment procedure's (proc_align.c) */
-  proc_align_timing(&drv.cfg, &tmg);
+  proc_align_timing(&drv.cfg, drv.cfg.lambda_m, &tmg);
   for (int k = 0; k < (int)drv.cfg.offset_samples + (int)tmg.n_timeout + 2; ++k) {
     /* 0.1 rad mechanical at 5 Hz: 2 x 10 x 2 pi rad/s electrical peak */
     hal.sample.enc_angle = 1.0f + 0.1f * sinf(31.4159f * (float)k * drv.cfg.ts);

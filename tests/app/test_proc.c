@@ -180,7 +180,7 @@ static void alignment_bounded_then_hands_over(void **state) {
   const proc_row_t *r = proc_row(PROC_ALIGN);
   r->init(&fx.st, &fx.su);
   proc_align_timing_t t;
-  proc_align_timing(&fx.cfg, &t);
+  proc_align_timing(&fx.cfg, fx.cfg.lambda_m, &t);
   assert_true(t.kd > 0.0f && t.still_need > 0u && t.n_timeout > t.still_need);
   const float v_max = 20.0f;
   const uint32_t need = t.still_need > (uint32_t)(0.01f / fx.cfg.ts) + 1u
@@ -214,7 +214,7 @@ static void alignment_times_out_on_a_swinging_rotor(void **state) {
   const proc_row_t *r = proc_row(PROC_ALIGN);
   r->init(&fx.st, &fx.su);
   proc_align_timing_t t;
-  proc_align_timing(&fx.cfg, &t);
+  proc_align_timing(&fx.cfg, fx.cfg.lambda_m, &t);
   proc_out_t out;
   int res = PROC_RUNNING;
   uint32_t n = 0u;
@@ -360,7 +360,7 @@ static void drive_publishes_the_procedures(void **state) {
   assert_int_equal(tm.proc.id, PROC_ALIGN);
   assert_int_equal(tm.proc.status, PROC_ST_RUNNING);
   proc_align_timing_t tmg; /* a rotor that never moves: still_need periods */
-  proc_align_timing(&cfg, &tmg);
+  proc_align_timing(&cfg, cfg.lambda_m, &tmg);
   for (uint32_t k = 0; k < tmg.still_need && drv.state == DRIVE_STATE_ALIGN; ++k) {
     drive_isr(&drv);
   }

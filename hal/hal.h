@@ -44,6 +44,7 @@ typedef struct {
   float cpu_hz;       /* CPU clock for hal_isr_stats() [Hz] (0: no cycle counter) */
   float i_full_scale; /* largest phase current the ADC reads, either sign [A] (0: not known) */
   float v_full_scale; /* largest DC-link voltage the ADC reads [V] (0: not known) */
+  float i_lsb;        /* the current ADC's step [A] (0: not known) */
   uint32_t features;  /* HAL_CAP_* */
 } hal_caps_t;
 

@@ -639,11 +639,14 @@ static FD_NOINLINE void drive_window_sample(const drive_t *drv, float i[3], floa
 static FD_NOINLINE void drive_isum_row(drive_t *drv, bool due) {
   (void)due;
   const drive_config_t *c = &drv->cfg;
-  /* the absolute bound no lower than the sensors' own noise (proc_offset.c) */
+  /* the absolute bound no lower than the sensors' own noise (proc_offset.c)
+   * plus the three channels' rounding (at most half a step each: at zero
+   * current, without dither, the offsets' samples do not show it) */
   /* mut: isum_noise_floor_ignored */
-  const protect_isum_view_t v = {
-      drv->tm.i_abc, fd_maxf(c->i_sum_abs, drv->i_sum_noise), c->i_sum_rel,
-      (drv->caps->features & HAL_CAP_I_ABC) != 0u && gates_on_state(drv->state)};
+  const float floor_n = drv->i_sum_noise + 1.5f * drv->caps->i_lsb;
+  const protect_isum_view_t v = {drv->tm.i_abc, fd_maxf(c->i_sum_abs, floor_n), c->i_sum_rel,
+                                 (drv->caps->features & HAL_CAP_I_ABC) != 0u &&
+                                     gates_on_state(drv->state)};
   const uint32_t f = protect_isum_step(&drv->isum, &v);
   if (f != 0u) {
     drive_trip(drv, f);

@@ -84,7 +84,7 @@
   X(109, i_sum_rel,     F32,  "",       0.2f,        0.01f,   1.0f,     LIVE, "controller.i_sum_rel",      \
     "current-sensor check: |i_a + i_b + i_c| above i_sum_rel times the largest |i_x| (and i_sum_abs) trips current_sensor") \
   X(110, i_sum_abs,     F32,  "A",      0.05f,       0.0f,    1e3f,     LIVE, "controller.i_sum_abs",      \
-    "current-sensor check: the noise floor of |i_a + i_b + i_c| (raised to 3 sigma of the sum's noise the offset calibration measures)")                                          \
+    "current-sensor check: the noise floor of |i_a + i_b + i_c| (raised to 3 sigma of the sum's noise the offset calibration measures plus 1.5 ADC steps)")                                          \
   X(120, asc_speed,     F32,  "",       0.9f,        0.0f,    2.0f,     LIVE, "controller.asc_speed",      \
     "safe state: active short circuit above asc_speed times the rectifier speed v_dc/(sqrt(3) psi_pm), or on overvoltage; 0: gates off only (docs/faults.md)") \
   X(121, asc_hold,      F32,  "s",      0.05f,       1e-3f,   10.0f,    LIVE, "controller.asc_hold",       \

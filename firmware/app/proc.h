@@ -361,9 +361,18 @@ typedef struct {
   float w0;                 /* the filtered speed at the window's start [rad/s] */
   float win[3];             /* over the window: int sgn(w), int w, int T (filtered) */
   uint32_t win_n;           /* blocks in the window */
-  float ls[10];             /* the normal equations (ident_mech.h) */
   float res[4];             /* J, T_c, B, the fit's residual */
   float w;                  /* the speed [rad/s mechanical] (the PLL's) */
+  uint8_t plat;             /* the constant-speed plateau in force (proc_mech.c) */
+  bool plat_meas;           /* ... measured (settled) */
+  union {
+    float ls[10];       /* the steps: the normal equations (ident_mech.h) */
+    struct {            /* the plateaus (J solved): */
+      float integ;      /* the speed loop's integral [A] */
+      float p_t, p_th0; /* the plateau's torque integral [N m s], its start angle [rad] */
+      float ps[5];      /* the sums s s, s w, w w, s T, w T (T = T_c s + B w) */
+    } pl;
+  };
 } proc_mech_t;
 /* The star point's a, b (proc_star.c): the signals of a sweep in
  * PROC_STAR_BINS bins of the current vector's angle, then their fit. */

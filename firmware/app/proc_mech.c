@@ -43,8 +43,26 @@
 #define PROC_MECH_LO      0.4f /* ... coast to this */
 #define PROC_MECH_TRIP    1.3f
 
-/* The steps: q current sign and the speed that ends each (x w_hi). */
-enum { PH_ACC = 0, PH_COAST = 1, PH_BRAKE = 2, PH_COAST_B = 3, PH_BACK = 4, PH_END = 5 };
+/* The friction's plateaus: speeds (x w_hi), the speed loop's bandwidth
+ * [rad/s], the settling (at least, at most) and the measurement [s]. */
+#define PROC_MECH_NP      6u
+#define PROC_MECH_BW      20.0f
+#define PROC_MECH_T_SET   0.6f
+#define PROC_MECH_T_PLAT  1.0f
+#define PROC_MECH_SET_TOL 0.02f /* settled: within this of the plateau's speed */
+static const float mech_plat[PROC_MECH_NP] = {0.2f, 0.5f, 1.0f, -0.2f, -0.5f, -1.0f};
+
+/* The steps: q current sign and the speed that ends each (x w_hi); then
+ * the plateaus. */
+enum {
+  PH_ACC = 0,
+  PH_COAST = 1,
+  PH_BRAKE = 2,
+  PH_COAST_B = 3,
+  PH_BACK = 4,
+  PH_PLAT = 5,
+  PH_END = 6
+};
 
 FD_COLD static void mech_init(proc_state_t *st, const proc_setup_t *su) {
   proc_mech_t *m = &st->mech;
@@ -66,6 +84,23 @@ FD_COLD static void mech_init(proc_state_t *st, const proc_setup_t *su) {
   ident_mech_reset(m->ls);
   m->res[0] = m->res[1] = m->res[2] = m->res[3] = 0.0f;
   m->w = 0.0f;
+  m->plat = 0u;
+  m->plat_meas = false;
+}
+
+/* The friction from the plateaus: the least squares of T_k = T_c s_k + B
+ * w_k (s_k = sgn(w_k)) over the plateaus' mean torque T_k and speed w_k
+ * (the angle over the plateau: a count over PROC_MECH_T_PLAT), the normal
+ * equations solved by Cramer's rule. false: singular. */
+FD_COLD static bool mech_plat_solve(proc_mech_t *m) {
+  const float *p = m->pl.ps;
+  const float det = p[0] * p[2] - p[1] * p[1];
+  if (!(fabsf(det) > 1e-6f * p[0] * p[2])) {
+    return false;
+  }
+  m->res[1] = (p[2] * p[3] - p[1] * p[4]) / det;
+  m->res[2] = (p[0] * p[4] - p[1] * p[3]) / det;
+  return true;
 }
 
 /* The scales of the least squares' columns (ident_mech.h): speed w_s,
@@ -167,7 +202,8 @@ FD_COLD static int mech_step(proc_state_t *st, const proc_setup_t *su, const pro
   if (m->n_all == 0u) {
     m->b_th0 = th;
   }
-  if (++m->n_all % PROC_MECH_D == 0u) {
+  /* the steps' rows (not on the plateaus: J is solved, ls taken) */
+  if (++m->n_all % PROC_MECH_D == 0u && m->phase < PH_PLAT) {
     mech_block(m, c, th);
   }
   /* the steps */
@@ -186,24 +222,76 @@ FD_COLD static int mech_step(proc_state_t *st, const proc_setup_t *su, const pro
   case PH_COAST_B:
     next = w >= -PROC_MECH_LO * w_hi || t >= PROC_MECH_T_COAST;
     break;
-  default: /* PH_BACK */
+  case PH_BACK:
     next = w >= 0.0f || t >= PROC_MECH_T_STEP;
+    break;
+  default: /* PH_PLAT: settle, then measure over PROC_MECH_T_PLAT */
+    next = false;
+    if (!m->plat_meas) {
+      const float wr = mech_plat[m->plat] * w_hi;
+      if ((t >= PROC_MECH_T_SET && fabsf(w - wr) <= PROC_MECH_SET_TOL * fabsf(wr)) ||
+          t >= PROC_MECH_T_STEP) {
+        m->plat_meas = true;
+        m->n = 0u;
+        m->pl.p_t = 0.0f;
+        m->pl.p_th0 = th;
+      }
+    } else {
+      m->pl.p_t +=
+          1.5f * mm->pole_pairs * (mm->lambda_m + (mm->ld - mm->lq) * idq.d) * idq.q * c->ts;
+      if (t >= PROC_MECH_T_PLAT) { /* the plateau's mean torque and speed */
+        const float wk = (th - m->pl.p_th0) / t, tk = m->pl.p_t / t;
+        /* mut: mech_plateau_sign_ignored */
+        const float sk = wk > 0.0f ? 1.0f : -1.0f;
+        m->pl.ps[0] += sk * sk;
+        m->pl.ps[1] += sk * wk;
+        m->pl.ps[2] += wk * wk;
+        m->pl.ps[3] += sk * tk;
+        m->pl.ps[4] += wk * tk;
+        m->plat_meas = false;
+        m->n = 0u;
+        next = ++m->plat >= PROC_MECH_NP;
+      }
+    }
     break;
   }
   if (next) {
     m->phase++;
     m->n = 0u;
+    if (m->phase == PH_PLAT) {
+      /* J (and a first T_c, B) from the steps: the speed loop's gain */
+      mech_solve(m, c);
+      if (!(m->res[0] > 0.0f) || !fd_isfinite(m->res[0])) {
+        out->fault = DRIVE_FAULT_CONTROL; /* no fit: the rotor did not move as a free inertia */
+        return PROC_FAILED;
+      }
+      /* the normal equations' place taken by the plateaus' */
+      m->pl.integ = 0.0f;
+      m->pl.p_t = m->pl.p_th0 = 0.0f;
+      for (unsigned k = 0; k < 5u; ++k) {
+        m->pl.ps[k] = 0.0f;
+      }
+    }
     if (m->phase == PH_END) {
       out->apply = false;
-      mech_solve(m, c);
-      if (!(m->res[0] > 0.0f) || !fd_isfinite(m->res[1]) || !fd_isfinite(m->res[2])) {
-        out->fault = DRIVE_FAULT_CONTROL; /* no fit: the rotor did not move as a free inertia */
+      if (!mech_plat_solve(m) || !fd_isfinite(m->res[1]) || !fd_isfinite(m->res[2])) {
+        out->fault = DRIVE_FAULT_CONTROL; /* the plateaus carry no friction fit */
         return PROC_FAILED;
       }
       return PROC_DONE;
     }
   }
-  const float iq = m->phase == PH_ACC || m->phase == PH_BACK ? i : m->phase == PH_BRAKE ? -i : 0.0f;
+  float iq = m->phase == PH_ACC || m->phase == PH_BACK ? i : m->phase == PH_BRAKE ? -i : 0.0f;
+  if (m->phase == PH_PLAT) {
+    /* the speed loop: PI on the source's speed, T = J bw e, the integral
+     * zero at bw / 2 (settled to e^-6 in PROC_MECH_T_SET: no J dw/dt
+     * left in the plateau's torque), within +-i (the integral held) */
+    const float kt = 1.5f * mm->pole_pairs * mm->lambda_m;
+    const float kp = kt > 0.0f ? m->res[0] * PROC_MECH_BW / kt : 0.0f;
+    const float e = mech_plat[m->plat] * w_hi - w;
+    m->pl.integ = fd_clampf(m->pl.integ + 0.5f * PROC_MECH_BW * kp * e * c->ts, -i, i);
+    iq = fd_clampf(kp * e + m->pl.integ, -i, i);
+  }
   const dq_t v = current_ctrl_update(&m->cc, (dq_t){0.0f, iq}, idq, we, in->v_max);
   const sincos_t sc_out = frames_sincos(frames_wrap_pi(in->pos->theta + we * 1.5f * c->ts));
   out->v_ab = frames_park_inv(v, sc_out);

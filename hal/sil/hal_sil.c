@@ -25,6 +25,7 @@ void hal_sil_init(hal_sil_t *h, const hal_sil_board_t *board) {
   h->caps.cpu_hz = 0.0f;
   h->caps.i_full_scale = board->i_full_scale;
   h->caps.v_full_scale = board->v_full_scale;
+  h->caps.i_lsb = board->i_lsb;
   h->caps.features = HAL_CAP_ENCODER | HAL_CAP_STAR_POINT | HAL_CAP_I_ABC |
                      (board->asym_edges ? HAL_CAP_ASYM_EDGES : 0u);
   h->timer_counts = board->timer_counts;

@@ -35,6 +35,7 @@ typedef struct {
   uint32_t watchdog_ms;             /* watchdog timeout; 0: none */
   bool asym_edges;                  /* HAL_CAP_ASYM_EDGES */
   float i_full_scale, v_full_scale; /* the ADC ranges (hal_caps_t; 0: not known) */
+  float i_lsb;                      /* the current ADC's step (hal_caps_t; 0: not known) */
 } hal_sil_board_t;
 
 typedef struct {

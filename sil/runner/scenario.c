@@ -1157,6 +1157,8 @@ int scenario_parse(const char *json, const char *origin, scenario_t *sc, char *e
   /* the ADC ranges the drive's HAL reports (hal_caps_t): the sensors' */
   sc->board.i_full_scale = (float)sc->plant.sensors.i_full_scale;
   sc->board.v_full_scale = (float)sc->plant.sensors.v_full_scale;
+  sc->board.i_lsb =
+      (float)(2.0 * sc->plant.sensors.i_full_scale / ldexp(1.0, sc->plant.sensors.adc_bits));
   if (!(sc->drive.i_trip < sc->board.i_full_scale)) {
     return scn_fail(
         &c, "controller.i_trip",

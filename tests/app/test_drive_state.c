@@ -37,7 +37,7 @@ static void sample(float ia, float ib, float ic, float vdc) {
 }
 
 static void setup_with(const drive_config_t *cfg) {
-  const hal_sil_board_t board = {0.0f, 1.0f, 0u, 1e-6f, 62.5e-6f, 50u, false, 0.0f, 0.0f};
+  const hal_sil_board_t board = {0.0f, 1.0f, 0u, 1e-6f, 62.5e-6f, 50u, false, 0.0f, 0.0f, 0.0f};
   hal_sil_init(&hal, &board);
   hal_sil_bind(&hal);
   drive_config_err_t err;
@@ -459,7 +459,7 @@ static void lowered_i_max_reclamps_the_currents(void **state) {
  * as the full scale and would never reach i_trip). */
 static void protections_must_fit_the_adc_ranges(void **state) {
   (void)state;
-  const hal_sil_board_t board = {0.0f, 1.0f, 0u, 1e-6f, 62.5e-6f, 50u, false, 8.0f, 500.0f};
+  const hal_sil_board_t board = {0.0f, 1.0f, 0u, 1e-6f, 62.5e-6f, 50u, false, 8.0f, 500.0f, 0.0f};
   hal_sil_init(&hal, &board);
   hal_sil_bind(&hal);
   drive_config_t cfg;

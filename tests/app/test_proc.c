@@ -328,7 +328,7 @@ static void drive_publishes_the_procedures(void **state) {
   (void)state;
   static hal_sil_t hal;
   static drive_t drv;
-  const hal_sil_board_t board = {0.0f, 1.0f, 0u, 1e-6f, 62.5e-6f, 50u, false, 0.0f, 0.0f};
+  const hal_sil_board_t board = {0.0f, 1.0f, 0u, 1e-6f, 62.5e-6f, 50u, false, 0.0f, 0.0f, 0.0f};
   hal_sil_init(&hal, &board);
   hal_sil_bind(&hal);
   drive_config_t cfg;
@@ -392,7 +392,7 @@ static void identification_runs_alone_and_stops(void **state) {
   (void)state;
   static hal_sil_t hal;
   static drive_t drv;
-  const hal_sil_board_t board = {0.0f, 1.0f, 0u, 1e-6f, 62.5e-6f, 50u, false, 0.0f, 0.0f};
+  const hal_sil_board_t board = {0.0f, 1.0f, 0u, 1e-6f, 62.5e-6f, 50u, false, 0.0f, 0.0f, 0.0f};
   hal_sil_init(&hal, &board);
   hal_sil_bind(&hal);
   drive_config_t cfg;

@@ -34,7 +34,7 @@ static rig_t rig; /* large: off the stack */
 
 static void rig_init(void) {
   memset(&rig, 0, sizeof rig);
-  const hal_sil_board_t board = {0.0f, 1.0f, 0u, 1e-6f, 62.5e-6f, 0u, false, 0.0f, 0.0f};
+  const hal_sil_board_t board = {0.0f, 1.0f, 0u, 1e-6f, 62.5e-6f, 0u, false, 0.0f, 0.0f, 0.0f};
   hal_sil_init(&rig.hal, &board);
   hal_sil_bind(&rig.hal);
   drive_config_t cfg;

@@ -42,7 +42,7 @@ static void test_every_telemetry_signal_has_a_row(void **state) {
 
 static void test_frames_carry_the_table(void **state) {
   (void)state;
-  const hal_sil_board_t board = {0.0f, 1.0f, 0u, 1e-6f, 62.5e-6f, 0u, false, 0.0f, 0.0f};
+  const hal_sil_board_t board = {0.0f, 1.0f, 0u, 1e-6f, 62.5e-6f, 0u, false, 0.0f, 0.0f, 0.0f};
   hal_sil_init(&hal, &board);
   hal_sil_bind(&hal);
   drive_config_t cfg;

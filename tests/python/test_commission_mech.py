@@ -7,7 +7,9 @@ noise, dead time (average inverter), Coulomb friction (a passive load of 1 %
 of the rated torque) and the machine's viscous friction. Each result
 against the plant's truth with the issue's limits: pole pairs exact,
 encoder offset within 1 deg electrical, lambda_m within 2 %, J within 5 %,
-friction (Coulomb and viscous) within 10 %; the true peak current within
+friction (Coulomb and viscous) within 10 % (mech's constant-speed plateaus;
+broken on purpose by hand: T_c, B left from the torque steps' fit, as on
+main, fail test_friction[preset] by T_c -17 %); the true peak current within
 each procedure's bound (1.3 id_i_test + 5 % i_max, proc_poles.c). The
 encoder's offset: the plant's encoder reads the rotor's d axis at zero, so
 the main run's truth is 0; a second run adds `inject.encoder_error` (a
@@ -168,9 +170,15 @@ def test_poles_enc_flux_inertia(case):
     assert _check(out, tr) == []
 
 
-@pytest.mark.xfail(reason="friction: 10-25 % off in the SIL (T_c, B), within 6 % on the unit "
-                          "tests' model: open (issue 25 g)", strict=False)
-@pytest.mark.parametrize("case", [c for c in CASES if c not in _XFAIL])
+# The friction from constant-speed plateaus (proc_mech.c): spm:1's viscous B
+# is +25 % (T_c -3.3 %): a 0.2 kg m^2 rotor whose B w at the top plateau is
+# small against T_c; open (docs/commissioning.md, mech).
+_XFAIL_FRICTION = {"spm:1": "spm:1: B +25 % from the plateaus (T_c -3.3 %): open (issue 25 g)"}
+
+
+@pytest.mark.parametrize("case", [
+    pytest.param(c, marks=pytest.mark.xfail(reason=_XFAIL_FRICTION[c], strict=True))
+    if c in _XFAIL_FRICTION else c for c in CASES if c not in _XFAIL])
 def test_friction(case):
     out, tr = _case(case)
     assert _check(out, tr, friction=True) == []

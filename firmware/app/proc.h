@@ -161,7 +161,6 @@ typedef struct {
   uint32_t n;        /* periods since it began */
   uint32_t calm_n;   /* periods the encoder's speed has stayed below w_calm */
   float phi;         /* the current's angle last period [rad] */
-  float lam;         /* the machine's lambda_m (a flux map's at zero current) [Vs] */
 } proc_align_t;
 
 typedef struct {
@@ -323,7 +322,6 @@ typedef struct {
   float acc_c, acc_s; /* the point's sums */
   uint32_t acc_n;
   float dir; /* +1, -1: the encoder counts with the vector's angle or against it */
-  float lam; /* the machine's lambda_m (a flux map's at zero current) [Vs] */
 } proc_enc_t;
 
 /* proc_flux.c: the rotor spun by the current loop on the encoder. */

@@ -64,7 +64,6 @@ FD_COLD static void align_init(proc_state_t *st, const proc_setup_t *su) {
   a->n = 0u;
   a->calm_n = 0u;
   a->phi = 0.0f;
-  a->lam = su->machine->lambda_m;
 }
 
 FD_COLD static int align_step(proc_state_t *st, const proc_setup_t *su, const proc_in_t *in,
@@ -72,7 +71,7 @@ FD_COLD static int align_step(proc_state_t *st, const proc_setup_t *su, const pr
   proc_align_t *a = &st->align;
   const drive_config_t *c = su->cfg;
   proc_align_timing_t tmg;
-  proc_align_timing(c, a->lam, &tmg);
+  proc_align_timing(c, su->machine->lambda_m, &tmg);
   /* mut: encoder_alignment_undamped */
   const bool enc = !su->gated && tmg.kd > 0.0f;
   const float w = in->pos->omega;

@@ -71,8 +71,6 @@ FD_COLD static void enc_init(proc_state_t *st, const proc_setup_t *su) {
     e->e[k] = 0.0f;
   }
   e->acc_c = e->acc_s = 0.0f;
-  /* mut: enc_timing_map_flux_ignored */
-  e->lam = su->machine->lambda_m;
   e->acc_n = 0u;
   e->dir = 0.0f;
 }
@@ -102,7 +100,10 @@ FD_COLD static int enc_step(proc_state_t *st, const proc_setup_t *su, const proc
   }
   const float th = proc_enc_unwrap(&e->u, in->s->enc_angle);
   const uint32_t n_move = (uint32_t)(PROC_ENC_MOVE / c->ts) + 1u;
-  const uint32_t n_settle = enc_n_settle(c, e->lam);
+  /* the machine's lambda_m, a flux map's too (the header) */
+  /* mut: enc_timing_map_flux_ignored */
+  const float lam = su->machine->lambda_m;
+  const uint32_t n_settle = enc_n_settle(c, lam);
   const uint32_t n_point = n_move + 2u * n_settle; /* move, settle, average */
   const unsigned last = 2u * PROC_ENC_POINTS;
   e->n_all++;
@@ -157,7 +158,7 @@ FD_COLD static int enc_step(proc_state_t *st, const proc_setup_t *su, const proc
   }
   /* the alignment's damping: the vector led against the encoder's speed */
   proc_align_timing_t tmg;
-  proc_align_timing(c, e->lam, &tmg);
+  proc_align_timing(c, lam, &tmg);
   const float w = e->dir * in->pos->omega; /* 0 until the direction is known */
   const float phi = e->theta_v + fd_clampf(-tmg.kd * w, -0.25f * FRAMES_PI, 0.25f * FRAMES_PI);
   const sincos_t sc = frames_sincos(frames_wrap_pi(phi));

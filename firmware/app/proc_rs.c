@@ -118,8 +118,10 @@ FD_COLD static void rs_init(proc_state_t *st, const proc_setup_t *su) {
   /* mut: rs_loop_rotor_gains */
   const machine_ldq_t l0 = machine_inductance(su->machine, (dq_t){0.0f, 0.0f});
   const float l_min = fminf(l0.dd, l0.qq);
-  r->loop = (machine_t){
-      MACHINE_LINEAR, su->machine->pole_pairs, su->machine->rs, l_min, l_min, 0.0f, NULL};
+  if (machine_init_linear(&r->loop, su->machine->pole_pairs, su->machine->rs, l_min, l_min, 0.0f) !=
+      0) {
+    r->loop = *su->machine; /* not a valid linear model (the set was checked): the machine's */
+  }
   const current_ctrl_cfg_t ccfg = {&r->loop, su->cfg->current_bw, su->cfg->ts};
   current_ctrl_init(&r->cc, &ccfg);
   r->n_levels = (uint8_t)su->cfg->id_rs_levels;

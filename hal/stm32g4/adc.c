@@ -349,7 +349,10 @@ const hal_caps_t *hal_caps(void) {
         BOARD_I_MID_V < BOARD_VDDA - BOARD_I_MID_V ? BOARD_I_MID_V : BOARD_VDDA - BOARD_I_MID_V;
     caps.i_full_scale = i_span * (BOARD_I_A_PER_V < 0.0f ? -BOARD_I_A_PER_V : BOARD_I_A_PER_V);
     caps.v_full_scale = BOARD_VDDA * BOARD_VDC_RATIO;
-    caps.i_lsb = 2.0f * caps.i_full_scale / 4096.0f; /* 12-bit conversions over the span */
+    /* one 12-bit step of VDDA through the amplifier (the full scale above is
+     * the shorter side of the mid-point, not half the span) */
+    caps.i_lsb =
+        BOARD_VDDA / 4096.0f * (BOARD_I_A_PER_V < 0.0f ? -BOARD_I_A_PER_V : BOARD_I_A_PER_V);
 #if BOARD_HAS_STAR_WINDOW
     /* the DFC window: independent edges, two star-point samples */
     caps.features = HAL_CAP_DWT_CYCLES | HAL_CAP_ASYM_EDGES | HAL_CAP_STAR_POINT;
